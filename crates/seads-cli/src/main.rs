@@ -1,0 +1,49 @@
+//! `seads`: the command line of the SEADS workspace — the only crate that prints.
+#![allow(clippy::print_stdout, clippy::print_stderr)] // printing is this crate's job
+
+mod games;
+
+use std::process::ExitCode;
+
+use clap::{Parser, Subcommand};
+
+/// SEADS: learn reward-free manipulation skills that play board games, and solve boards with them.
+#[derive(Debug, Parser)]
+#[command(name = "seads", version, about, long_about = None, propagate_version = true)]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Debug, Subcommand)]
+enum Command {
+    /// The discrete board games: depth tables, train/test splits, optimal solutions.
+    #[command(subcommand)]
+    Games(games::GamesCommand),
+    /// The main job on embedded defaults: print both depth tables and solve a sample board.
+    Run,
+}
+
+/// Input the user gave that cannot be used (exit code 2, like a usage error).
+#[derive(Debug, thiserror::Error)]
+#[error(transparent)]
+pub struct BadInput(#[from] pub anyhow::Error);
+
+fn main() -> ExitCode {
+    let cli = Cli::parse();
+    let result = match cli.command {
+        Command::Games(cmd) => games::run(cmd),
+        Command::Run => games::demo(),
+    };
+    match result {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(err) => {
+            eprintln!("error: {err:#}");
+            if err.is::<BadInput>() {
+                ExitCode::from(2)
+            } else {
+                ExitCode::FAILURE
+            }
+        }
+    }
+}

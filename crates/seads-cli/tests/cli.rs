@@ -1,0 +1,167 @@
+//! End-to-end tests of the `seads` binary.
+
+use std::process::{Command, Output};
+
+fn seads(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_seads"))
+        .args(args)
+        .output()
+        .expect("run seads")
+}
+
+fn json(args: &[&str]) -> serde_json::Value {
+    let out = seads(args);
+    assert!(
+        out.status.success(),
+        "seads {args:?}: {}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    serde_json::from_slice(&out.stdout).expect("valid JSON")
+}
+
+/// Exit code 2 and a single `error:` line on stderr.
+fn check_bad_input(args: &[&str], needle: &str) {
+    let out = seads(args);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "seads {args:?}: {stderr}");
+    assert_eq!(stderr.lines().count(), 1, "one line: {stderr}");
+    assert!(
+        stderr.starts_with("error: ") && stderr.contains(needle),
+        "{stderr}"
+    );
+}
+
+#[test]
+fn depths_json() {
+    let v = json(&["games", "depths", "--game", "tileswap", "--json"]);
+    assert_eq!(v["game"], "tileswap");
+    assert_eq!(v["size"], 3);
+    let counts: Vec<u64> = serde_json::from_value(v["counts"].clone()).unwrap();
+    assert_eq!(counts.len(), 17);
+    assert_eq!(counts[..4], [1, 12, 88, 470]);
+    let v = json(&[
+        "games",
+        "depths",
+        "--game",
+        "lightsout",
+        "--size",
+        "4",
+        "--json",
+    ]);
+    assert_eq!(
+        v["counts"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|c| c.as_u64().unwrap())
+            .sum::<u64>(),
+        1 << 12
+    );
+}
+
+#[test]
+fn split_json() {
+    let v = json(&["games", "split", "--game", "lightsout", "--json"]);
+    assert_eq!(v["train"], serde_json::json!([7, 99, 785, 4200, 17849]));
+    assert_eq!(v["test"], serde_json::json!([18, 201, 1515, 8450, 35281]));
+    let v = json(&[
+        "games",
+        "split",
+        "--game",
+        "tileswap",
+        "--max-depth",
+        "2",
+        "--json",
+    ]);
+    assert_eq!(v["train"], serde_json::json!([7, 31]));
+}
+
+#[test]
+fn solve_json_and_table() {
+    let board = "1,1,0,0,0,1,0,0,0,0,0,0,1,0,0,0,1,1,1,0,0,0,1,0,0";
+    let v = json(&[
+        "games",
+        "solve",
+        "--game",
+        "lightsout",
+        "--board",
+        board,
+        "--json",
+    ]);
+    assert_eq!(v["moves"], serde_json::json!([0, 17]));
+    assert_eq!(v["depth"], 2);
+    let v = json(&[
+        "games",
+        "solve",
+        "--game",
+        "tileswap",
+        "--board",
+        "3,1,2,0,4,5,6,7,8",
+        "--json",
+    ]);
+    assert_eq!(v["moves"], serde_json::json!([0]));
+    let out = seads(&[
+        "games",
+        "solve",
+        "--game",
+        "tileswap",
+        "--board",
+        "0,1,2,3,4,5,6,7,8",
+    ]);
+    assert!(String::from_utf8_lossy(&out.stdout).contains("already solved"));
+}
+
+#[test]
+fn bad_boards_get_one_line_and_exit_code_2() {
+    check_bad_input(
+        &["games", "solve", "--game", "lightsout", "--board", "1,0,1"],
+        "has 25 fields, got 3",
+    );
+    let two = format!("2{}", ",0".repeat(24));
+    check_bad_input(
+        &["games", "solve", "--game", "lightsout", "--board", &two],
+        "0 or 1",
+    );
+    check_bad_input(
+        &[
+            "games",
+            "solve",
+            "--game",
+            "tileswap",
+            "--board",
+            "0,1,2,3,4,5,6,7,7",
+        ],
+        "exactly once",
+    );
+    check_bad_input(
+        &[
+            "games",
+            "solve",
+            "--game",
+            "tileswap",
+            "--board",
+            "0,1,2,3,a,5,6,7,8",
+        ],
+        "field 4",
+    );
+    let corner = format!("1{}", ",0".repeat(24));
+    check_bad_input(
+        &["games", "solve", "--game", "lightsout", "--board", &corner],
+        "cannot be solved",
+    );
+    check_bad_input(
+        &["games", "depths", "--game", "lightsout", "--size", "7"],
+        "infeasible",
+    );
+    check_bad_input(
+        &["games", "depths", "--game", "tileswap", "--size", "4"],
+        "size 4",
+    );
+}
+
+#[test]
+fn unknown_game_is_a_usage_error() {
+    let out = seads(&["games", "depths", "--game", "chess"]);
+    assert_eq!(out.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("unknown game"));
+}

@@ -1,0 +1,182 @@
+//! Optimal LightsOut solutions by linear algebra over GF(2).
+//!
+//! Moves commute and are self-inverse, so a solution is a *set* of moves x with A·x = b, where
+//! column m of A is the mask of move m. The shortest solution is the lightest x in the coset
+//! x₀ + ker A; its weight is the board's solution depth (the BFS layer of SPEC §1.3).
+
+use crate::{BoardGame, GameError, LightsOut, MoveId, SymbolicState};
+
+/// A reusable solver for one LightsOut size: the elimination of A is done once, at construction.
+#[derive(Debug, Clone)]
+pub struct Gf2Solver {
+    dim: usize,
+    rank: usize,
+    /// Row r of the reduced system is the XOR of the original equations in `transform[r]`.
+    transform: Vec<SymbolicState>,
+    /// Pivot column of reduced row r, for r < rank.
+    pivots: Vec<usize>,
+    /// A basis of the null space of A ("quiet patterns").
+    kernel: Vec<SymbolicState>,
+}
+
+impl Gf2Solver {
+    /// Eliminates the move matrix of `game`.
+    pub fn new(game: &LightsOut) -> Self {
+        let dim = game.num_moves();
+        // The equation of field i: Σ_m [move m toggles i]·x_m = b_i. A is symmetric, so the
+        // coefficients of equation i are exactly the mask of move i.
+        let mut rows: Vec<SymbolicState> = (0..dim).map(|i| game.mask(i)).collect();
+        let mut transform: Vec<SymbolicState> = (0..dim)
+            .map(|i| {
+                let mut t = SymbolicState::ZERO;
+                t.set(i, true);
+                t
+            })
+            .collect();
+        let mut pivots = Vec::new();
+        for col in 0..dim {
+            let r = pivots.len();
+            let Some(p) = (r..dim).find(|&i| rows[i].get(col)) else {
+                continue;
+            };
+            rows.swap(r, p);
+            transform.swap(r, p);
+            for i in 0..dim {
+                if i != r && rows[i].get(col) {
+                    let (row, t) = (rows[r], transform[r]);
+                    rows[i] ^= row;
+                    transform[i] ^= t;
+                }
+            }
+            pivots.push(col);
+        }
+        let rank = pivots.len();
+        let kernel = (0..dim)
+            .filter(|c| !pivots.contains(c))
+            .map(|free| {
+                let mut v = SymbolicState::ZERO;
+                v.set(free, true);
+                for (r, &p) in pivots.iter().enumerate() {
+                    if rows[r].get(free) {
+                        v.set(p, true);
+                    }
+                }
+                v
+            })
+            .collect();
+        Self {
+            dim,
+            rank,
+            transform,
+            pivots,
+            kernel,
+        }
+    }
+
+    /// Rank of the move matrix (23 for 5×5, so 2^23 boards are solvable).
+    pub fn rank(&self) -> usize {
+        self.rank
+    }
+
+    /// Dimension of the null space: every solvable board has 2^nullity solutions.
+    pub fn nullity(&self) -> usize {
+        self.dim - self.rank
+    }
+
+    /// The quiet patterns spanning the null space.
+    pub fn kernel(&self) -> &[SymbolicState] {
+        &self.kernel
+    }
+
+    /// Whether some set of moves turns `board` off.
+    pub fn is_solvable(&self, board: SymbolicState) -> bool {
+        (self.rank..self.dim).all(|r| !parity(self.transform[r] & board))
+    }
+
+    /// A shortest set of moves turning `board` off, as ascending move ids.
+    pub fn solve(&self, board: SymbolicState) -> Result<Vec<MoveId>, GameError> {
+        Ok(self.optimal_moves(board)?.ones().collect())
+    }
+
+    /// The solution depth of `board` (length of a shortest solution).
+    pub fn depth(&self, board: SymbolicState) -> Result<usize, GameError> {
+        Ok(self.optimal_moves(board)?.count_ones() as usize)
+    }
+
+    /// The lightest solution vector; ties go to the first found in Gray-code order.
+    fn optimal_moves(&self, board: SymbolicState) -> Result<SymbolicState, GameError> {
+        if !self.is_solvable(board) {
+            return Err(GameError::Unsolvable { game: "lightsout" });
+        }
+        let mut x = SymbolicState::ZERO;
+        for (r, &p) in self.pivots.iter().enumerate() {
+            if parity(self.transform[r] & board) {
+                x.set(p, true);
+            }
+        }
+        let mut best = x;
+        for i in 1u64..(1 << self.kernel.len()) {
+            x ^= self.kernel[i.trailing_zeros() as usize];
+            if x.count_ones() < best.count_ones() {
+                best = x;
+            }
+        }
+        Ok(best)
+    }
+}
+
+fn parity(z: SymbolicState) -> bool {
+    z.count_ones() % 2 == 1
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn five_by_five_has_rank_23_and_weight_12_quiet_patterns() {
+        let s = Gf2Solver::new(&LightsOut::new(5).unwrap());
+        assert_eq!(s.rank(), 23);
+        assert_eq!(s.nullity(), 2);
+        let g = LightsOut::new(5).unwrap();
+        for &k in s.kernel() {
+            let pressed: Vec<MoveId> = k.ones().collect();
+            assert!(
+                g.is_goal(g.apply_all(g.goal(), &pressed)),
+                "quiet pattern changes nothing"
+            );
+            assert!(k.count_ones() >= 12);
+        }
+    }
+
+    #[test]
+    fn unsolvable_board_is_reported() {
+        let g = LightsOut::new(5).unwrap();
+        let s = Gf2Solver::new(&g);
+        let mut board = g.goal();
+        board.set(0, true); // a single lit corner is not in the image of A for 5×5
+        assert_eq!(
+            s.solve(board),
+            Err(GameError::Unsolvable { game: "lightsout" })
+        );
+    }
+
+    #[test]
+    fn solves_known_board_optimally() {
+        let g = LightsOut::new(5).unwrap();
+        let s = Gf2Solver::new(&g);
+        let board = g.apply_all(g.goal(), &[3, 7, 19]);
+        assert_eq!(s.solve(board).unwrap(), vec![3, 7, 19]);
+        assert_eq!(s.depth(g.goal()).unwrap(), 0);
+    }
+
+    #[test]
+    fn thirteen_by_thirteen_is_invertible() {
+        let g = LightsOut::new(13).unwrap();
+        let s = Gf2Solver::new(&g);
+        let board = g.apply_all(g.goal(), &[0, 84, 168]);
+        let moves = s.solve(board).unwrap();
+        assert!(g.is_goal(g.apply_all(board, &moves)));
+        assert!(moves.len() <= 3);
+    }
+}

@@ -1,0 +1,168 @@
+//! LightsOut N×N (SPEC §1.1): pressing a field toggles it and its edge neighbours.
+
+use crate::{BoardGame, GameError, GameKind, MoveId, SymbolicState};
+
+/// LightsOut on an N×N board, 3 ≤ N ≤ 13. Bit `row·N + col` of a board is 1 iff that light is on.
+#[derive(Debug, Clone)]
+pub struct LightsOut {
+    n: usize,
+    masks: Vec<SymbolicState>,
+    /// The low 32 bits of every mask: the whole mask when N ≤ 5 (used by the enumeration).
+    masks_low: Vec<u32>,
+}
+
+impl LightsOut {
+    /// Smallest supported side length.
+    pub const MIN_SIZE: usize = 3;
+    /// Largest supported side length (13×13 = 169 bits fit a [`SymbolicState`]).
+    pub const MAX_SIZE: usize = 13;
+
+    /// LightsOut on an `n`×`n` board.
+    pub fn new(n: usize) -> Result<Self, GameError> {
+        if !(Self::MIN_SIZE..=Self::MAX_SIZE).contains(&n) {
+            return Err(GameError::UnsupportedSize {
+                game: "lightsout",
+                size: n,
+                allowed: "3 to 13",
+            });
+        }
+        let masks = (0..n * n)
+            .map(|m| {
+                let (r, c) = (m / n, m % n);
+                let mut mask = SymbolicState::ZERO;
+                mask.set(m, true);
+                if r > 0 {
+                    mask.set(m - n, true);
+                }
+                if r + 1 < n {
+                    mask.set(m + n, true);
+                }
+                if c > 0 {
+                    mask.set(m - 1, true);
+                }
+                if c + 1 < n {
+                    mask.set(m + 1, true);
+                }
+                mask
+            })
+            .collect::<Vec<SymbolicState>>();
+        let masks_low = masks.iter().map(|m| m.low_u64() as u32).collect();
+        Ok(Self {
+            n,
+            masks,
+            masks_low,
+        })
+    }
+
+    /// The set of fields toggled by move `mv`.
+    pub fn mask(&self, mv: MoveId) -> SymbolicState {
+        self.masks[mv]
+    }
+
+    /// The move masks as 32-bit words; complete only for N ≤ 5, where a board fits 25 bits.
+    pub(crate) fn masks_low(&self) -> &[u32] {
+        &self.masks_low
+    }
+}
+
+impl BoardGame for LightsOut {
+    fn kind(&self) -> GameKind {
+        GameKind::LightsOut
+    }
+    fn size(&self) -> usize {
+        self.n
+    }
+    fn num_moves(&self) -> usize {
+        self.n * self.n
+    }
+    fn symbolic_len(&self) -> usize {
+        self.n * self.n
+    }
+    fn goal(&self) -> SymbolicState {
+        SymbolicState::ZERO
+    }
+    #[inline]
+    fn apply(&self, board: SymbolicState, mv: MoveId) -> SymbolicState {
+        board ^ self.masks[mv]
+    }
+    fn values(&self, board: SymbolicState) -> Vec<u8> {
+        (0..self.n * self.n).map(|d| board.get(d) as u8).collect()
+    }
+    fn board_from_values(&self, values: &[u8]) -> Result<SymbolicState, GameError> {
+        let expected = self.n * self.n;
+        if values.len() != expected {
+            return Err(GameError::WrongLength {
+                game: "lightsout",
+                expected,
+                found: values.len(),
+            });
+        }
+        let mut z = SymbolicState::ZERO;
+        for (index, &v) in values.iter().enumerate() {
+            match v {
+                0 => {}
+                1 => z.set(index, true),
+                _ => {
+                    return Err(GameError::BadSymbol {
+                        game: "lightsout",
+                        index,
+                        symbol: v.to_string(),
+                        allowed: "0 or 1",
+                    });
+                }
+            }
+        }
+        Ok(z)
+    }
+    fn is_valid(&self, z: SymbolicState) -> bool {
+        z.ones().all(|d| d < self.n * self.n)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn corner_edge_interior_presses_toggle_3_4_5_fields() {
+        let g = LightsOut::new(5).unwrap();
+        assert_eq!(g.mask(0).ones().collect::<Vec<_>>(), vec![0, 1, 5]);
+        assert_eq!(g.mask(2).count_ones(), 4);
+        assert_eq!(
+            g.mask(12).ones().collect::<Vec<_>>(),
+            vec![7, 11, 12, 13, 17]
+        );
+        assert_eq!(g.mask(24).ones().collect::<Vec<_>>(), vec![19, 23, 24]);
+    }
+
+    #[test]
+    fn sizes_outside_3_to_13_are_rejected() {
+        assert!(LightsOut::new(2).is_err());
+        assert!(LightsOut::new(14).is_err());
+        assert_eq!(LightsOut::new(13).unwrap().num_moves(), 169);
+    }
+
+    #[test]
+    fn parse_errors_name_the_problem() {
+        let g = LightsOut::new(3).unwrap();
+        assert_eq!(
+            g.parse("1,0,1"),
+            Err(GameError::WrongLength {
+                game: "lightsout",
+                expected: 9,
+                found: 3
+            })
+        );
+        assert!(matches!(
+            g.parse("1,0,1,0,2,0,0,0,0"),
+            Err(GameError::BadSymbol { index: 4, .. })
+        ));
+        assert!(matches!(
+            g.parse("1,0,x,0,1,0,0,0,0"),
+            Err(GameError::BadSymbol { index: 2, .. })
+        ));
+        let b = g.parse("1, 1,0,1,0,0,0,0,0").unwrap();
+        assert_eq!(g.format(b), "1,1,0,1,0,0,0,0,0");
+        assert_eq!(b, g.apply(g.goal(), 0));
+    }
+}

@@ -1,0 +1,210 @@
+//! TileSwap 3×3 (SPEC §1.2): swap two edge-adjacent tiles; z is the 81-bit one-hot matrix.
+
+use crate::{BoardGame, GameError, GameKind, MoveId, SymbolicState};
+
+/// Number of cells (and tiles) of the 3×3 board.
+const CELLS: usize = 9;
+
+/// The 12 swaps by move id (SPEC §1.2 table): ids 0–5 swap a cell with the cell below it,
+/// ids 6–11 with the cell to its right.
+const SWAPS: [(usize, usize); 12] = {
+    let mut swaps = [(0, 0); 12];
+    let mut id = 0;
+    while id < 12 {
+        swaps[id] = if id < 6 {
+            let (r, c) = (id % 2, id / 2);
+            (3 * r + c, 3 * (r + 1) + c)
+        } else {
+            let m = id - 6;
+            let (r, c) = (m % 3, m / 3);
+            (3 * r + c, 3 * r + c + 1)
+        };
+        id += 1;
+    }
+    swaps
+};
+
+/// TileSwap on the 3×3 board. A board holds a permutation of the tile ids 0..8; the goal has
+/// tile `3r + c` at cell (r, c). Bit `9p + t` of z is 1 iff tile t lies in cell p.
+#[derive(Debug, Clone, Default)]
+pub struct TileSwap;
+
+impl TileSwap {
+    /// TileSwap 3×3.
+    pub fn new() -> Self {
+        TileSwap
+    }
+
+    /// TileSwap of side `n`; only 3 is defined (SPEC §1.2).
+    pub fn with_size(n: usize) -> Result<Self, GameError> {
+        if n == 3 {
+            Ok(TileSwap)
+        } else {
+            Err(GameError::UnsupportedSize {
+                game: "tileswap",
+                size: n,
+                allowed: "3",
+            })
+        }
+    }
+
+    /// The two row-major cells exchanged by move `mv`.
+    pub fn swap_cells(mv: MoveId) -> (usize, usize) {
+        SWAPS[mv]
+    }
+
+    /// The tiles per cell of a board given as its one-hot symbolic state.
+    pub fn tiles(z: SymbolicState) -> [u8; CELLS] {
+        let bits = z.low_u128();
+        std::array::from_fn(|p| (((bits >> (9 * p)) & 0x1ff) as u16).trailing_zeros() as u8)
+    }
+
+    /// The one-hot symbolic state of a permutation (tile per cell).
+    pub fn from_tiles(tiles: &[u8; CELLS]) -> SymbolicState {
+        let bits = tiles
+            .iter()
+            .enumerate()
+            .fold(0u128, |acc, (p, &t)| acc | 1u128 << (9 * p + t as usize));
+        SymbolicState::from_u128(bits)
+    }
+}
+
+impl BoardGame for TileSwap {
+    fn kind(&self) -> GameKind {
+        GameKind::TileSwap
+    }
+    fn size(&self) -> usize {
+        3
+    }
+    fn num_moves(&self) -> usize {
+        SWAPS.len()
+    }
+    fn symbolic_len(&self) -> usize {
+        CELLS * CELLS
+    }
+    fn goal(&self) -> SymbolicState {
+        Self::from_tiles(&[0, 1, 2, 3, 4, 5, 6, 7, 8])
+    }
+    #[inline]
+    fn apply(&self, board: SymbolicState, mv: MoveId) -> SymbolicState {
+        let (p, q) = SWAPS[mv];
+        let bits = board.low_u128();
+        let diff = ((bits >> (9 * p)) ^ (bits >> (9 * q))) & 0x1ff;
+        SymbolicState::from_u128(bits ^ (diff << (9 * p)) ^ (diff << (9 * q)))
+    }
+    fn values(&self, board: SymbolicState) -> Vec<u8> {
+        Self::tiles(board).to_vec()
+    }
+    fn board_from_values(&self, values: &[u8]) -> Result<SymbolicState, GameError> {
+        if values.len() != CELLS {
+            return Err(GameError::WrongLength {
+                game: "tileswap",
+                expected: CELLS,
+                found: values.len(),
+            });
+        }
+        let mut counts = [0usize; CELLS];
+        for (index, &v) in values.iter().enumerate() {
+            if v as usize >= CELLS {
+                return Err(GameError::BadSymbol {
+                    game: "tileswap",
+                    index,
+                    symbol: v.to_string(),
+                    allowed: "a tile id 0..8",
+                });
+            }
+            counts[v as usize] += 1;
+        }
+        if let Some(tile) = (0..CELLS).find(|&t| counts[t] != 1) {
+            return Err(GameError::NotPermutation {
+                tile: tile as u8,
+                count: counts[tile],
+            });
+        }
+        let tiles: [u8; CELLS] = values.try_into().expect("length checked");
+        Ok(Self::from_tiles(&tiles))
+    }
+    fn is_valid(&self, z: SymbolicState) -> bool {
+        let bits = z.low_u128();
+        if z.words()[2] != 0 || bits >> 81 != 0 {
+            return false;
+        }
+        let mut seen = 0u16;
+        for p in 0..CELLS {
+            let block = ((bits >> (9 * p)) & 0x1ff) as u16;
+            if block.count_ones() != 1 {
+                return false;
+            }
+            seen |= block;
+        }
+        seen == 0x1ff
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn move_table_matches_spec() {
+        let expected = [
+            (0, 3),
+            (3, 6),
+            (1, 4),
+            (4, 7),
+            (2, 5),
+            (5, 8),
+            (0, 1),
+            (3, 4),
+            (6, 7),
+            (1, 2),
+            (4, 5),
+            (7, 8),
+        ];
+        assert_eq!(SWAPS, expected);
+    }
+
+    #[test]
+    fn goal_is_identity_matrix() {
+        let g = TileSwap::new();
+        let z = g.goal();
+        assert_eq!(
+            z.ones().collect::<Vec<_>>(),
+            (0..9).map(|p| 10 * p).collect::<Vec<_>>()
+        );
+        assert_eq!(g.format(z), "0,1,2,3,4,5,6,7,8");
+        assert!(g.is_valid(z));
+    }
+
+    #[test]
+    fn apply_swaps_tiles() {
+        let g = TileSwap::new();
+        let z = g.apply(g.goal(), 0);
+        assert_eq!(TileSwap::tiles(z), [3, 1, 2, 0, 4, 5, 6, 7, 8]);
+        let z = g.apply(g.goal(), 6);
+        assert_eq!(g.format(z), "1,0,2,3,4,5,6,7,8");
+    }
+
+    #[test]
+    fn parse_rejects_non_permutations() {
+        let g = TileSwap::new();
+        assert!(matches!(
+            g.parse("0,1,2,3,4,5,6,7,7"),
+            Err(GameError::NotPermutation { tile: 7, count: 2 })
+        ));
+        assert!(matches!(
+            g.parse("0,1,2,3,4,5,6,7,9"),
+            Err(GameError::BadSymbol { index: 8, .. })
+        ));
+        assert!(matches!(
+            g.parse("0,1,2"),
+            Err(GameError::WrongLength {
+                expected: 9,
+                found: 3,
+                ..
+            })
+        ));
+        assert!(TileSwap::with_size(4).is_err());
+        assert!(!g.is_valid(SymbolicState::from_u64(3)));
+    }
+}

@@ -1,0 +1,86 @@
+//! `cargo xtask <command>`: project automation, so that local checks and CI are one command.
+#![allow(clippy::print_stdout, clippy::print_stderr)] // a command-line tool
+
+mod ci;
+mod gen_splits;
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, ExitCode};
+
+use anyhow::{Context, Result, bail};
+
+const HELP: &str = "\
+cargo xtask <command>
+
+Commands:
+  run          set up libtorch if needed, build in release mode and run `seads run` (the main job)
+  ci           set up, then cargo fmt --check, clippy -D warnings, and every test (what CI runs)
+  setup        install libtorch for tch into .venv / .libtorch (idempotent; scripts/setup.sh)
+  gen-splits   write data/depth_counts.csv and data/split_counts.csv from a fresh enumeration
+";
+
+fn main() -> ExitCode {
+    let args: Vec<String> = std::env::args().skip(1).collect();
+    let result = match args.first().map(String::as_str) {
+        Some("run") => run_main_job(&args[1..]),
+        Some("ci") => ci::run(),
+        Some("setup") => setup(),
+        Some("gen-splits") => gen_splits::run(&root()),
+        Some("help" | "--help" | "-h") | None => {
+            print!("{HELP}");
+            Ok(())
+        }
+        Some(other) => {
+            eprint!("unknown command {other:?}\n\n{HELP}");
+            return ExitCode::from(2);
+        }
+    };
+    match result {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(err) => {
+            eprintln!("xtask: {err:#}");
+            ExitCode::FAILURE
+        }
+    }
+}
+
+/// The repository root (the parent of this crate's folder).
+fn root() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .parent()
+        .expect("xtask lives in the workspace")
+        .to_path_buf()
+}
+
+/// Runs a command in the repository root and fails if it fails.
+fn step(program: &str, args: &[&str]) -> Result<()> {
+    eprintln!("xtask: $ {program} {}", args.join(" "));
+    let status = Command::new(program)
+        .args(args)
+        .current_dir(root())
+        .status()
+        .with_context(|| format!("could not start {program}"))?;
+    if !status.success() {
+        bail!("`{program} {}` failed ({status})", args.join(" "));
+    }
+    Ok(())
+}
+
+fn setup() -> Result<()> {
+    step("bash", &["scripts/setup.sh"])
+}
+
+fn run_main_job(extra: &[String]) -> Result<()> {
+    setup()?;
+    let mut args = vec![
+        "run",
+        "--release",
+        "--quiet",
+        "-p",
+        "seads-cli",
+        "--",
+        "run",
+    ];
+    args.extend(extra.iter().map(String::as_str));
+    step("cargo", &args)
+}
