@@ -1,3 +1,34 @@
 //! Embodied environments of SEADS (SPEC §2): a continuous manipulator — Cursor, planar Reacher,
-//! Kinova Jaco — in front of a board game, with the ground-truth symbolic mapping Φ(s) = z.
-//! Will own the environment trait, the environments, their registry and a batched runner.
+//! Kinova Jaco — in front of a board game.
+//!
+//! [`Environment`] is the narrow trait every later stage uses: reset with a seed, step, the
+//! observation `[manipulator state, z, ρ]`, the ground-truth symbolic mapping Φ(s) = z, setting
+//! the board. [`Embodied`] implements it once for every [`Manipulator`]; the board side (reset
+//! distribution, push layout, step counter) is shared. Environments are built by name with
+//! [`make_env`], and [`VecEnv`] steps a batch of them.
+//!
+//! Architecture invariant: pure simulation. No printing and no files; randomness only from the
+//! seeded streams of each environment (`seed`), so the same seed gives the same episode.
+
+mod board;
+mod config;
+mod cursor;
+mod embodied;
+mod error;
+mod layout;
+mod reacher;
+mod registry;
+mod runner;
+mod scene;
+mod spec;
+
+pub use config::EnvConfig;
+pub use cursor::Cursor;
+pub use embodied::{Embodied, Environment, Manipulator, Touch};
+pub use error::EnvError;
+pub use layout::Layout;
+pub use reacher::Reacher;
+pub use registry::{EnvInfo, env_names, list_envs, make_env};
+pub use runner::VecEnv;
+pub use scene::{FieldView, Scene, Shape};
+pub use spec::{EnvSpec, Push, StepOutcome};

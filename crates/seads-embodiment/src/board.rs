@@ -1,0 +1,114 @@
+//! The board inside an environment: the game, its current state and the reset distribution.
+
+use std::collections::BTreeMap;
+use std::sync::{Arc, Mutex, OnceLock};
+
+use rand::{RngExt, SeedableRng};
+use rand_chacha::ChaCha8Rng;
+use seads_games::{
+    BoardDataset, BoardGame, GameKind, LightsOut, MoveId, Split, SymbolicState, TileSwap, sample_by_action_sampling,
+};
+
+use crate::{EnvConfig, EnvError};
+
+/// Where reset boards come from.
+#[derive(Clone)]
+enum BoardSource {
+    /// Uniform among the enumerated boards of a depth and split (LightsOut ≤ 5×5, TileSwap).
+    Dataset(Arc<BoardDataset>),
+    /// Distinct random moves from the goal, redrawn until the split matches (larger boards).
+    ActionSampling,
+}
+
+/// The game part of an environment, with its own RNG stream (SPEC §1.5).
+#[derive(Clone)]
+pub(crate) struct BoardState {
+    game: Arc<dyn BoardGame>,
+    source: BoardSource,
+    split: Split,
+    max_depth: usize,
+    random_depth: bool,
+    board: SymbolicState,
+    rng: ChaCha8Rng,
+}
+
+impl BoardState {
+    /// A board of `kind` and `size` with the reset distribution of `config`.
+    pub fn new(kind: GameKind, size: usize, config: &EnvConfig) -> Result<Self, EnvError> {
+        let game: Arc<dyn BoardGame> = Arc::from(kind.build(size)?);
+        let max_depth = config.max_solution_depth;
+        let source = if kind == GameKind::TileSwap || size <= 5 {
+            let data = dataset(kind, size, max_depth);
+            let split = config.reset_split;
+            let depths = if config.random_solution_depth { 1..=max_depth } else { max_depth..=max_depth };
+            if let Some(d) = depths.clone().find(|&d| data.boards(d, split).is_empty()) {
+                return Err(EnvError::InvalidConfig(format!(
+                    "{kind} {size}×{size} has no {split} boards of solution depth {d} (max_solution_depth = {max_depth})"
+                )));
+            }
+            BoardSource::Dataset(data)
+        } else {
+            BoardSource::ActionSampling
+        };
+        let goal = game.goal();
+        Ok(Self {
+            game,
+            source,
+            split: config.reset_split,
+            max_depth,
+            random_depth: config.random_solution_depth,
+            board: goal,
+            rng: ChaCha8Rng::seed_from_u64(0),
+        })
+    }
+
+    pub fn game(&self) -> &dyn BoardGame {
+        self.game.as_ref()
+    }
+
+    pub fn board(&self) -> SymbolicState {
+        self.board
+    }
+
+    pub fn seed(&mut self, seed: u64) {
+        self.rng = ChaCha8Rng::seed_from_u64(seed);
+    }
+
+    /// Draws a new board from the reset distribution.
+    pub fn reset(&mut self) {
+        let depth = if self.random_depth { self.rng.random_range(1..=self.max_depth) } else { self.max_depth };
+        self.board = match &self.source {
+            BoardSource::Dataset(data) => data.sample(depth, self.split, &mut self.rng).expect("checked in new()"),
+            BoardSource::ActionSampling => sample_by_action_sampling(self.game.as_ref(), depth, self.split, &mut self.rng),
+        };
+    }
+
+    /// Puts the board into `board` (for evaluation and replay).
+    pub fn set(&mut self, board: SymbolicState) -> Result<(), EnvError> {
+        if !self.game.is_valid(board) {
+            return Err(EnvError::InvalidConfig(format!("not a valid {} board: {board:?}", self.game.kind())));
+        }
+        self.board = board;
+        Ok(())
+    }
+
+    pub fn apply(&mut self, mv: MoveId) {
+        self.board = self.game.apply(self.board, mv);
+    }
+}
+
+/// Enumerated boards are shared by every environment of the same game, size and depth.
+fn dataset(kind: GameKind, size: usize, max_depth: usize) -> Arc<BoardDataset> {
+    static CACHE: OnceLock<Mutex<BTreeMap<(GameKind, usize, usize), Arc<BoardDataset>>>> = OnceLock::new();
+    let mut cache = CACHE.get_or_init(Default::default).lock().unwrap_or_else(|e| e.into_inner());
+    cache
+        .entry((kind, size, max_depth))
+        .or_insert_with(|| {
+            let data = match kind {
+                GameKind::LightsOut => BoardDataset::build(&LightsOut::new(size).expect("size checked"), max_depth),
+                GameKind::TileSwap => BoardDataset::build(&TileSwap::new(), max_depth),
+            };
+            Arc::new(data.expect("LightsOut ≤ 5×5 and TileSwap are enumerable"))
+        })
+        .clone()
+}

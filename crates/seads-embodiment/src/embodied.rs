@@ -1,0 +1,271 @@
+//! The environment trait and `Embodied<M>`: a manipulator in front of a board, with the step
+//! counter, remaining-time entry and termination rules every embodiment shares (SPEC §2.1).
+
+use rand::SeedableRng;
+use rand_chacha::ChaCha8Rng;
+use seads_games::{MoveId, SymbolicState};
+
+use crate::board::BoardState;
+use crate::{EnvError, EnvSpec, FieldView, Layout, Push, Scene, Shape, StepOutcome};
+
+/// A continuous manipulator in front of a board game (SPEC §2).
+///
+/// The observation is `[manipulator state, z, ρ]` with ρ = (T_max − t)/T_max the remaining time
+/// of the current skill. A step ends the skill (`done`) when it moved the board or reached T_max.
+pub trait Environment: Send + Sync {
+    /// Dimensions, bounds and name.
+    fn spec(&self) -> &EnvSpec;
+    /// Re-seeds the board's and the manipulator's random streams (both from `seed`).
+    fn seed(&mut self, seed: u64);
+    /// Draws a new board and manipulator state and resets the step counter.
+    fn reset(&mut self);
+    /// Applies one action. Errors on an action of the wrong length or with a non-finite entry,
+    /// on a step past the step limit, and when the simulation diverges.
+    fn step(&mut self, action: &[f32]) -> Result<StepOutcome, EnvError>;
+    /// Writes the current observation (`spec().obs_dim` values).
+    fn observe(&self, out: &mut [f32]);
+    /// The current symbolic state z = Φ(s).
+    fn board(&self) -> SymbolicState;
+    /// Puts the board into `board`, keeping the manipulator where it is.
+    fn set_board(&mut self, board: SymbolicState) -> Result<(), EnvError>;
+    /// Restarts the step counter (before each skill of a plan; the environment is not reset).
+    fn reset_step_counter(&mut self);
+    /// Changes the step limit (`None`: unlimited, as for recording long episodes).
+    fn set_step_limit(&mut self, limit: Option<usize>);
+    /// Puts the manipulator into the state given by the manipulator part of an observation.
+    fn restore_manipulator(&mut self, state: &[f32]) -> Result<(), EnvError>;
+    /// A top view of the board and the manipulator.
+    fn scene(&self) -> Scene;
+    /// A boxed copy (same state, same random streams).
+    fn box_clone(&self) -> Box<dyn Environment>;
+
+    /// The current observation as a new vector.
+    fn observation(&self) -> Vec<f32> {
+        let mut obs = vec![0.0; self.spec().obs_dim];
+        self.observe(&mut obs);
+        obs
+    }
+}
+
+impl Clone for Box<dyn Environment> {
+    fn clone(&self) -> Self {
+        self.box_clone()
+    }
+}
+
+/// Where the manipulator touched the board during a step.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Touch {
+    /// A push at normalised board coordinates (u, v), resolved by the board's [`Layout`].
+    At {
+        /// Column direction, 0..1.
+        u: f64,
+        /// Row direction, 0..1.
+        v: f64,
+    },
+    /// A press detected on a given LightsOut field (Jaco's per-field touch sensors).
+    Field(MoveId),
+}
+
+/// The embodiment-specific part of an environment: state, dynamics, observation.
+pub trait Manipulator: Clone + Send + Sync + 'static {
+    /// Length M of the manipulator observation.
+    fn state_dim(&self) -> usize;
+    /// Lower and upper action bounds.
+    fn action_bounds(&self) -> (Vec<f32>, Vec<f32>);
+    /// Default steps per skill T_max.
+    fn default_step_limit(&self) -> usize;
+    /// Draws a random initial state.
+    fn reset(&mut self, rng: &mut ChaCha8Rng);
+    /// Advances one environment step under a finite, correctly sized `action`. Each touch of the
+    /// board is reported to `touch`, which answers what it did; once it answered a move, later
+    /// touches of the same step are ignored by the board. Returns `false` if the state diverged.
+    fn step(&mut self, action: &[f32], rng: &mut ChaCha8Rng, touch: &mut dyn FnMut(Touch) -> Push) -> bool;
+    /// Writes the manipulator observation (M values).
+    fn observe(&self, out: &mut [f32]);
+    /// Sets the state from a manipulator observation; `Err(reason)` if it is not a valid state or
+    /// the observation does not determine the state.
+    fn restore(&mut self, state: &[f32]) -> Result<(), String>;
+    /// Whether [`Manipulator::restore`] can rebuild the full state from an observation.
+    fn can_restore(&self) -> bool {
+        true
+    }
+    /// Draws the manipulator and widens `extent` to what it can reach.
+    fn draw(&self, shapes: &mut Vec<Shape>, extent: &mut [f64; 4]);
+}
+
+/// A manipulator `M` in front of a board: implements [`Environment`] for every embodiment.
+#[derive(Clone)]
+pub struct Embodied<M: Manipulator> {
+    spec: EnvSpec,
+    manipulator: M,
+    board: BoardState,
+    layout: Layout,
+    rng: ChaCha8Rng,
+    steps: usize,
+}
+
+impl<M: Manipulator> Embodied<M> {
+    pub(crate) fn new(name: &str, manipulator: M, board: BoardState, layout: Layout, step_limit: Option<usize>) -> Self {
+        let game = board.game();
+        let (action_low, action_high) = manipulator.action_bounds();
+        let spec = EnvSpec {
+            name: name.to_owned(),
+            game: game.kind(),
+            board_size: game.size(),
+            manipulator_dim: manipulator.state_dim(),
+            symbolic_len: game.symbolic_len(),
+            obs_dim: manipulator.state_dim() + game.symbolic_len() + 1,
+            action_dim: action_low.len(),
+            action_low,
+            action_high,
+            num_skills: game.num_moves(),
+            step_limit: Some(step_limit.unwrap_or(manipulator.default_step_limit())),
+        };
+        let mut env = Self { spec, manipulator, board, layout, rng: ChaCha8Rng::seed_from_u64(0), steps: 0 };
+        env.seed(0);
+        env.reset();
+        env
+    }
+
+    /// The manipulator.
+    pub fn manipulator(&self) -> &M {
+        &self.manipulator
+    }
+
+    fn check_action(&self, action: &[f32]) -> Result<(), EnvError> {
+        if action.len() != self.spec.action_dim {
+            return Err(EnvError::ActionLength {
+                env: self.spec.name.clone(),
+                expected: self.spec.action_dim,
+                found: action.len(),
+            });
+        }
+        if let Some(index) = action.iter().position(|a| !a.is_finite()) {
+            return Err(EnvError::NonFiniteAction { env: self.spec.name.clone(), index, value: action[index] });
+        }
+        Ok(())
+    }
+}
+
+impl<M: Manipulator> Environment for Embodied<M> {
+    fn spec(&self) -> &EnvSpec {
+        &self.spec
+    }
+
+    fn seed(&mut self, seed: u64) {
+        self.board.seed(seed);
+        self.rng = ChaCha8Rng::seed_from_u64(seed);
+    }
+
+    fn reset(&mut self) {
+        self.board.reset();
+        self.manipulator.reset(&mut self.rng);
+        self.steps = 0;
+    }
+
+    fn step(&mut self, action: &[f32]) -> Result<StepOutcome, EnvError> {
+        self.check_action(action)?;
+        if let Some(limit) = self.spec.step_limit
+            && self.steps >= limit
+        {
+            return Err(EnvError::StepLimitReached { env: self.spec.name.clone(), limit });
+        }
+        let (board, layout) = (&mut self.board, self.layout);
+        let mut push = Push::None;
+        let finite = self.manipulator.step(action, &mut self.rng, &mut |touch| {
+            if matches!(push, Push::Move(_)) {
+                return Push::None; // at most one move per step
+            }
+            let result = match touch {
+                Touch::At { u, v } => layout.locate(u, v).map_or(Push::Miss, Push::Move),
+                Touch::Field(mv) => Push::Move(mv),
+            };
+            match result {
+                Push::Move(mv) => {
+                    board.apply(mv);
+                    push = result;
+                }
+                Push::Miss => push = Push::Miss,
+                Push::None => {}
+            }
+            result
+        });
+        self.steps += 1;
+        if !finite {
+            return Err(EnvError::NonFiniteState { env: self.spec.name.clone(), steps: self.steps });
+        }
+        let truncated = self.spec.step_limit.is_some_and(|l| self.steps >= l);
+        Ok(StepOutcome { push, truncated })
+    }
+
+    fn observe(&self, out: &mut [f32]) {
+        let (m, d) = (self.spec.manipulator_dim, self.spec.symbolic_len);
+        self.manipulator.observe(&mut out[..m]);
+        self.board.board().write_f32(&mut out[m..m + d]);
+        out[m + d] = match self.spec.step_limit {
+            Some(limit) => limit.saturating_sub(self.steps) as f32 / limit as f32,
+            None => 1.0,
+        };
+    }
+
+    fn board(&self) -> SymbolicState {
+        self.board.board()
+    }
+
+    fn set_board(&mut self, board: SymbolicState) -> Result<(), EnvError> {
+        self.board.set(board)
+    }
+
+    fn reset_step_counter(&mut self) {
+        self.steps = 0;
+    }
+
+    fn set_step_limit(&mut self, limit: Option<usize>) {
+        self.spec.step_limit = limit;
+    }
+
+    fn restore_manipulator(&mut self, state: &[f32]) -> Result<(), EnvError> {
+        let invalid = |reason: String| EnvError::InvalidState { env: self.spec.name.clone(), reason };
+        if !self.manipulator.can_restore() {
+            let what = "restoring the manipulator from an observation".to_owned();
+            return Err(EnvError::Unsupported { env: self.spec.name.clone(), what });
+        }
+        if state.len() != self.spec.manipulator_dim {
+            return Err(invalid(format!("expected {} values, got {}", self.spec.manipulator_dim, state.len())));
+        }
+        if state.iter().any(|v| !v.is_finite()) {
+            return Err(invalid("non-finite value".into()));
+        }
+        self.manipulator.restore(state).map_err(invalid)
+    }
+
+    fn scene(&self) -> Scene {
+        let game = self.board.game();
+        let board = self.board.board();
+        let values = game.values(board);
+        let fields = self
+            .layout
+            .fields()
+            .into_iter()
+            .zip(values)
+            .map(|(rect, v)| match self.spec.game {
+                seads_games::GameKind::LightsOut => FieldView { rect, lit: Some(v == 1), label: None },
+                seads_games::GameKind::TileSwap => FieldView { rect, lit: None, label: Some(v.to_string()) },
+            })
+            .collect();
+        let mut scene = Scene {
+            title: self.spec.name.clone(),
+            extent: [0.0, 0.0, 1.0, 1.0],
+            fields,
+            pivots: self.layout.pivots().into_iter().map(|(u, v)| [u, v]).collect(),
+            shapes: Vec::new(),
+        };
+        self.manipulator.draw(&mut scene.shapes, &mut scene.extent);
+        scene
+    }
+
+    fn box_clone(&self) -> Box<dyn Environment> {
+        Box::new(self.clone())
+    }
+}
