@@ -13,7 +13,17 @@ use crate::{root, setup, step};
 pub fn run() -> Result<()> {
     setup()?;
     step("cargo", &["fmt", "--all", "--check"])?;
-    step("cargo", &["clippy", "--workspace", "--all-targets", "--", "-D", "warnings"])?;
+    step(
+        "cargo",
+        &[
+            "clippy",
+            "--workspace",
+            "--all-targets",
+            "--",
+            "-D",
+            "warnings",
+        ],
+    )?;
     let mut totals = Totals::default();
     test(&["test", "--workspace", "--doc"], &mut totals)?;
     test(&["test", "--workspace", "--all-targets"], &mut totals)?;
@@ -47,7 +57,11 @@ fn test(args: &[&str], totals: &mut Totals) -> Result<()> {
     }
     let status = child.wait()?;
     if !status.success() {
-        println!("ci: {} passed, {} failed", totals.passed, totals.failed.max(1));
+        println!(
+            "ci: {} passed, {} failed",
+            totals.passed,
+            totals.failed.max(1)
+        );
         bail!("`cargo {}` failed ({status})", args.join(" "));
     }
     Ok(())
@@ -56,6 +70,13 @@ fn test(args: &[&str], totals: &mut Totals) -> Result<()> {
 /// The number before `label` in a `test result:` line ("ok. 5 passed; 0 failed; …").
 fn count(line: &str, label: &str) -> u64 {
     line.split(';')
-        .find_map(|part| part.trim().trim_start_matches("ok. ").trim_start_matches("FAILED. ").strip_suffix(label)?.parse().ok())
+        .find_map(|part| {
+            part.trim()
+                .trim_start_matches("ok. ")
+                .trim_start_matches("FAILED. ")
+                .strip_suffix(label)?
+                .parse()
+                .ok()
+        })
         .unwrap_or(0)
 }

@@ -6,7 +6,8 @@ use std::sync::{Arc, Mutex, OnceLock};
 use rand::{RngExt, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use seads_games::{
-    BoardDataset, BoardGame, GameKind, LightsOut, MoveId, Split, SymbolicState, TileSwap, sample_by_action_sampling,
+    BoardDataset, BoardGame, GameKind, LightsOut, MoveId, Split, SymbolicState, TileSwap,
+    sample_by_action_sampling,
 };
 
 use crate::{EnvConfig, EnvError};
@@ -40,7 +41,11 @@ impl BoardState {
         let source = if kind == GameKind::TileSwap || size <= 5 {
             let data = dataset(kind, size, max_depth);
             let split = config.reset_split;
-            let depths = if config.random_solution_depth { 1..=max_depth } else { max_depth..=max_depth };
+            let depths = if config.random_solution_depth {
+                1..=max_depth
+            } else {
+                max_depth..=max_depth
+            };
             if let Some(d) = depths.clone().find(|&d| data.boards(d, split).is_empty()) {
                 return Err(EnvError::InvalidConfig(format!(
                     "{kind} {size}×{size} has no {split} boards of solution depth {d} (max_solution_depth = {max_depth})"
@@ -76,17 +81,28 @@ impl BoardState {
 
     /// Draws a new board from the reset distribution.
     pub fn reset(&mut self) {
-        let depth = if self.random_depth { self.rng.random_range(1..=self.max_depth) } else { self.max_depth };
+        let depth = if self.random_depth {
+            self.rng.random_range(1..=self.max_depth)
+        } else {
+            self.max_depth
+        };
         self.board = match &self.source {
-            BoardSource::Dataset(data) => data.sample(depth, self.split, &mut self.rng).expect("checked in new()"),
-            BoardSource::ActionSampling => sample_by_action_sampling(self.game.as_ref(), depth, self.split, &mut self.rng),
+            BoardSource::Dataset(data) => data
+                .sample(depth, self.split, &mut self.rng)
+                .expect("checked in new()"),
+            BoardSource::ActionSampling => {
+                sample_by_action_sampling(self.game.as_ref(), depth, self.split, &mut self.rng)
+            }
         };
     }
 
     /// Puts the board into `board` (for evaluation and replay).
     pub fn set(&mut self, board: SymbolicState) -> Result<(), EnvError> {
         if !self.game.is_valid(board) {
-            return Err(EnvError::InvalidConfig(format!("not a valid {} board: {board:?}", self.game.kind())));
+            return Err(EnvError::InvalidConfig(format!(
+                "not a valid {} board: {board:?}",
+                self.game.kind()
+            )));
         }
         self.board = board;
         Ok(())
@@ -99,13 +115,19 @@ impl BoardState {
 
 /// Enumerated boards are shared by every environment of the same game, size and depth.
 fn dataset(kind: GameKind, size: usize, max_depth: usize) -> Arc<BoardDataset> {
-    static CACHE: OnceLock<Mutex<BTreeMap<(GameKind, usize, usize), Arc<BoardDataset>>>> = OnceLock::new();
-    let mut cache = CACHE.get_or_init(Default::default).lock().unwrap_or_else(|e| e.into_inner());
+    static CACHE: OnceLock<Mutex<BTreeMap<(GameKind, usize, usize), Arc<BoardDataset>>>> =
+        OnceLock::new();
+    let mut cache = CACHE
+        .get_or_init(Default::default)
+        .lock()
+        .unwrap_or_else(|e| e.into_inner());
     cache
         .entry((kind, size, max_depth))
         .or_insert_with(|| {
             let data = match kind {
-                GameKind::LightsOut => BoardDataset::build(&LightsOut::new(size).expect("size checked"), max_depth),
+                GameKind::LightsOut => {
+                    BoardDataset::build(&LightsOut::new(size).expect("size checked"), max_depth)
+                }
                 GameKind::TileSwap => BoardDataset::build(&TileSwap::new(), max_depth),
             };
             Arc::new(data.expect("LightsOut ≤ 5×5 and TileSwap are enumerable"))

@@ -23,6 +23,9 @@ pub struct EnvConfig {
     pub random_solution_depth: bool,
     /// Steps per skill, overriding the environment's default T_max.
     pub step_limit: Option<usize>,
+    /// Jaco only: physics steps per 0.1 s environment step (reference: 50 steps of 2 ms). Fewer
+    /// steps run proportionally faster with coarser contact and servo dynamics.
+    pub physics_substeps: Option<usize>,
 }
 
 impl Default for EnvConfig {
@@ -34,6 +37,7 @@ impl Default for EnvConfig {
             max_solution_depth: 5,
             random_solution_depth: true,
             step_limit: None,
+            physics_substeps: None,
         }
     }
 }
@@ -49,6 +53,9 @@ impl EnvConfig {
             && !(0.0..=1.0).contains(&s)
         {
             return bad(format!("spacing must lie in [0, 1], got {s}"));
+        }
+        if self.physics_substeps == Some(0) {
+            return bad("physics_substeps must be at least 1".into());
         }
         if self.step_limit == Some(0) {
             return bad("step_limit must be at least 1".into());

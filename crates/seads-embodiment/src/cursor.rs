@@ -25,7 +25,10 @@ impl Manipulator for Cursor {
     }
 
     fn action_bounds(&self) -> (Vec<f32>, Vec<f32>) {
-        (vec![-MAX_STEP, -MAX_STEP, -1.0], vec![MAX_STEP, MAX_STEP, 1.0])
+        (
+            vec![-MAX_STEP, -MAX_STEP, -1.0],
+            vec![MAX_STEP, MAX_STEP, 1.0],
+        )
     }
 
     fn default_step_limit(&self) -> usize {
@@ -37,14 +40,22 @@ impl Manipulator for Cursor {
         self.y = rng.random::<f64>();
     }
 
-    fn step(&mut self, action: &[f32], _rng: &mut ChaCha8Rng, touch: &mut dyn FnMut(Touch) -> Push) -> bool {
+    fn step(
+        &mut self,
+        action: &[f32],
+        _rng: &mut ChaCha8Rng,
+        touch: &mut dyn FnMut(Touch) -> Push,
+    ) -> bool {
         let dx = action[0].clamp(-MAX_STEP, MAX_STEP) as f64;
         let dy = action[1].clamp(-MAX_STEP, MAX_STEP) as f64;
         self.x = (self.x + dx).clamp(0.0, 1.0);
         self.y = (self.y + dy).clamp(0.0, 1.0);
         if action[2] > PUSH_THRESHOLD {
             // The push is evaluated at the new position.
-            touch(Touch::At { u: self.x, v: self.y });
+            touch(Touch::At {
+                u: self.x,
+                v: self.y,
+            });
         }
         true
     }
@@ -63,6 +74,8 @@ impl Manipulator for Cursor {
     }
 
     fn draw(&self, shapes: &mut Vec<Shape>, _extent: &mut [f64; 4]) {
-        shapes.push(Shape::Marker { at: [self.x, self.y] });
+        shapes.push(Shape::Marker {
+            at: [self.x, self.y],
+        });
     }
 }

@@ -80,7 +80,12 @@ pub trait Manipulator: Clone + Send + Sync + 'static {
     /// Advances one environment step under a finite, correctly sized `action`. Each touch of the
     /// board is reported to `touch`, which answers what it did; once it answered a move, later
     /// touches of the same step are ignored by the board. Returns `false` if the state diverged.
-    fn step(&mut self, action: &[f32], rng: &mut ChaCha8Rng, touch: &mut dyn FnMut(Touch) -> Push) -> bool;
+    fn step(
+        &mut self,
+        action: &[f32],
+        rng: &mut ChaCha8Rng,
+        touch: &mut dyn FnMut(Touch) -> Push,
+    ) -> bool;
     /// Writes the manipulator observation (M values).
     fn observe(&self, out: &mut [f32]);
     /// Sets the state from a manipulator observation; `Err(reason)` if it is not a valid state or
@@ -106,7 +111,13 @@ pub struct Embodied<M: Manipulator> {
 }
 
 impl<M: Manipulator> Embodied<M> {
-    pub(crate) fn new(name: &str, manipulator: M, board: BoardState, layout: Layout, step_limit: Option<usize>) -> Self {
+    pub(crate) fn new(
+        name: &str,
+        manipulator: M,
+        board: BoardState,
+        layout: Layout,
+        step_limit: Option<usize>,
+    ) -> Self {
         let game = board.game();
         let (action_low, action_high) = manipulator.action_bounds();
         let spec = EnvSpec {
@@ -122,7 +133,14 @@ impl<M: Manipulator> Embodied<M> {
             num_skills: game.num_moves(),
             step_limit: Some(step_limit.unwrap_or(manipulator.default_step_limit())),
         };
-        let mut env = Self { spec, manipulator, board, layout, rng: ChaCha8Rng::seed_from_u64(0), steps: 0 };
+        let mut env = Self {
+            spec,
+            manipulator,
+            board,
+            layout,
+            rng: ChaCha8Rng::seed_from_u64(0),
+            steps: 0,
+        };
         env.seed(0);
         env.reset();
         env
@@ -142,7 +160,11 @@ impl<M: Manipulator> Embodied<M> {
             });
         }
         if let Some(index) = action.iter().position(|a| !a.is_finite()) {
-            return Err(EnvError::NonFiniteAction { env: self.spec.name.clone(), index, value: action[index] });
+            return Err(EnvError::NonFiniteAction {
+                env: self.spec.name.clone(),
+                index,
+                value: action[index],
+            });
         }
         Ok(())
     }
@@ -169,7 +191,10 @@ impl<M: Manipulator> Environment for Embodied<M> {
         if let Some(limit) = self.spec.step_limit
             && self.steps >= limit
         {
-            return Err(EnvError::StepLimitReached { env: self.spec.name.clone(), limit });
+            return Err(EnvError::StepLimitReached {
+                env: self.spec.name.clone(),
+                limit,
+            });
         }
         let (board, layout) = (&mut self.board, self.layout);
         let mut push = Push::None;
@@ -193,7 +218,10 @@ impl<M: Manipulator> Environment for Embodied<M> {
         });
         self.steps += 1;
         if !finite {
-            return Err(EnvError::NonFiniteState { env: self.spec.name.clone(), steps: self.steps });
+            return Err(EnvError::NonFiniteState {
+                env: self.spec.name.clone(),
+                steps: self.steps,
+            });
         }
         let truncated = self.spec.step_limit.is_some_and(|l| self.steps >= l);
         Ok(StepOutcome { push, truncated })
@@ -226,13 +254,23 @@ impl<M: Manipulator> Environment for Embodied<M> {
     }
 
     fn restore_manipulator(&mut self, state: &[f32]) -> Result<(), EnvError> {
-        let invalid = |reason: String| EnvError::InvalidState { env: self.spec.name.clone(), reason };
+        let invalid = |reason: String| EnvError::InvalidState {
+            env: self.spec.name.clone(),
+            reason,
+        };
         if !self.manipulator.can_restore() {
             let what = "restoring the manipulator from an observation".to_owned();
-            return Err(EnvError::Unsupported { env: self.spec.name.clone(), what });
+            return Err(EnvError::Unsupported {
+                env: self.spec.name.clone(),
+                what,
+            });
         }
         if state.len() != self.spec.manipulator_dim {
-            return Err(invalid(format!("expected {} values, got {}", self.spec.manipulator_dim, state.len())));
+            return Err(invalid(format!(
+                "expected {} values, got {}",
+                self.spec.manipulator_dim,
+                state.len()
+            )));
         }
         if state.iter().any(|v| !v.is_finite()) {
             return Err(invalid("non-finite value".into()));
@@ -250,15 +288,28 @@ impl<M: Manipulator> Environment for Embodied<M> {
             .into_iter()
             .zip(values)
             .map(|(rect, v)| match self.spec.game {
-                seads_games::GameKind::LightsOut => FieldView { rect, lit: Some(v == 1), label: None },
-                seads_games::GameKind::TileSwap => FieldView { rect, lit: None, label: Some(v.to_string()) },
+                seads_games::GameKind::LightsOut => FieldView {
+                    rect,
+                    lit: Some(v == 1),
+                    label: None,
+                },
+                seads_games::GameKind::TileSwap => FieldView {
+                    rect,
+                    lit: None,
+                    label: Some(v.to_string()),
+                },
             })
             .collect();
         let mut scene = Scene {
             title: self.spec.name.clone(),
             extent: [0.0, 0.0, 1.0, 1.0],
             fields,
-            pivots: self.layout.pivots().into_iter().map(|(u, v)| [u, v]).collect(),
+            pivots: self
+                .layout
+                .pivots()
+                .into_iter()
+                .map(|(u, v)| [u, v])
+                .collect(),
             shapes: Vec::new(),
         };
         self.manipulator.draw(&mut scene.shapes, &mut scene.extent);

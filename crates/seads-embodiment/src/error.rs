@@ -42,7 +42,9 @@ pub enum EnvError {
         steps: usize,
     },
     /// `step` was called after the skill's step limit without a reset.
-    #[error("{env}: the step limit of {limit} steps is reached; reset the environment or its step counter first")]
+    #[error(
+        "{env}: the step limit of {limit} steps is reached; reset the environment or its step counter first"
+    )]
     StepLimitReached {
         /// Environment name.
         env: String,

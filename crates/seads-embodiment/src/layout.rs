@@ -16,12 +16,20 @@ fn pivots() -> [(f64, f64, MoveId); 12] {
         for col in 0..3usize {
             if row != 2 {
                 // Swap with the cell below: move id 2·col + row (SPEC §1.2).
-                out[i] = (0.5 * field + field * col as f64, (row + 1) as f64 * field, 2 * col + row);
+                out[i] = (
+                    0.5 * field + field * col as f64,
+                    (row + 1) as f64 * field,
+                    2 * col + row,
+                );
                 i += 1;
             }
             if col != 2 {
                 // Swap with the cell to the right: move id 6 + 3·col + row.
-                out[i] = (field * (col + 1) as f64, 0.5 * field + row as f64 * field, 6 + 3 * col + row);
+                out[i] = (
+                    field * (col + 1) as f64,
+                    0.5 * field + row as f64 * field,
+                    6 + 3 * col + row,
+                );
                 i += 1;
             }
         }
@@ -67,7 +75,11 @@ impl Layout {
             Layout::Grid { n } => Some(grid_bin(v, n) * n + grid_bin(u, n)),
             Layout::Spaced { n, spacing } => {
                 let centres = spaced_centres(n, spacing);
-                let hit = |x: f64| centres.iter().position(|&c| (x - c).abs() < SPACED_FIELD / 2.0);
+                let hit = |x: f64| {
+                    centres
+                        .iter()
+                        .position(|&c| (x - c).abs() < SPACED_FIELD / 2.0)
+                };
                 Some(hit(v)? * n + hit(u)?)
             }
             Layout::Pivots => {
@@ -86,8 +98,15 @@ impl Layout {
     /// The fields as rectangles `[u0, v0, u1, v1]`, row-major.
     pub fn fields(&self) -> Vec<[f64; 4]> {
         match *self {
-            Layout::Grid { n } => square_fields(&(0..n).map(|i| (i as f64 + 0.5) / n as f64).collect::<Vec<_>>(), 1.0 / n as f64),
-            Layout::Spaced { n, spacing } => square_fields(&spaced_centres(n, spacing), SPACED_FIELD),
+            Layout::Grid { n } => square_fields(
+                &(0..n)
+                    .map(|i| (i as f64 + 0.5) / n as f64)
+                    .collect::<Vec<_>>(),
+                1.0 / n as f64,
+            ),
+            Layout::Spaced { n, spacing } => {
+                square_fields(&spaced_centres(n, spacing), SPACED_FIELD)
+            }
             Layout::Pivots => square_fields(&[1.0 / 6.0, 0.5, 5.0 / 6.0], 1.0 / 3.0),
         }
     }
@@ -111,9 +130,15 @@ fn grid_bin(x: f64, n: usize) -> usize {
 /// Field centres along one axis of a spaced board.
 fn spaced_centres(n: usize, spacing: f64) -> Vec<f64> {
     let free = 1.0 - n as f64 * SPACED_FIELD;
-    let gap = if n > 1 { spacing * free / (n - 1) as f64 } else { 0.0 };
+    let gap = if n > 1 {
+        spacing * free / (n - 1) as f64
+    } else {
+        0.0
+    };
     let pitch = SPACED_FIELD + gap;
-    (0..n).map(|i| 0.5 + (i as f64 - (n - 1) as f64 / 2.0) * pitch).collect()
+    (0..n)
+        .map(|i| 0.5 + (i as f64 - (n - 1) as f64 / 2.0) * pitch)
+        .collect()
 }
 
 fn square_fields(centres: &[f64], side: f64) -> Vec<[f64; 4]> {
@@ -134,7 +159,11 @@ mod tests {
         assert_eq!(g.locate(0.0, 0.0), Some(0));
         assert_eq!(g.locate(0.2, 0.2), Some(0));
         assert_eq!(g.locate(0.2001, 0.0), Some(1));
-        assert_eq!(g.locate(0.6, 0.6), Some(12), "0.6 ≤ linspace edge 0.6000000000000001");
+        assert_eq!(
+            g.locate(0.6, 0.6),
+            Some(12),
+            "0.6 ≤ linspace edge 0.6000000000000001"
+        );
         assert_eq!(g.locate(1.0, 1.0), Some(24));
         assert_eq!(g.locate(0.5, 0.9), Some(22));
     }
@@ -143,9 +172,18 @@ mod tests {
     fn pivots_match_the_table() {
         let p = Layout::Pivots;
         let table = [
-            ((1.0 / 6.0, 1.0 / 3.0), 0), ((1.0 / 3.0, 1.0 / 6.0), 6), ((0.5, 1.0 / 3.0), 2), ((2.0 / 3.0, 1.0 / 6.0), 9),
-            ((5.0 / 6.0, 1.0 / 3.0), 4), ((1.0 / 6.0, 2.0 / 3.0), 1), ((1.0 / 3.0, 0.5), 7), ((0.5, 2.0 / 3.0), 3),
-            ((2.0 / 3.0, 0.5), 10), ((5.0 / 6.0, 2.0 / 3.0), 5), ((1.0 / 3.0, 5.0 / 6.0), 8), ((2.0 / 3.0, 5.0 / 6.0), 11),
+            ((1.0 / 6.0, 1.0 / 3.0), 0),
+            ((1.0 / 3.0, 1.0 / 6.0), 6),
+            ((0.5, 1.0 / 3.0), 2),
+            ((2.0 / 3.0, 1.0 / 6.0), 9),
+            ((5.0 / 6.0, 1.0 / 3.0), 4),
+            ((1.0 / 6.0, 2.0 / 3.0), 1),
+            ((1.0 / 3.0, 0.5), 7),
+            ((0.5, 2.0 / 3.0), 3),
+            ((2.0 / 3.0, 0.5), 10),
+            ((5.0 / 6.0, 2.0 / 3.0), 5),
+            ((1.0 / 3.0, 5.0 / 6.0), 8),
+            ((2.0 / 3.0, 5.0 / 6.0), 11),
         ];
         for ((u, v), mv) in table {
             assert_eq!(p.locate(u, v), Some(mv), "pivot at ({u}, {v})");
@@ -155,7 +193,14 @@ mod tests {
     #[test]
     fn outer_triangles_are_dead_and_centres_resolve_like_the_reference() {
         let p = Layout::Pivots;
-        for (u, v) in [(0.0, 0.0), (1.0, 1.0), (0.5, 0.02), (0.02, 0.5), (0.98, 0.5), (0.5, 0.98)] {
+        for (u, v) in [
+            (0.0, 0.0),
+            (1.0, 1.0),
+            (0.5, 0.02),
+            (0.02, 0.5),
+            (0.98, 0.5),
+            (0.5, 0.98),
+        ] {
             assert_eq!(p.locate(u, v), None, "({u}, {v})");
         }
         // The centre of the middle field lies on four diamond edges; float rounding of the
@@ -170,11 +215,18 @@ mod tests {
         let s = Layout::Spaced { n: 7, spacing: 1.0 };
         let f = s.fields();
         assert_eq!(f.len(), 49);
-        assert!((f[0][0]).abs() < 1e-12, "outer fields touch the border at s = 1");
+        assert!(
+            (f[0][0]).abs() < 1e-12,
+            "outer fields touch the border at s = 1"
+        );
         assert!((f[0][2] - f[0][0] - 1.0 / 13.0).abs() < 1e-12);
         let centre = (f[24][0] + f[24][2]) / 2.0;
         assert_eq!(s.locate(centre, centre), Some(24));
-        assert_eq!(s.locate((f[0][2] + f[1][0]) / 2.0, 0.5), None, "gap between fields");
+        assert_eq!(
+            s.locate((f[0][2] + f[1][0]) / 2.0, 0.5),
+            None,
+            "gap between fields"
+        );
         let packed = Layout::Spaced { n: 5, spacing: 0.0 };
         assert_eq!(packed.locate(0.01, 0.01), None, "empty border at s = 0");
         assert_eq!(packed.locate(0.5, 0.5), Some(12));

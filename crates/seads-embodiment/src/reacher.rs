@@ -61,7 +61,11 @@ fn impedance(depth: f64) -> f64 {
     if x >= 1.0 {
         return IMP_MAX;
     }
-    let y = if x <= 0.5 { 2.0 * x * x } else { 1.0 - 2.0 * (1.0 - x) * (1.0 - x) };
+    let y = if x <= 0.5 {
+        2.0 * x * x
+    } else {
+        1.0 - 2.0 * (1.0 - x) * (1.0 - x)
+    };
     IMP_MIN + y * (IMP_MAX - IMP_MIN)
 }
 
@@ -76,7 +80,10 @@ impl Reacher {
         let m22 = I2;
         let eta = M2 * L1 * C2 * s2;
         let bias = [-eta * (2.0 * qd1 * qd2 + qd2 * qd2), eta * qd1 * qd1];
-        let fs = [tau[0] - bias[0] - DAMPING * qd1, tau[1] - bias[1] - DAMPING * qd2];
+        let fs = [
+            tau[0] - bias[0] - DAMPING * qd1,
+            tau[1] - bias[1] - DAMPING * qd2,
+        ];
         let det = m11 * m22 - m12 * m12;
         let minv22 = m11 / det;
         let a0_wrist = (-m12 * fs[0] + m11 * fs[1]) / det;
@@ -104,7 +111,10 @@ impl Reacher {
         let f = [fs[0], fs[1] + fc_wrist];
         let (a11, a12, a22) = (m11 + H * DAMPING, m12, m22 + H * DAMPING);
         let det_h = a11 * a22 - a12 * a12;
-        let qdd = [(a22 * f[0] - a12 * f[1]) / det_h, (-a12 * f[0] + a11 * f[1]) / det_h];
+        let qdd = [
+            (a22 * f[0] - a12 * f[1]) / det_h,
+            (-a12 * f[0] + a11 * f[1]) / det_h,
+        ];
         for i in 0..2 {
             self.qd[i] += H * qdd[i];
             self.q[i] += H * self.qd[i];
@@ -122,7 +132,10 @@ impl Reacher {
 
 /// World plane (m) → normalised board coordinates (no flip: row 0 at y ≈ −0.15).
 fn to_board(p: [f64; 2]) -> [f64; 2] {
-    [(p[0] + BOARD_HALF) / (2.0 * BOARD_HALF), (p[1] + BOARD_HALF) / (2.0 * BOARD_HALF)]
+    [
+        (p[0] + BOARD_HALF) / (2.0 * BOARD_HALF),
+        (p[1] + BOARD_HALF) / (2.0 * BOARD_HALF),
+    ]
 }
 
 impl Manipulator for Reacher {
@@ -145,7 +158,12 @@ impl Manipulator for Reacher {
         self.qd = [0.0; 2];
     }
 
-    fn step(&mut self, action: &[f32], _rng: &mut ChaCha8Rng, touch: &mut dyn FnMut(Touch) -> Push) -> bool {
+    fn step(
+        &mut self,
+        action: &[f32],
+        _rng: &mut ChaCha8Rng,
+        touch: &mut dyn FnMut(Touch) -> Push,
+    ) -> bool {
         let u = [action[0] as f64, action[1] as f64];
         for _ in 0..SUBSTEPS {
             self.physics_step(u);
@@ -175,8 +193,14 @@ impl Manipulator for Reacher {
     fn draw(&self, shapes: &mut Vec<Shape>, extent: &mut [f64; 4]) {
         let (elbow, tip) = self.links();
         let (base, elbow, tip) = (to_board([0.0, 0.0]), to_board(elbow), to_board(tip));
-        shapes.push(Shape::Segment { from: base, to: elbow });
-        shapes.push(Shape::Segment { from: elbow, to: tip });
+        shapes.push(Shape::Segment {
+            from: base,
+            to: elbow,
+        });
+        shapes.push(Shape::Segment {
+            from: elbow,
+            to: tip,
+        });
         shapes.push(Shape::Joint { at: base });
         shapes.push(Shape::Joint { at: elbow });
         shapes.push(Shape::Marker { at: tip });
@@ -195,37 +219,59 @@ mod tests {
         let mut arm = Reacher { q, qd };
         arm.physics_step(u);
         for i in 0..2 {
-            assert!((arm.q[i] - q_next[i]).abs() < 1e-12, "q[{i}] = {} ≠ {}", arm.q[i], q_next[i]);
-            assert!((arm.qd[i] - qd_next[i]).abs() < 1e-10, "qd[{i}] = {} ≠ {}", arm.qd[i], qd_next[i]);
+            assert!(
+                (arm.q[i] - q_next[i]).abs() < 1e-12,
+                "q[{i}] = {} ≠ {}",
+                arm.q[i],
+                q_next[i]
+            );
+            assert!(
+                (arm.qd[i] - qd_next[i]).abs() < 1e-10,
+                "qd[{i}] = {} ≠ {}",
+                arm.qd[i],
+                qd_next[i]
+            );
         }
     }
 
     #[test]
     fn free_motion_matches_hand_computation() {
-        check([0.3, 1.0], [0.5, -1.2], [0.7, -0.4], [0.3225523654003376, 0.9568340999046914], [
-            1.1276182700168813,
-            -2.1582950047654323,
-        ]);
+        check(
+            [0.3, 1.0],
+            [0.5, -1.2],
+            [0.7, -0.4],
+            [0.3225523654003376, 0.9568340999046914],
+            [1.1276182700168813, -2.1582950047654323],
+        );
         // Controls beyond ±1 are clipped.
-        check([0.0, 0.0], [0.0, 0.0], [2.0, -3.0], [0.037342333980211743, -0.0959039400040797], [
-            1.8671166990105872,
-            -4.795197000203985,
-        ]);
+        check(
+            [0.0, 0.0],
+            [0.0, 0.0],
+            [2.0, -3.0],
+            [0.037342333980211743, -0.0959039400040797],
+            [1.8671166990105872, -4.795197000203985],
+        );
     }
 
     #[test]
     fn violated_wrist_limit_matches_hand_computation() {
         // Deep violation (impedance 0.95): the limit pushes the wrist back although the motor
         // drives it outwards.
-        check([1.0, 3.0], [0.1, 0.5], [0.0, 1.0], [0.9990999514685305, 2.992524291348141], [
-            -0.04500242657347436,
-            -0.37378543259293995,
-        ]);
+        check(
+            [1.0, 3.0],
+            [0.1, 0.5],
+            [0.0, 1.0],
+            [0.9990999514685305, 2.992524291348141],
+            [-0.04500242657347436, -0.37378543259293995],
+        );
         // Shallow violation below the impedance width (impedance 0.916).
-        check([-0.2, -WRIST_LIMIT - 0.0004], [0.0, -0.3], [0.5, -1.0], [-0.18596017210892762, -2.809363545113862], [
-            0.7019913945536199,
-            -0.8218370961467438,
-        ]);
+        check(
+            [-0.2, -WRIST_LIMIT - 0.0004],
+            [0.0, -0.3],
+            [0.5, -1.0],
+            [-0.18596017210892762, -2.809363545113862],
+            [0.7019913945536199, -0.8218370961467438],
+        );
     }
 
     #[test]
@@ -236,7 +282,11 @@ mod tests {
         }
         assert!((arm.qd[0] - GEAR / DAMPING).abs() < 1e-6, "{:?}", arm.qd);
         // The wrist rests against its soft limit, slightly beyond it under full torque.
-        assert!(arm.q[1] > WRIST_LIMIT && arm.q[1] < WRIST_LIMIT + 0.1, "{}", arm.q[1]);
+        assert!(
+            arm.q[1] > WRIST_LIMIT && arm.q[1] < WRIST_LIMIT + 0.1,
+            "{}",
+            arm.q[1]
+        );
     }
 
     #[test]

@@ -4,7 +4,10 @@ use seads_games::GameKind;
 use serde::Serialize;
 
 use crate::board::BoardState;
-use crate::{Cursor, EnvConfig, EnvError, Environment, Embodied, Layout, Manipulator, Reacher};
+use crate::{
+    Cursor, Embodied, EnvConfig, EnvError, Environment, Jaco, JacoBoard, Layout, Manipulator,
+    Reacher,
+};
 
 /// One registered environment.
 struct Entry {
@@ -18,6 +21,7 @@ struct Entry {
 enum Embodiment {
     Cursor,
     Reacher,
+    Jaco(JacoBoard),
 }
 
 const REGISTRY: &[Entry] = &[
@@ -45,6 +49,24 @@ const REGISTRY: &[Entry] = &[
         game: GameKind::TileSwap,
         embodiment: Embodiment::Reacher,
     },
+    Entry {
+        name: "lightsout-jaco",
+        description: "LightsOut 5×5 pressed by a Kinova Jaco arm with 3-finger hand (rapier3d)",
+        game: GameKind::LightsOut,
+        embodiment: Embodiment::Jaco(JacoBoard::LightsOut { stairs: false }),
+    },
+    Entry {
+        name: "tileswap-jaco",
+        description: "TileSwap 3×3 pressed by a Kinova Jaco arm with 3-finger hand (rapier3d)",
+        game: GameKind::TileSwap,
+        embodiment: Embodiment::Jaco(JacoBoard::TileSwap),
+    },
+    Entry {
+        name: "lightsout3d-jaco",
+        description: "LightsOut 5×5 with fields raised by distance from the centre, pressed by a Jaco arm",
+        game: GameKind::LightsOut,
+        embodiment: Embodiment::Jaco(JacoBoard::LightsOut { stairs: true }),
+    },
 ];
 
 /// The registered environment names.
@@ -57,9 +79,18 @@ pub fn make_env(name: &str, config: &EnvConfig) -> Result<Box<dyn Environment>, 
     let entry = REGISTRY
         .iter()
         .find(|e| e.name == name)
-        .ok_or_else(|| EnvError::UnknownEnv { name: name.to_owned(), valid: env_names().join(", ") })?;
+        .ok_or_else(|| EnvError::UnknownEnv {
+            name: name.to_owned(),
+            valid: env_names().join(", "),
+        })?;
     config.validate()?;
     let layout = layout(entry, config)?;
+    if config.physics_substeps.is_some() && !matches!(entry.embodiment, Embodiment::Jaco(_)) {
+        return Err(EnvError::InvalidConfig(format!(
+            "physics_substeps applies to the Jaco environments, not {}",
+            entry.name
+        )));
+    }
     let size = match layout {
         Layout::Grid { n } | Layout::Spaced { n, .. } => n,
         Layout::Pivots => 3,
@@ -68,6 +99,12 @@ pub fn make_env(name: &str, config: &EnvConfig) -> Result<Box<dyn Environment>, 
     Ok(match entry.embodiment {
         Embodiment::Cursor => build(entry.name, Cursor::default(), board, layout, config),
         Embodiment::Reacher => build(entry.name, Reacher::default(), board, layout, config),
+        Embodiment::Jaco(jaco) => {
+            let substeps = config
+                .physics_substeps
+                .unwrap_or(crate::jaco::DEFAULT_SUBSTEPS);
+            build(entry.name, Jaco::new(jaco, substeps), board, layout, config)
+        }
     })
 }
 
@@ -78,7 +115,13 @@ fn build<M: Manipulator>(
     layout: Layout,
     config: &EnvConfig,
 ) -> Box<dyn Environment> {
-    Box::new(Embodied::new(name, manipulator, board, layout, config.step_limit))
+    Box::new(Embodied::new(
+        name,
+        manipulator,
+        board,
+        layout,
+        config.step_limit,
+    ))
 }
 
 /// The board layout an entry gets under `config`; only `lightsout-cursor` has variants.
@@ -96,9 +139,14 @@ fn layout(entry: &Entry, config: &EnvConfig) -> Result<Layout, EnvError> {
         )));
     }
     if !(5..=13).contains(&size) || size % 2 == 0 {
-        return Err(EnvError::InvalidConfig(format!("spaced LightsOut boards have odd sizes 5 to 13, got {size}")));
+        return Err(EnvError::InvalidConfig(format!(
+            "spaced LightsOut boards have odd sizes 5 to 13, got {size}"
+        )));
     }
-    Ok(Layout::Spaced { n: size, spacing: config.spacing.unwrap_or(0.0) })
+    Ok(Layout::Spaced {
+        n: size,
+        spacing: config.spacing.unwrap_or(0.0),
+    })
 }
 
 /// Summary of a registered environment, as listed by `seads envs`.
@@ -123,7 +171,8 @@ pub fn list_envs() -> Vec<EnvInfo> {
     REGISTRY
         .iter()
         .map(|e| {
-            let env = make_env(e.name, &EnvConfig::default()).expect("registered environments build");
+            let env =
+                make_env(e.name, &EnvConfig::default()).expect("registered environments build");
             let spec = env.spec();
             EnvInfo {
                 name: e.name.to_owned(),
@@ -131,7 +180,9 @@ pub fn list_envs() -> Vec<EnvInfo> {
                 obs_dim: spec.obs_dim,
                 action_dim: spec.action_dim,
                 num_skills: spec.num_skills,
-                step_limit: spec.step_limit.expect("default environments have a step limit"),
+                step_limit: spec
+                    .step_limit
+                    .expect("default environments have a step limit"),
             }
         })
         .collect()

@@ -23,7 +23,10 @@ impl VecEnv {
                 env
             })
             .collect();
-        Ok(Self { envs, parallel: false })
+        Ok(Self {
+            envs,
+            parallel: false,
+        })
     }
 
     /// Steps environments on rayon's pool (worth it for expensive physics, not for the Cursor).
@@ -80,7 +83,10 @@ impl VecEnv {
         outcomes: &mut [StepOutcome],
     ) -> Result<(), EnvError> {
         let (a, o) = (self.action_dim(), self.obs_dim());
-        let step_one = |(((env, act), ob), (out, &on)): (((&mut Box<dyn Environment>, &[f32]), &mut [f32]), (&mut StepOutcome, &bool))| {
+        let step_one = |(((env, act), ob), (out, &on)): (
+            ((&mut Box<dyn Environment>, &[f32]), &mut [f32]),
+            (&mut StepOutcome, &bool),
+        )| {
             if on {
                 *out = env.step(act)?;
                 env.observe(ob);
@@ -103,4 +109,35 @@ impl VecEnv {
                 .try_for_each(step_one)
         }
     }
+}
+
+/// Steps `env` `steps` times with uniformly random actions from a stream seeded with `seed`,
+/// resetting whenever a skill ends (the throughput workload of `seads env-bench` and the
+/// benches). Returns the number of game moves made.
+pub fn random_rollout(
+    env: &mut dyn Environment,
+    steps: usize,
+    seed: u64,
+) -> Result<usize, EnvError> {
+    use rand::{RngExt, SeedableRng};
+    let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(seed);
+    let (low, high) = (
+        env.spec().action_low.clone(),
+        env.spec().action_high.clone(),
+    );
+    // A pool of actions drawn up front, so that the loop measures the environment, not the RNG.
+    let pool: Vec<f32> = (0..4096 * low.len())
+        .map(|i| rng.random_range(low[i % low.len()]..=high[i % low.len()]))
+        .collect();
+    let mut obs = vec![0.0; env.spec().obs_dim];
+    let mut moves = 0;
+    for (_, action) in (0..steps).zip(pool.chunks(low.len()).cycle()) {
+        let outcome = env.step(action)?;
+        env.observe(&mut obs);
+        moves += outcome.moved() as usize;
+        if outcome.done() {
+            env.reset();
+        }
+    }
+    Ok(moves)
 }

@@ -35,7 +35,9 @@ pub struct EnvSpec {
 impl EnvSpec {
     /// The ground-truth symbolic mapping Φ(s): the D entries before ρ, non-zero → 1.
     pub fn phi(&self, obs: &[f32]) -> SymbolicState {
-        SymbolicState::from_observation(&obs[self.manipulator_dim..self.manipulator_dim + self.symbolic_len])
+        SymbolicState::from_observation(
+            &obs[self.manipulator_dim..self.manipulator_dim + self.symbolic_len],
+        )
     }
 }
 

@@ -5,22 +5,42 @@
 use seads_embodiment::{EnvConfig, Environment, Layout, Push, make_env};
 use seads_games::{GameKind, MoveId};
 
-const SEEDS: [u64; 20] = [1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15, 16, 17, 18, 19, 20];
+const SEEDS: [u64; 20] = [
+    1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15, 16, 17, 18, 19, 20,
+];
 
 /// Where to push for each move, in normalised board coordinates: field centres (LightsOut) or
 /// pivot points (TileSwap).
 fn targets(game: GameKind) -> Vec<(MoveId, [f64; 2])> {
     match game {
-        GameKind::LightsOut => (0..25).map(|m| (m, [(m % 5) as f64 * 0.2 + 0.1, (m / 5) as f64 * 0.2 + 0.1])).collect(),
+        GameKind::LightsOut => (0..25)
+            .map(|m| (m, [(m % 5) as f64 * 0.2 + 0.1, (m / 5) as f64 * 0.2 + 0.1]))
+            .collect(),
         GameKind::TileSwap => {
             let pivots = Layout::Pivots.pivots();
-            (0..12).map(|m| (m, pivots.iter().copied().find(|&(u, v)| Layout::Pivots.locate(u, v) == Some(m)).map(|(u, v)| [u, v]).unwrap())).collect()
+            (0..12)
+                .map(|m| {
+                    (
+                        m,
+                        pivots
+                            .iter()
+                            .copied()
+                            .find(|&(u, v)| Layout::Pivots.locate(u, v) == Some(m))
+                            .map(|(u, v)| [u, v])
+                            .unwrap(),
+                    )
+                })
+                .collect()
         }
     }
 }
 
 /// Runs `controller` from a fresh reset until the skill ends; returns the move it made.
-fn run_skill(env: &mut dyn Environment, seed: u64, mut controller: impl FnMut(&[f32]) -> [f32; 3]) -> Option<MoveId> {
+fn run_skill(
+    env: &mut dyn Environment,
+    seed: u64,
+    mut controller: impl FnMut(&[f32]) -> [f32; 3],
+) -> Option<MoveId> {
     env.seed(seed);
     env.reset();
     let limit = env.spec().step_limit.unwrap();
@@ -41,7 +61,9 @@ fn check_all_moves(name: &str, controller: impl Fn(Layout, MoveId, [f64; 2], &[f
     let layout = Layout::standard(game, env.spec().board_size);
     for seed in SEEDS {
         for (mv, target) in targets(game) {
-            let made = run_skill(env.as_mut(), seed, |obs| controller(layout, mv, target, obs));
+            let made = run_skill(env.as_mut(), seed, |obs| {
+                controller(layout, mv, target, obs)
+            });
             assert_eq!(made, Some(mv), "{name}, seed {seed}: aiming at move {mv}");
         }
     }
@@ -51,7 +73,11 @@ fn check_all_moves(name: &str, controller: impl Fn(Layout, MoveId, [f64; 2], &[f
 fn cursor_controller(_: Layout, _: MoveId, target: [f64; 2], obs: &[f32]) -> [f32; 3] {
     let d = [target[0] - obs[0] as f64, target[1] - obs[1] as f64];
     let arrive = d[0].abs() <= 0.2 && d[1].abs() <= 0.2;
-    [d[0].clamp(-0.2, 0.2) as f32, d[1].clamp(-0.2, 0.2) as f32, if arrive { 1.0 } else { -1.0 }]
+    [
+        d[0].clamp(-0.2, 0.2) as f32,
+        d[1].clamp(-0.2, 0.2) as f32,
+        if arrive { 1.0 } else { -1.0 },
+    ]
 }
 
 #[test]
@@ -64,9 +90,17 @@ fn cursor_produces_every_move() {
 /// control period), push when the fingertip is well inside the target's region and nearly still.
 /// The centre field lies within the wrist's ±160° limit circle except at its corners, so there
 /// the wrist is pressed against its soft limit and only the shoulder aims.
-fn reacher_controller(layout: Layout, target_move: MoveId, target: [f64; 2], obs: &[f32]) -> [f32; 3] {
+fn reacher_controller(
+    layout: Layout,
+    target_move: MoveId,
+    target: [f64; 2],
+    obs: &[f32],
+) -> [f32; 3] {
     const L: f64 = 0.12;
-    let (q, qd) = ([obs[0] as f64, obs[1] as f64], [obs[2] as f64, obs[3] as f64]);
+    let (q, qd) = (
+        [obs[0] as f64, obs[1] as f64],
+        [obs[2] as f64, obs[3] as f64],
+    );
     let p = [target[0] * 0.3 - 0.15, target[1] * 0.3 - 0.15];
     let wrap = |a: f64| a - (a / std::f64::consts::TAU).round() * std::f64::consts::TAU;
     let side = if q[1] >= 0.0 { 1.0 } else { -1.0 };
@@ -79,11 +113,17 @@ fn reacher_controller(layout: Layout, target_move: MoveId, target: [f64; 2], obs
         let c2 = ((p[0] * p[0] + p[1] * p[1] - 2.0 * L * L) / (2.0 * L * L)).clamp(-1.0, 1.0);
         let q2 = c2.acos() * side;
         let q1 = p[1].atan2(p[0]) - (L * q2.sin()).atan2(L + L * q2.cos());
-        [(1.0 * wrap(q1 - q[0]) - 0.1 * qd[0]).clamp(-1.0, 1.0), (1.0 * (q2 - q[1]) - 0.05 * qd[1]).clamp(-1.0, 1.0)]
+        [
+            (1.0 * wrap(q1 - q[0]) - 0.1 * qd[0]).clamp(-1.0, 1.0),
+            (1.0 * (q2 - q[1]) - 0.05 * qd[1]).clamp(-1.0, 1.0),
+        ]
     };
     // Check the fingertip now and where it will be after the step (the push is evaluated there).
     let tip = |q: [f64; 2]| {
-        let t = [L * q[0].cos() + L * (q[0] + q[1]).cos(), L * q[0].sin() + L * (q[0] + q[1]).sin()];
+        let t = [
+            L * q[0].cos() + L * (q[0] + q[1]).cos(),
+            L * q[0].sin() + L * (q[0] + q[1]).sin(),
+        ];
         ((t[0] + 0.15) / 0.3, (t[1] + 0.15) / 0.3)
     };
     let margin = 0.01;
@@ -96,7 +136,11 @@ fn reacher_controller(layout: Layout, target_move: MoveId, target: [f64; 2], obs
     // Far beyond ±160° the soft wrist limit yanks the arm back within the step: no push then
     // (slightly beyond is the resting pose of a wrist pressed against its limit).
     let still = qd[0].abs() + qd[1].abs() < 0.3 && q[1].abs() < 2.95;
-    [u[0] as f32, u[1] as f32, if inside && still { 1.0 } else { -1.0 }]
+    [
+        u[0] as f32,
+        u[1] as f32,
+        if inside && still { 1.0 } else { -1.0 },
+    ]
 }
 
 #[test]

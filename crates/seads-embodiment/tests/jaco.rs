@@ -1,0 +1,195 @@
+//! Jaco: a scripted Cartesian controller with its own forward kinematics (transcribed from the
+//! MJCF, independent of the environment's code) moves the tool centre point above a field or
+//! pivot, points the hand down and descends until the press registers.
+
+use rapier3d::math::{Rotation, Vector};
+use rapier3d::na::{DMatrix, DVector};
+use seads_embodiment::{EnvConfig, Environment, Layout, make_env};
+use seads_games::MoveId;
+
+/// MJCF frames of b_1 … b_6: offset and (w, x, y, z) orientation relative to the parent.
+const FRAMES: [([f32; 3], [f32; 4]); 6] = [
+    ([0.0, 0.0, 0.15675], [0.0, 0.0, 1.0, 0.0]),
+    ([0.0, 0.0016, -0.11875], [0.0, 0.0, -0.707107, 0.707107]),
+    ([0.0, -0.41, 0.0], [0.0, 0.0, 1.0, 0.0]),
+    ([0.0, 0.2073, -0.0114], [0.0, 0.0, -0.707107, 0.707107]),
+    ([0.0, -0.03703, -0.06414], [0.0, 0.0, 0.5, 0.866025]),
+    ([0.0, -0.03703, -0.06414], [0.0, 0.0, 0.5, 0.866025]),
+];
+const CTRL_MAX: [f32; 6] = [0.62832, 0.62832, 0.62832, 0.83776, 0.83776, 0.83776];
+
+/// Tool centre point and hand z axis for arm joint angles `q`.
+fn forward(q: &[f32; 6]) -> (Vector, Vector) {
+    let (mut p, mut r) = (Vector::new(0.0, 0.4, 0.0), Rotation::IDENTITY);
+    for (i, (pos, quat)) in FRAMES.iter().enumerate() {
+        p += r * Vector::from_array(*pos);
+        r = r
+            * Rotation::from_xyzw(quat[1], quat[2], quat[3], quat[0]).normalize()
+            * Rotation::from_rotation_z(q[i]);
+    }
+    (p + r * Vector::new(0.0, -0.0001, -0.159), r * Vector::Z)
+}
+
+/// Joint angles from the observation's (sin, cos) pairs.
+fn angles(obs: &[f32]) -> [f32; 6] {
+    std::array::from_fn(|j| obs[2 * j].atan2(obs[2 * j + 1]))
+}
+
+/// Damped least squares on [position (3), hand z axis x/y (2)]: joint velocities towards `target`.
+fn controller(target: Vector, obs: &[f32]) -> Vec<f32> {
+    let q = angles(obs);
+    let task = |q: &[f32; 6]| {
+        let (p, z) = forward(q);
+        [p.x, p.y, p.z, z.x, z.y]
+    };
+    let now = task(&q);
+    let goal = [target.x, target.y, target.z, 0.0, 0.0];
+    let mut jac = DMatrix::<f32>::zeros(5, 6);
+    for j in 0..6 {
+        let mut qq = q;
+        qq[j] += 1e-3;
+        let t = task(&qq);
+        for r in 0..5 {
+            jac[(r, j)] = (t[r] - now[r]) / 1e-3;
+        }
+    }
+    let err = DVector::from_iterator(5, (0..5).map(|r| (goal[r] - now[r]) * 3.0));
+    let jjt = &jac * jac.transpose() + DMatrix::identity(5, 5) * 0.01;
+    let qd = jac.transpose() * jjt.lu().solve(&err).expect("damped system is regular");
+    let mut action: Vec<f32> = (0..6)
+        .map(|j| (qd[j] / CTRL_MAX[j]).clamp(-1.0, 1.0))
+        .collect();
+    action.extend([1.0; 3]); // close the hand: open fingers splay ±9 cm and would press neighbours
+    action
+}
+
+/// Aims at board point `target` (world x, y): above it first, then down. Returns the move made.
+fn press(env: &mut dyn Environment, seed: u64, target: [f32; 2], top: f32) -> Option<MoveId> {
+    env.seed(seed);
+    env.reset();
+    let limit = env.spec().step_limit.unwrap();
+    let mut descending = false;
+    for _ in 0..limit {
+        let obs = env.observation();
+        let (tcp, _) = forward(&angles(&obs));
+        // Approach from above, then descend (and stay descending) once over the target.
+        descending |= (tcp.x - target[0]).hypot(tcp.y - target[1]) < 0.02;
+        let goal = Vector::new(
+            target[0],
+            target[1],
+            if descending {
+                (tcp.z - 0.05).max(top - 0.05)
+            } else {
+                top + 0.10
+            },
+        );
+        let out = env.step(&controller(goal, &obs)).unwrap();
+        if out.done() {
+            return out.game_move();
+        }
+    }
+    None
+}
+
+#[test]
+fn forward_kinematics_matches_the_observed_pinch_site() {
+    let mut env = make_env("lightsout-jaco", &EnvConfig::default()).unwrap();
+    for seed in 0..3 {
+        env.seed(seed);
+        env.reset();
+        let obs = env.observation();
+        let (tcp, z) = forward(&angles(&obs));
+        // Reset puts the tool in the box above the board, pointing down.
+        assert!(
+            tcp.x.abs() <= 0.11 && tcp.y.abs() <= 0.11 && (0.19..=0.41).contains(&tcp.z),
+            "seed {seed}: {tcp:?}"
+        );
+        assert!(z.z > 0.95, "hand axis {z:?}");
+        // The pinch site is 3.4 cm beyond the grip site along the tool axis.
+        let pinch = Vector::new(obs[30], obs[31], obs[32]);
+        assert!(
+            (pinch - tcp).length() < 0.05 && pinch.z < tcp.z,
+            "{pinch:?} vs {tcp:?}"
+        );
+    }
+}
+
+/// Presses every move in `moves` from every seed; returns the failures.
+fn sweep(name: &str, seeds: &[u64], moves: &[MoveId]) -> Vec<String> {
+    let mut env = make_env(name, &EnvConfig::default()).unwrap();
+    let n = env.spec().board_size;
+    let mut failures = Vec::new();
+    for &seed in seeds {
+        for &mv in moves {
+            let (target, top) = match n {
+                5 => {
+                    let (row, col) = (mv / 5, mv % 5);
+                    let ring = row.abs_diff(2).max(col.abs_diff(2));
+                    let top = if name.starts_with("lightsout3d") {
+                        [0.02, 0.06, 0.10][ring]
+                    } else {
+                        0.02
+                    };
+                    ([(col as f32 - 2.0) * 0.1, (2.0 - row as f32) * 0.1], top)
+                }
+                _ => {
+                    let (u, v) = Layout::Pivots
+                        .pivots()
+                        .into_iter()
+                        .find(|&(u, v)| Layout::Pivots.locate(u, v) == Some(mv))
+                        .unwrap();
+                    ([u as f32 * 0.3 - 0.15, (1.0 - v as f32) * 0.3 - 0.15], 0.02)
+                }
+            };
+            let made = press(env.as_mut(), seed, target, top);
+            if made != Some(mv) {
+                failures.push(format!("seed {seed}: aimed at {mv}, made {made:?}"));
+            }
+        }
+    }
+    failures
+}
+
+fn check(name: &str, seeds: &[u64], moves: &[MoveId]) {
+    let failures = sweep(name, seeds, moves);
+    assert!(
+        failures.is_empty(),
+        "{name}: {} of {} presses failed: {failures:?}",
+        failures.len(),
+        seeds.len() * moves.len()
+    );
+}
+
+/// CI: a few moves of each Jaco environment.
+#[test]
+fn jaco_presses_fields_and_pivots() {
+    check("lightsout-jaco", &[1], &[0, 12, 24]);
+    check("tileswap-jaco", &[1], &[2, 7]);
+    check("lightsout3d-jaco", &[1], &[6]);
+}
+
+/// Every move of every Jaco environment on several seeds (minutes): `cargo test --release -p
+/// seads-embodiment --test jaco -- --ignored`.
+#[test]
+#[ignore = "full sweep, minutes; run on demand with --ignored"]
+fn jaco_produces_every_move_full_sweep() {
+    // The scripted controller is simple: on the 3-D board the raised outer ring sometimes blocks
+    // the hand above an inner field within the 50 steps. Measured: see the closing note.
+    let seeds: Vec<u64> = (1..=10).collect();
+    for (name, k) in [
+        ("lightsout-jaco", 25),
+        ("lightsout3d-jaco", 25),
+        ("tileswap-jaco", 12),
+    ] {
+        let failures = sweep(name, &seeds, &(0..k).collect::<Vec<_>>());
+        eprintln!(
+            "{name}: {} of {} presses made the intended move",
+            seeds.len() * k - failures.len(),
+            seeds.len() * k
+        );
+        assert!(
+            failures.len() * 100 <= seeds.len() * k,
+            "{name}: more than 1 % failed: {failures:?}"
+        );
+    }
+}
