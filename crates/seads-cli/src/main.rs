@@ -1,6 +1,8 @@
 //! `seads`: the command line of the SEADS workspace — the only crate that prints.
 #![allow(clippy::print_stdout, clippy::print_stderr)] // printing is this crate's job
 
+mod draw;
+mod envs;
 mod games;
 
 use std::process::ExitCode;
@@ -22,6 +24,16 @@ enum Command {
     Games(games::GamesCommand),
     /// The main job on embedded defaults: print both depth tables and solve a sample board.
     Run,
+    /// List the embodied environments with their dimensions.
+    Envs {
+        /// Print JSON.
+        #[arg(long)]
+        json: bool,
+    },
+    /// Draw a top view of an environment after reset (board, tile numbers, manipulator).
+    Render(envs::RenderArgs),
+    /// Measure environment steps per second with random actions.
+    EnvBench(envs::BenchArgs),
 }
 
 /// Input the user gave that cannot be used (exit code 2, like a usage error).
@@ -34,6 +46,9 @@ fn main() -> ExitCode {
     let result = match cli.command {
         Command::Games(cmd) => games::run(cmd),
         Command::Run => games::demo(),
+        Command::Envs { json } => envs::envs(json),
+        Command::Render(args) => envs::render(args),
+        Command::EnvBench(args) => envs::env_bench(args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

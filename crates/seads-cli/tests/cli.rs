@@ -165,3 +165,94 @@ fn unknown_game_is_a_usage_error() {
     assert_eq!(out.status.code(), Some(2));
     assert!(String::from_utf8_lossy(&out.stderr).contains("unknown game"));
 }
+
+#[test]
+fn envs_json_lists_every_environment() {
+    let v = json(&["envs", "--json"]);
+    let names: Vec<&str> = v
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|e| e["name"].as_str().unwrap())
+        .collect();
+    assert_eq!(
+        names,
+        [
+            "lightsout-cursor",
+            "tileswap-cursor",
+            "lightsout-reacher",
+            "tileswap-reacher",
+            "lightsout-jaco",
+            "tileswap-jaco",
+            "lightsout3d-jaco"
+        ]
+    );
+    assert_eq!(v[0]["obs_dim"], 28);
+    assert_eq!(v[5]["obs_dim"], 124);
+}
+
+#[test]
+fn render_writes_png_and_svg() {
+    let dir = tempfile::tempdir().unwrap();
+    for (env, file) in [("tileswap-cursor", "a.png"), ("lightsout-reacher", "b.svg")] {
+        let out = dir.path().join(file);
+        let status = seads(&[
+            "render",
+            "--env",
+            env,
+            "--seed",
+            "2",
+            "--out",
+            out.to_str().unwrap(),
+        ]);
+        assert!(
+            status.status.success(),
+            "{}",
+            String::from_utf8_lossy(&status.stderr)
+        );
+        let bytes = std::fs::read(&out).unwrap();
+        if file.ends_with(".png") {
+            assert_eq!(&bytes[1..4], b"PNG");
+        } else {
+            let text = String::from_utf8(bytes).unwrap();
+            assert!(text.contains("<svg") && text.contains("lightsout-reacher"));
+        }
+    }
+    check_bad_input(
+        &["render", "--env", "lightsout-robot", "--out", "x.png"],
+        "valid environments: lightsout-cursor",
+    );
+    check_bad_input(
+        &[
+            "render",
+            "--env",
+            "lightsout-cursor",
+            "--board-size",
+            "6",
+            "--out",
+            "x.png",
+        ],
+        "odd sizes",
+    );
+}
+
+#[test]
+fn env_bench_reports_steps_per_second() {
+    let v = json(&[
+        "env-bench",
+        "--env",
+        "tileswap-reacher",
+        "--steps",
+        "20000",
+        "--threads",
+        "2",
+        "--json",
+    ]);
+    assert_eq!(v["env"], "tileswap-reacher");
+    assert_eq!(v["steps"], 20000);
+    assert!(v["steps_per_sec"].as_f64().unwrap() > 0.0);
+    check_bad_input(
+        &["env-bench", "--env", "lightsout-cursor", "--threads", "0"],
+        "at least 1",
+    );
+}

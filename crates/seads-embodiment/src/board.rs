@@ -115,8 +115,8 @@ impl BoardState {
 
 /// Enumerated boards are shared by every environment of the same game, size and depth.
 fn dataset(kind: GameKind, size: usize, max_depth: usize) -> Arc<BoardDataset> {
-    static CACHE: OnceLock<Mutex<BTreeMap<(GameKind, usize, usize), Arc<BoardDataset>>>> =
-        OnceLock::new();
+    type Cache = BTreeMap<(GameKind, usize, usize), Arc<BoardDataset>>;
+    static CACHE: OnceLock<Mutex<Cache>> = OnceLock::new();
     let mut cache = CACHE
         .get_or_init(Default::default)
         .lock()

@@ -23,6 +23,9 @@
 //! - Presses are detected from the contacts of the physics step just taken (the reference reads
 //!   the contacts cached before the substep).
 
+// The MJCF's rounded quaternion literals (0.707107, 0.866025) are kept as written there.
+#![allow(clippy::approx_constant)]
+
 use std::f32::consts::{PI, TAU};
 
 use rand::RngExt;
@@ -703,10 +706,8 @@ impl Manipulator for Jaco {
             out[12 + j] = symlog1p(torque);
             out[18 + j] = qd[j];
         }
-        for f in 0..3 {
-            out[24 + f] = q[6 + f];
-            out[27 + f] = qd[6 + f];
-        }
+        out[24..27].copy_from_slice(&q[6..9]);
+        out[27..30].copy_from_slice(&qd[6..9]);
         let hand = self.hand_pose();
         out[30..33].copy_from_slice(&hand.transform_point(vec3(PINCH_SITE)).to_array());
         let rot = rapier3d::math::Matrix::from_quat(hand.rotation * quat(SITE_QUAT));

@@ -115,9 +115,9 @@ impl Reacher {
             (a22 * f[0] - a12 * f[1]) / det_h,
             (-a12 * f[0] + a11 * f[1]) / det_h,
         ];
-        for i in 0..2 {
-            self.qd[i] += H * qdd[i];
-            self.q[i] += H * self.qd[i];
+        for ((q, qd), acc) in self.q.iter_mut().zip(&mut self.qd).zip(qdd) {
+            *qd += H * acc;
+            *q += H * *qd;
         }
     }
 

@@ -138,7 +138,7 @@ fn layout(entry: &Entry, config: &EnvConfig) -> Result<Layout, EnvError> {
             entry.name
         )));
     }
-    if !(5..=13).contains(&size) || size % 2 == 0 {
+    if !(5..=13).contains(&size) || size.is_multiple_of(2) {
         return Err(EnvError::InvalidConfig(format!(
             "spaced LightsOut boards have odd sizes 5 to 13, got {size}"
         )));

@@ -83,32 +83,41 @@ impl VecEnv {
         outcomes: &mut [StepOutcome],
     ) -> Result<(), EnvError> {
         let (a, o) = (self.action_dim(), self.obs_dim());
-        let step_one = |(((env, act), ob), (out, &on)): (
-            ((&mut Box<dyn Environment>, &[f32]), &mut [f32]),
-            (&mut StepOutcome, &bool),
-        )| {
-            if on {
-                *out = env.step(act)?;
-                env.observe(ob);
-            }
-            Ok(())
-        };
         if self.parallel {
             self.envs
                 .par_iter_mut()
                 .zip(actions.par_chunks(a))
                 .zip(obs.par_chunks_mut(o))
                 .zip(outcomes.par_iter_mut().zip(active.par_iter()))
-                .try_for_each(step_one)
+                .try_for_each(|(((env, act), ob), (out, &on))| {
+                    step_active(env.as_mut(), on, act, ob, out)
+                })
         } else {
             self.envs
                 .iter_mut()
                 .zip(actions.chunks(a))
                 .zip(obs.chunks_mut(o))
                 .zip(outcomes.iter_mut().zip(active.iter()))
-                .try_for_each(step_one)
+                .try_for_each(|(((env, act), ob), (out, &on))| {
+                    step_active(env.as_mut(), on, act, ob, out)
+                })
         }
     }
+}
+
+/// Steps one environment of a batch if it is active.
+fn step_active(
+    env: &mut dyn Environment,
+    active: bool,
+    action: &[f32],
+    obs: &mut [f32],
+    outcome: &mut StepOutcome,
+) -> Result<(), EnvError> {
+    if active {
+        *outcome = env.step(action)?;
+        env.observe(obs);
+    }
+    Ok(())
 }
 
 /// Steps `env` `steps` times with uniformly random actions from a stream seeded with `seed`,

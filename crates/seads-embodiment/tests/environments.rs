@@ -262,7 +262,7 @@ fn vec_env_steps_like_single_environments() {
     let mut outcomes = vec![StepOutcome::default(); 4];
     let active = [true, false, true, true];
     let actions: Vec<f32> = (0..4 * a)
-        .map(|i| ((i * 7 % 11) as f32 / 5.0 - 1.0))
+        .map(|i| (i * 7 % 11) as f32 / 5.0 - 1.0)
         .collect();
     batch
         .step(&active, &actions, &mut obs, &mut outcomes)

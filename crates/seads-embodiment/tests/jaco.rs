@@ -1,6 +1,8 @@
 //! Jaco: a scripted Cartesian controller with its own forward kinematics (transcribed from the
 //! MJCF, independent of the environment's code) moves the tool centre point above a field or
 //! pivot, points the hand down and descends until the press registers.
+#![allow(clippy::approx_constant)] // the MJCF's rounded quaternion literals
+#![allow(clippy::print_stderr)] // the full sweep reports its measured success
 
 use rapier3d::math::{Rotation, Vector};
 use rapier3d::na::{DMatrix, DVector};

@@ -1,0 +1,154 @@
+//! `seads envs`, `seads render`, `seads env-bench`: the embodied environments.
+
+use std::path::PathBuf;
+use std::time::Instant;
+
+use anyhow::{Context, Result};
+use clap::Args;
+use seads_embodiment::{EnvConfig, Environment, list_envs, make_env, random_rollout};
+use serde::Serialize;
+
+use crate::BadInput;
+
+/// Builds an environment, turning configuration mistakes into exit code 2.
+pub fn build_env(name: &str, config: &EnvConfig) -> Result<Box<dyn Environment>> {
+    make_env(name, config).map_err(|e| BadInput(e.into()).into())
+}
+
+/// `seads envs`: every registered environment with its dimensions.
+pub fn envs(json: bool) -> Result<()> {
+    let envs = list_envs();
+    if json {
+        println!("{}", serde_json::to_string(&envs)?);
+        return Ok(());
+    }
+    println!(
+        "{:<18} {:>7} {:>6} {:>6} {:>5}  description",
+        "name", "obs", "action", "skills", "T_max"
+    );
+    for e in envs {
+        println!(
+            "{:<18} {:>7} {:>6} {:>6} {:>5}  {}",
+            e.name, e.obs_dim, e.action_dim, e.num_skills, e.step_limit, e.description
+        );
+    }
+    Ok(())
+}
+
+/// Arguments of `seads render`.
+#[derive(Debug, Args)]
+pub struct RenderArgs {
+    /// Environment name (see `seads envs`).
+    #[arg(long)]
+    env: String,
+    /// Seed of the reset (board and manipulator).
+    #[arg(long, default_value_t = 0)]
+    seed: u64,
+    /// Output image: .png or .svg.
+    #[arg(long)]
+    out: PathBuf,
+    /// Board side for lightsout-cursor (5, 7, 9, 13).
+    #[arg(long)]
+    board_size: Option<usize>,
+    /// Relative spacing between fields (spaced LightsOut boards), in [0, 1].
+    #[arg(long)]
+    spacing: Option<f64>,
+}
+
+/// `seads render`: a top view of a freshly reset environment.
+pub fn render(args: RenderArgs) -> Result<()> {
+    let config = EnvConfig {
+        board_size: args.board_size,
+        spacing: args.spacing,
+        ..EnvConfig::default()
+    };
+    let mut env = build_env(&args.env, &config)?;
+    env.seed(args.seed);
+    env.reset();
+    let title = format!("{} (seed {})", args.env, args.seed);
+    crate::draw::render_scene(&env.scene(), &title, &args.out)?;
+    println!("wrote {}", args.out.display());
+    Ok(())
+}
+
+/// Arguments of `seads env-bench`.
+#[derive(Debug, Args)]
+pub struct BenchArgs {
+    /// Environment name (see `seads envs`).
+    #[arg(long)]
+    env: String,
+    /// Total environment steps (random actions, reset when a skill ends).
+    #[arg(long, default_value_t = 1_000_000)]
+    steps: usize,
+    /// Threads, each stepping its own environment.
+    #[arg(long, default_value_t = 1)]
+    threads: usize,
+    /// Jaco only: physics steps per environment step (reference: 50).
+    #[arg(long)]
+    physics_substeps: Option<usize>,
+    /// Print JSON.
+    #[arg(long)]
+    json: bool,
+}
+
+#[derive(Serialize)]
+struct BenchReport {
+    env: String,
+    steps: usize,
+    threads: usize,
+    seconds: f64,
+    steps_per_sec: f64,
+}
+
+/// `seads env-bench`: environment steps per second with random actions.
+pub fn env_bench(args: BenchArgs) -> Result<()> {
+    if args.threads == 0 || args.steps == 0 {
+        return Err(BadInput(anyhow::anyhow!("--steps and --threads must be at least 1")).into());
+    }
+    let config = EnvConfig {
+        physics_substeps: args.physics_substeps,
+        ..EnvConfig::default()
+    };
+    let template = build_env(&args.env, &config)?;
+    let per_thread = args.steps.div_ceil(args.threads);
+    let envs: Vec<Box<dyn Environment>> = (0..args.threads)
+        .map(|i| {
+            let mut env = template.clone();
+            env.seed(i as u64 + 1);
+            env.reset();
+            env
+        })
+        .collect();
+    let start = Instant::now();
+    std::thread::scope(|scope| {
+        let handles: Vec<_> = envs
+            .into_iter()
+            .enumerate()
+            .map(|(i, mut env)| {
+                scope.spawn(move || random_rollout(env.as_mut(), per_thread, i as u64))
+            })
+            .collect();
+        handles
+            .into_iter()
+            .try_for_each(|h| h.join().expect("bench thread").map(|_| ()))
+    })
+    .context("stepping the environment")?;
+    let seconds = start.elapsed().as_secs_f64();
+    let steps = per_thread * args.threads;
+    let report = BenchReport {
+        env: args.env,
+        steps,
+        threads: args.threads,
+        seconds,
+        steps_per_sec: steps as f64 / seconds,
+    };
+    if args.json {
+        println!("{}", serde_json::to_string(&report)?);
+    } else {
+        println!(
+            "{}: {} steps on {} thread(s) in {:.3} s = {:.0} steps/s",
+            report.env, steps, report.threads, seconds, report.steps_per_sec
+        );
+    }
+    Ok(())
+}
