@@ -4,6 +4,7 @@
 mod draw;
 mod envs;
 mod games;
+mod train;
 
 use std::process::ExitCode;
 
@@ -34,6 +35,8 @@ enum Command {
     Render(envs::RenderArgs),
     /// Measure environment steps per second with random actions.
     EnvBench(envs::BenchArgs),
+    /// Train SEADS skills and their forward model on an environment (no task reward).
+    Train(train::TrainArgs),
 }
 
 /// Input the user gave that cannot be used (exit code 2, like a usage error).
@@ -49,6 +52,7 @@ fn main() -> ExitCode {
         Command::Envs { json } => envs::envs(json),
         Command::Render(args) => envs::render(args),
         Command::EnvBench(args) => envs::env_bench(args),
+        Command::Train(args) => train::train(args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

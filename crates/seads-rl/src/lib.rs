@@ -1,7 +1,65 @@
-//! Reinforcement learning for SEADS (SPEC §3.2): soft actor-critic on tch (libtorch) for the
-//! skill-conditioned policy π(a | s, k). Will own the actor, the twin critics and their updates.
+//! Reinforcement learning for SEADS: soft actor-critic on tch (SPEC §3.2) and the SEADS training
+//! loop of Algorithm 3 (SPEC §3.3, §3.7) — episode collection in lockstep with batched policy
+//! calls, long- and short-term episode buffers, relabelling with the skill model, skill-model and
+//! SAC updates, skill coverage, checkpoints and run directories.
 //!
-//! Architecture invariant: with `seads-skillmodel`, the only crate that links libtorch.
+//! Architecture invariant: with `seads-skillmodel`, the only crate that links libtorch. No
+//! printing; the binary shows progress from the values [`Run::step`] returns. Every random
+//! choice comes from streams seeded by the run's seed (network initialisation included), never
+//! from libtorch's global generator.
+
+mod config;
+mod episode;
+mod run;
+mod sac;
+mod trainer;
+
+use std::path::Path;
+
+pub use config::{RelabelConfig, TrainConfig};
+pub use episode::{Episode, policy_input, run_episodes, skill_coverage};
+pub use run::{Metrics, Run, RunEvent, checkpoints, latest_checkpoint, load_config, read_metrics};
+pub use sac::{Sac, SacConfig, SacLosses, TransitionBatch};
+pub use trainer::{COVERAGE_SEED, EpochStats, Timings, Trainer};
+
+/// Errors of training and checkpoints.
+#[derive(Debug, thiserror::Error)]
+pub enum RlError {
+    /// A configuration value that cannot be used.
+    #[error("invalid configuration: {0}")]
+    Config(String),
+    /// The environment failed.
+    #[error(transparent)]
+    Env(#[from] seads_embodiment::EnvError),
+    /// The skill model failed.
+    #[error(transparent)]
+    SkillModel(#[from] seads_skillmodel::SkillModelError),
+    /// Reading or writing a file failed.
+    #[error("{path}: {reason}")]
+    Io {
+        /// The file.
+        path: String,
+        /// What went wrong.
+        reason: String,
+    },
+    /// A checkpoint is missing, corrupt or from another configuration.
+    #[error("cannot load checkpoint {path}: {reason}")]
+    Checkpoint {
+        /// The file.
+        path: String,
+        /// What went wrong.
+        reason: String,
+    },
+}
+
+impl RlError {
+    fn io(path: &Path, e: impl std::fmt::Display) -> Self {
+        RlError::Io {
+            path: path.display().to_string(),
+            reason: e.to_string(),
+        }
+    }
+}
 
 #[cfg(test)]
 mod tests {
@@ -11,14 +69,18 @@ mod tests {
     /// libtorch is installed and linked: one Adam step of a small MLP lowers its loss.
     #[test]
     fn tch_smoke_adam_step_lowers_loss() {
-        tch::manual_seed(0);
         let vs = nn::VarStore::new(Device::Cpu);
         let net = nn::seq()
             .add(nn::linear(vs.root() / "l1", 4, 16, Default::default()))
             .add_fn(|x| x.relu())
             .add(nn::linear(vs.root() / "l2", 16, 1, Default::default()));
         let mut opt = nn::Adam::default().build(&vs, 1e-2).expect("optimizer");
-        let x = Tensor::randn([64, 4], (Kind::Float, Device::Cpu));
+        let x = Tensor::from_slice(
+            &(0..256)
+                .map(|i| ((i * 37 % 101) as f32 - 50.0) / 25.0)
+                .collect::<Vec<_>>(),
+        )
+        .view([64, 4]);
         let y = x.sum_dim_intlist(1, true, Kind::Float);
         let loss = |net: &nn::Sequential| (net.forward(&x) - &y).square().mean(Kind::Float);
         let before = f64::try_from(loss(&net)).unwrap();

@@ -1,0 +1,579 @@
+//! The SEADS training loop (SPEC §3.7, Algorithm 3): collect episodes with the skill policy,
+//! relabel them with the skill model, update the skill model and SAC.
+
+use std::collections::VecDeque;
+use std::path::Path;
+use std::time::Instant;
+
+use rand::RngExt;
+use rand_chacha::ChaCha8Rng;
+use seads_embodiment::{EnvConfig, EnvSpec, Environment, make_env};
+use seads_games::{Split, SymbolicState};
+use seads_skillmodel::{SkillModel, SkillTransition, episode_rewards, minimum_reward, relabel};
+use serde::{Deserialize, Serialize};
+use tch::{Device, Kind, Tensor};
+
+use crate::episode::{policy_input, run_episodes, skill_coverage, stream};
+use crate::{Episode, RlError, Sac, SacLosses, TrainConfig, TransitionBatch};
+
+/// First seed of the skill-coverage evaluation (the paper's 444555 … 444574).
+pub const COVERAGE_SEED: u64 = 444_555;
+
+/// Independent random streams of a run (one per purpose).
+#[derive(Debug, Clone, Serialize, Deserialize)]
+struct Streams {
+    /// Skill labels of new episodes.
+    labels: ChaCha8Rng,
+    /// Policy noise while collecting.
+    collect: ChaCha8Rng,
+    /// Buffer sampling and relabelling choices.
+    sample: ChaCha8Rng,
+    /// SAC update noise and minibatches.
+    sac: ChaCha8Rng,
+}
+
+/// Seconds spent per phase since the start of the run (the epoch profile).
+#[derive(Debug, Clone, Copy, Default, Serialize, Deserialize)]
+pub struct Timings {
+    /// Episode collection (environment steps and policy calls).
+    pub collect: f64,
+    /// Skill-model scores, rewards and assignments, for both batches.
+    pub relabel: f64,
+    /// Skill-model gradient steps.
+    pub skill_model: f64,
+    /// SAC gradient steps (including minibatch assembly).
+    pub sac: f64,
+    /// Skill-coverage evaluations.
+    pub evaluate: f64,
+}
+
+/// What one epoch did.
+#[derive(Debug, Clone, Default, Serialize)]
+pub struct EpochStats {
+    /// Epoch index (0-based) of the epoch just run.
+    pub epoch: u64,
+    /// Environment steps so far.
+    pub env_steps: u64,
+    /// Whether updates ran (they start once the buffer holds `sampled_episodes` episodes).
+    pub updated: bool,
+    /// Mean final reward of the SAC batch.
+    pub mean_reward: f32,
+    /// Fraction of the new episodes that changed the board.
+    pub changed: f32,
+    /// Mean skill-model loss of this epoch.
+    pub skill_model_loss: f32,
+    /// Mean SAC losses of this epoch.
+    pub sac: SacLosses,
+}
+
+/// Progress counters saved with every checkpoint.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+struct Progress {
+    epoch: u64,
+    env_steps: u64,
+    timings: Timings,
+    streams: Streams,
+}
+
+/// A SEADS agent in training.
+pub struct Trainer {
+    config: TrainConfig,
+    spec: EnvSpec,
+    k: usize,
+    envs: Vec<Box<dyn Environment>>,
+    eval_env: Box<dyn Environment>,
+    sac: Sac,
+    model: Box<dyn SkillModel>,
+    episodes: VecDeque<Episode>,
+    progress: Progress,
+}
+
+impl Trainer {
+    /// A fresh agent for `config` (validated).
+    pub fn new(config: TrainConfig) -> Result<Self, RlError> {
+        config.validate()?;
+        if config.threads > 0 {
+            tch::set_num_threads(config.threads as i32);
+        }
+        let train_env = EnvConfig {
+            reset_split: Split::Train,
+            ..config.env_config.clone()
+        };
+        let template = make_env(&config.env, &train_env)?;
+        let spec = template.spec().clone();
+        let k = config.num_skills.unwrap_or(spec.num_skills);
+        let envs = (0..config.episodes_per_epoch)
+            .map(|i| {
+                let mut env = template.box_clone();
+                // Training workers are seeded 6242 + seed + i (the reference's base seed).
+                env.seed(6242 + config.seed + i as u64);
+                env
+            })
+            .collect();
+        // Coverage is measured on test boards drawn as in training (random depth up to the max).
+        let eval_config = EnvConfig {
+            reset_split: Split::Test,
+            ..config.env_config.clone()
+        };
+        let eval_env = make_env(&config.env, &eval_config)?;
+        let device = Device::Cpu;
+        let sac = Sac::new(
+            spec.obs_dim + k,
+            &spec.action_low,
+            &spec.action_high,
+            &config.sac,
+            device,
+            config.seed,
+        );
+        let model =
+            config
+                .skill_model
+                .build(spec.symbolic_len, k, device, config.seed.wrapping_add(1));
+        let streams = Streams {
+            labels: stream(config.seed, 1),
+            collect: stream(config.seed, 2),
+            sample: stream(config.seed, 3),
+            sac: stream(config.seed, 4),
+        };
+        let progress = Progress {
+            epoch: 0,
+            env_steps: 0,
+            timings: Timings::default(),
+            streams,
+        };
+        Ok(Self {
+            config,
+            spec,
+            k,
+            envs,
+            eval_env,
+            sac,
+            model,
+            episodes: VecDeque::new(),
+            progress,
+        })
+    }
+
+    /// The configuration.
+    pub fn config(&self) -> &TrainConfig {
+        &self.config
+    }
+
+    /// The environment's dimensions.
+    pub fn spec(&self) -> &EnvSpec {
+        &self.spec
+    }
+
+    /// Number of skills K.
+    pub fn num_skills(&self) -> usize {
+        self.k
+    }
+
+    /// Epochs run so far.
+    pub fn epoch(&self) -> u64 {
+        self.progress.epoch
+    }
+
+    /// Environment steps so far.
+    pub fn env_steps(&self) -> u64 {
+        self.progress.env_steps
+    }
+
+    /// Time spent per phase.
+    pub fn timings(&self) -> Timings {
+        self.progress.timings
+    }
+
+    /// Whether the step budget is spent.
+    pub fn finished(&self) -> bool {
+        self.progress.env_steps >= self.config.env_steps
+    }
+
+    /// The skill policy.
+    pub fn policy(&self) -> &Sac {
+        &self.sac
+    }
+
+    /// The skill model.
+    pub fn skill_model(&self) -> &dyn SkillModel {
+        self.model.as_ref()
+    }
+
+    /// One epoch of Algorithm 3.
+    pub fn run_epoch(&mut self) -> Result<EpochStats, RlError> {
+        let mut stats = EpochStats {
+            epoch: self.progress.epoch,
+            ..EpochStats::default()
+        };
+
+        // Collect with the parameters of the start of the epoch (the reference collects in the
+        // background while it updates; the new episodes join the buffers after the updates).
+        let start = Instant::now();
+        let skills: Vec<usize> = (0..self.envs.len())
+            .map(|_| self.progress.streams.labels.random_range(0..self.k))
+            .collect();
+        for env in &mut self.envs {
+            env.reset();
+        }
+        let new = run_episodes(
+            &mut self.envs,
+            &skills,
+            &self.sac,
+            self.k,
+            Some(&mut self.progress.streams.collect),
+        )?;
+        self.progress.timings.collect += start.elapsed().as_secs_f64();
+
+        if self.episodes.len() >= self.config.sampled_episodes {
+            stats.updated = true;
+            let (loss, _) = self.update_skill_model();
+            stats.skill_model_loss = loss;
+            let (losses, reward) = self.update_sac();
+            stats.sac = losses;
+            stats.mean_reward = reward;
+        }
+
+        let a = self.spec.action_dim;
+        stats.changed = new.iter().filter(|e| e.changed()).count() as f32 / new.len().max(1) as f32;
+        for episode in new {
+            self.progress.env_steps += episode.len(a) as u64;
+            if self.episodes.len() == self.config.buffer_capacity {
+                self.episodes.pop_front();
+            }
+            self.episodes.push_back(episode);
+        }
+        self.progress.epoch += 1;
+        stats.env_steps = self.progress.env_steps;
+        Ok(stats)
+    }
+
+    /// Indices of an update batch: `sampled_episodes` drawn with replacement from the long-term
+    /// buffer (all of it if it holds exactly that many), followed by the recent episodes.
+    fn update_batch(&mut self) -> Vec<usize> {
+        let n = self.episodes.len();
+        let mut batch: Vec<usize> = if n == self.config.sampled_episodes {
+            (0..n).collect()
+        } else {
+            (0..self.config.sampled_episodes)
+                .map(|_| self.progress.streams.sample.random_range(0..n))
+                .collect()
+        };
+        batch.extend(n.saturating_sub(self.config.recent_episodes)..n);
+        batch
+    }
+
+    /// Scores, clipped posteriors C and rewards R of episodes (row-major, K per episode).
+    fn score(&self, batch: &[usize]) -> (Vec<f32>, Vec<f32>) {
+        let pairs: Vec<(SymbolicState, SymbolicState)> = batch
+            .iter()
+            .map(|&i| (self.episodes[i].z0, self.episodes[i].zt))
+            .collect();
+        let scores = self.model.scores(&pairs);
+        let likelihoods = self.model.scores_are_likelihoods();
+        let mut clipped = Vec::with_capacity(scores.len());
+        let mut rewards = Vec::with_capacity(scores.len());
+        for row in scores.chunks(self.k) {
+            let (c, r) = episode_rewards(row, likelihoods, &self.config.reward);
+            clipped.extend(c);
+            rewards.extend(r);
+        }
+        (clipped, rewards)
+    }
+
+    /// Final labels of a batch after relabelling: each episode is chosen with probability `p`
+    /// (only board-changing ones if `changed_only`) and the chosen ones are relabelled together.
+    fn relabelled(
+        &mut self,
+        batch: &[usize],
+        clipped: &[f32],
+        p: f64,
+        changed_only: bool,
+    ) -> Vec<usize> {
+        let mut labels: Vec<usize> = batch.iter().map(|&i| self.episodes[i].skill).collect();
+        if p <= 0.0 {
+            return labels;
+        }
+        let chosen: Vec<usize> = (0..batch.len())
+            .filter(|&j| {
+                let draw = self.progress.streams.sample.random::<f64>() < p;
+                draw && (!changed_only || self.episodes[batch[j]].changed())
+            })
+            .collect();
+        let k = self.k;
+        let chosen_clipped: Vec<f32> = chosen
+            .iter()
+            .flat_map(|&j| clipped[j * k..(j + 1) * k].iter().copied())
+            .collect();
+        let chosen_labels: Vec<usize> = chosen.iter().map(|&j| labels[j]).collect();
+        for (&j, new) in chosen.iter().zip(relabel(
+            self.config.relabel.kind,
+            &chosen_clipped,
+            k,
+            &chosen_labels,
+        )) {
+            labels[j] = new;
+        }
+        labels
+    }
+
+    /// Step 3a: relabel a batch with p = 1 and take the skill-model steps.
+    fn update_skill_model(&mut self) -> (f32, usize) {
+        let start = Instant::now();
+        let batch = self.update_batch();
+        let (clipped, _) = self.score(&batch);
+        let labels = self.relabelled(&batch, &clipped, self.config.relabel.skill_model_p, false);
+        let tuples: Vec<SkillTransition> = batch
+            .iter()
+            .zip(&labels)
+            .map(|(&i, &skill)| SkillTransition {
+                z0: self.episodes[i].z0,
+                skill,
+                zt: self.episodes[i].zt,
+            })
+            .collect();
+        self.progress.timings.relabel += start.elapsed().as_secs_f64();
+
+        let start = Instant::now();
+        let config = &self.config.skill_model;
+        let mut loss = 0.0;
+        for _ in 0..config.updates_per_epoch {
+            let minibatch: Vec<SkillTransition> = (0..config.batch_size)
+                .map(|_| tuples[self.progress.streams.sample.random_range(0..tuples.len())])
+                .collect();
+            loss += self.model.train_step(&minibatch);
+        }
+        self.progress.timings.skill_model += start.elapsed().as_secs_f64();
+        (loss / config.updates_per_epoch.max(1) as f32, tuples.len())
+    }
+
+    /// Step 3b: relabel an independent batch with p = 0.5 (board-changing episodes only), reward
+    /// each episode's last transition, and take the SAC steps on its transitions.
+    fn update_sac(&mut self) -> (SacLosses, f32) {
+        let start = Instant::now();
+        let batch = self.update_batch();
+        let (clipped, rewards) = self.score(&batch);
+        let labels = self.relabelled(&batch, &clipped, self.config.relabel.sac_p, true);
+        let min_reward = minimum_reward(self.k);
+        let finals: Vec<f32> = batch
+            .iter()
+            .enumerate()
+            .map(|(j, &i)| {
+                if self.episodes[i].changed() {
+                    rewards[j * self.k + labels[j]]
+                } else {
+                    min_reward
+                }
+            })
+            .collect();
+        self.progress.timings.relabel += start.elapsed().as_secs_f64();
+
+        let start = Instant::now();
+        let a = self.spec.action_dim;
+        // Every transition of the batch: (batch position, time step).
+        let transitions: Vec<(usize, usize)> = batch
+            .iter()
+            .enumerate()
+            .flat_map(|(j, &i)| (0..self.episodes[i].len(a)).map(move |t| (j, t)))
+            .collect();
+        let config = self.config.sac.clone();
+        let mut total = SacLosses::default();
+        for _ in 0..config.updates_per_epoch {
+            let picks: Vec<(usize, usize)> = (0..config.batch_size)
+                .map(|_| transitions[self.progress.streams.sac.random_range(0..transitions.len())])
+                .collect();
+            let minibatch = self.transition_batch(&batch, &labels, &finals, &picks);
+            let losses = self.sac.update(&minibatch, &mut self.progress.streams.sac);
+            total.critic += losses.critic;
+            total.actor += losses.actor;
+            total.q += losses.q;
+        }
+        self.progress.timings.sac += start.elapsed().as_secs_f64();
+        let n = config.updates_per_epoch.max(1) as f32;
+        let mean_reward = finals.iter().sum::<f32>() / finals.len().max(1) as f32;
+        (
+            SacLosses {
+                critic: total.critic / n,
+                actor: total.actor / n,
+                q: total.q / n,
+            },
+            mean_reward,
+        )
+    }
+
+    /// SAC inputs for the picked transitions: `[s, onehot(final label)]`, the reward only on an
+    /// episode's last transition, done = 1 there (moves and time-outs alike).
+    fn transition_batch(
+        &self,
+        batch: &[usize],
+        labels: &[usize],
+        finals: &[f32],
+        picks: &[(usize, usize)],
+    ) -> TransitionBatch {
+        let (o, a) = (self.spec.obs_dim, self.spec.action_dim);
+        let width = o + self.k;
+        let mut out = TransitionBatch {
+            obs: vec![0.0; picks.len() * width],
+            actions: Vec::with_capacity(picks.len() * a),
+            rewards: Vec::with_capacity(picks.len()),
+            next_obs: vec![0.0; picks.len() * width],
+            dones: Vec::with_capacity(picks.len()),
+        };
+        for (row, &(j, t)) in picks.iter().enumerate() {
+            let e = &self.episodes[batch[j]];
+            let last = t + 1 == e.len(a);
+            policy_input(
+                &e.obs[t * o..(t + 1) * o],
+                labels[j],
+                &mut out.obs[row * width..(row + 1) * width],
+            );
+            policy_input(
+                &e.obs[(t + 1) * o..(t + 2) * o],
+                labels[j],
+                &mut out.next_obs[row * width..(row + 1) * width],
+            );
+            out.actions
+                .extend_from_slice(&e.actions[t * a..(t + 1) * a]);
+            out.rewards.push(if last { finals[j] } else { 0.0 });
+            out.dones.push(if last { 1.0 } else { 0.0 });
+        }
+        out
+    }
+
+    /// Skill coverage (SPEC §4.5): distinct game moves made by the K skills from identical
+    /// test-split resets, averaged over the evaluation seeds.
+    pub fn skill_coverage(&mut self) -> Result<f64, RlError> {
+        let start = Instant::now();
+        let seeds: Vec<u64> = (0..self.config.eval_seeds)
+            .map(|i| COVERAGE_SEED + i)
+            .collect();
+        let per_seed = skill_coverage(self.eval_env.as_ref(), &self.sac, self.k, &seeds)?;
+        self.progress.timings.evaluate += start.elapsed().as_secs_f64();
+        Ok(per_seed.iter().sum::<usize>() as f64 / per_seed.len() as f64)
+    }
+
+    /// Writes the complete training state into `dir` (which must exist).
+    pub fn save(&self, dir: &Path) -> Result<(), RlError> {
+        self.save_agent(dir)?;
+        self.sac.save(dir)?;
+        self.model.save(dir)?;
+        self.save_buffer(&dir.join("episodes.safetensors"))?;
+        let path = dir.join("progress.json");
+        std::fs::write(
+            &path,
+            serde_json::to_string(&self.progress).expect("progress serialises"),
+        )
+        .map_err(|e| RlError::io(&path, e))
+    }
+
+    /// Writes what is needed to execute and plan with the agent: the actor and the skill model.
+    pub fn save_agent(&self, dir: &Path) -> Result<(), RlError> {
+        self.sac.save_actor(dir)?;
+        self.model.save(dir)?;
+        Ok(())
+    }
+
+    /// Restores the complete training state written by [`Trainer::save`].
+    pub fn load(&mut self, dir: &Path) -> Result<(), RlError> {
+        self.sac.load(dir, false)?;
+        self.model.load(dir)?;
+        self.load_buffer(&dir.join("episodes.safetensors"))?;
+        let path = dir.join("progress.json");
+        let text = std::fs::read_to_string(&path).map_err(|e| RlError::io(&path, e))?;
+        self.progress = serde_json::from_str(&text).map_err(|e| RlError::Checkpoint {
+            path: path.display().to_string(),
+            reason: e.to_string(),
+        })?;
+        // Environments are re-seeded per resumed epoch, as the reference does (its worker seeds
+        // are base + 100 · first epoch): a resumed run does not repeat the boards of its start.
+        for (i, env) in self.envs.iter_mut().enumerate() {
+            env.seed(6242 + self.config.seed + i as u64 + 100 * self.progress.epoch);
+        }
+        Ok(())
+    }
+
+    fn save_buffer(&self, path: &Path) -> Result<(), RlError> {
+        let a = self.spec.action_dim;
+        let obs: Vec<f32> = self
+            .episodes
+            .iter()
+            .flat_map(|e| e.obs.iter().copied())
+            .collect();
+        let actions: Vec<f32> = self
+            .episodes
+            .iter()
+            .flat_map(|e| e.actions.iter().copied())
+            .collect();
+        let meta: Vec<i64> = self
+            .episodes
+            .iter()
+            .flat_map(|e| {
+                let (z0, zt) = (e.z0.words(), e.zt.words());
+                [
+                    e.len(a) as i64,
+                    e.skill as i64,
+                    e.game_move.map_or(-1, |m| m as i64),
+                ]
+                .into_iter()
+                .chain(z0.into_iter().chain(zt).map(|w| w as i64))
+            })
+            .collect();
+        let tensors = [
+            ("obs", Tensor::from_slice(&obs)),
+            ("actions", Tensor::from_slice(&actions)),
+            ("meta", Tensor::from_slice(&meta).view([-1, 9])),
+        ];
+        Tensor::write_safetensors(&tensors, path).map_err(|e| RlError::io(path, e))
+    }
+
+    fn load_buffer(&mut self, path: &Path) -> Result<(), RlError> {
+        let corrupt = |reason: String| RlError::Checkpoint {
+            path: path.display().to_string(),
+            reason,
+        };
+        let tensors = Tensor::read_safetensors(path).map_err(|e| corrupt(e.to_string()))?;
+        let get = |name: &str| {
+            tensors
+                .iter()
+                .find(|(n, _)| n == name)
+                .map(|(_, t)| t.shallow_clone())
+                .ok_or_else(|| corrupt(format!("no tensor {name:?}")))
+        };
+        let obs = Vec::<f32>::try_from(get("obs")?.to_kind(Kind::Float))
+            .map_err(|e| corrupt(e.to_string()))?;
+        let actions = Vec::<f32>::try_from(get("actions")?.to_kind(Kind::Float))
+            .map_err(|e| corrupt(e.to_string()))?;
+        let meta =
+            Vec::<i64>::try_from(get("meta")?.view([-1])).map_err(|e| corrupt(e.to_string()))?;
+        let (o, a) = (self.spec.obs_dim, self.spec.action_dim);
+        let (mut po, mut pa) = (0, 0);
+        self.episodes.clear();
+        for m in meta.chunks(9) {
+            let len = m[0] as usize;
+            let (obs_end, act_end) = (po + (len + 1) * o, pa + len * a);
+            if m.len() != 9
+                || obs_end > obs.len()
+                || act_end > actions.len()
+                || m[1] < 0
+                || m[1] as usize >= self.k
+            {
+                return Err(corrupt(
+                    "episode table does not match the environment".into(),
+                ));
+            }
+            let word = |i: usize| m[i] as u64;
+            self.episodes.push_back(Episode {
+                skill: m[1] as usize,
+                obs: obs[po..obs_end].to_vec(),
+                actions: actions[pa..act_end].to_vec(),
+                z0: SymbolicState::from_words([word(3), word(4), word(5)]),
+                zt: SymbolicState::from_words([word(6), word(7), word(8)]),
+                game_move: (m[2] >= 0).then_some(m[2] as usize),
+            });
+            (po, pa) = (obs_end, act_end);
+        }
+        if po != obs.len() || pa != actions.len() {
+            return Err(corrupt("trailing episode data".into()));
+        }
+        Ok(())
+    }
+}

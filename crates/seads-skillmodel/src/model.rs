@@ -1,0 +1,466 @@
+//! Skill models: the symbolic forward model q(z_T | z_0, k) of SEADS (SPEC §3.4) and the VIC
+//! discriminator q(k | z_0, z_T) (SPEC §3.9), behind one trait.
+
+use std::path::Path;
+
+use rand::SeedableRng;
+use rand_chacha::ChaCha8Rng;
+use seads_games::SymbolicState;
+use serde::{Deserialize, Serialize};
+use tch::nn::{self, Module};
+use tch::{Device, Kind, Tensor};
+
+use crate::SkillModelError;
+use crate::nn::{Adam, Mlp, mean_f32};
+
+/// float32 machine epsilon: α is clamped to [ε, 1 − ε] as PyTorch's Bernoulli does.
+const EPS: f64 = 1.192_092_9e-7;
+
+/// One (relabelled) skill execution as the skill model sees it.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct SkillTransition {
+    /// Symbolic state before the skill.
+    pub z0: SymbolicState,
+    /// The skill label.
+    pub skill: usize,
+    /// Symbolic state after the skill.
+    pub zt: SymbolicState,
+}
+
+/// A learned model of what skills do to the symbolic state.
+pub trait SkillModel: Send {
+    /// Number of skills K.
+    fn num_skills(&self) -> usize;
+    /// For each `(z_0, z_T)`, K scores ℓ_k (row-major, `pairs.len() × K`) with
+    /// log q(k | z_0, z_T) = ℓ_k − logsumexp ℓ. Forward model: ℓ_k = log q(z_T | z_0, k).
+    fn scores(&self, pairs: &[(SymbolicState, SymbolicState)]) -> Vec<f32>;
+    /// Whether the scores are likelihoods of z_T, so that the novelty bonus is defined.
+    fn scores_are_likelihoods(&self) -> bool;
+    /// One gradient step on `batch`; returns the loss.
+    fn train_step(&mut self, batch: &[SkillTransition]) -> f32;
+    /// Writes the parameters and the optimiser state.
+    fn save(&self, dir: &Path) -> Result<(), SkillModelError>;
+    /// Reads what [`SkillModel::save`] wrote.
+    fn load(&mut self, dir: &Path) -> Result<(), SkillModelError>;
+}
+
+/// Which skill model, and its network and optimiser. `Default` = the paper's forward model.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct SkillModelConfig {
+    /// `forward` (SEADS) or `vic` (skill discriminator, no planning).
+    pub kind: SkillModelKind,
+    /// Hidden layer sizes.
+    pub hidden: Vec<i64>,
+    /// Adam learning rate.
+    pub lr: f64,
+    /// Tuples per gradient step.
+    pub batch_size: usize,
+    /// Gradient steps per epoch.
+    pub updates_per_epoch: usize,
+}
+
+impl Default for SkillModelConfig {
+    fn default() -> Self {
+        Self {
+            kind: SkillModelKind::Forward,
+            hidden: vec![256, 256],
+            lr: 1e-3,
+            batch_size: 32,
+            updates_per_epoch: 4,
+        }
+    }
+}
+
+impl SkillModelConfig {
+    /// Checks the values.
+    pub fn validate(&self) -> Result<(), String> {
+        if self.hidden.is_empty() || self.hidden.iter().any(|&h| h <= 0) {
+            return Err(format!(
+                "skill_model.hidden must be positive layer sizes, got {:?}",
+                self.hidden
+            ));
+        }
+        if !(self.lr > 0.0 && self.lr.is_finite()) {
+            return Err(format!("skill_model.lr must be positive, got {}", self.lr));
+        }
+        if self.batch_size == 0 {
+            return Err("skill_model.batch_size must be at least 1".into());
+        }
+        Ok(())
+    }
+
+    /// Builds the model for symbolic states of `d` bits and `k` skills, initialised from `seed`.
+    pub fn build(&self, d: usize, k: usize, device: Device, seed: u64) -> Box<dyn SkillModel> {
+        match self.kind {
+            SkillModelKind::Forward => Box::new(ForwardModel::new(d, k, self, device, seed)),
+            SkillModelKind::Vic => Box::new(SkillDiscriminator::new(d, k, self, device, seed)),
+        }
+    }
+}
+
+/// The kind of skill model.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum SkillModelKind {
+    /// SEADS: the forward model q(z_T | z_0, k).
+    Forward,
+    /// VIC: the discriminator q(k | z_0, z_T).
+    Vic,
+}
+
+/// Writes the first `d` bits of each state as 0/1 floats into consecutive rows of width `width`
+/// starting at column `offset`.
+fn write_bits(
+    rows: &mut [f32],
+    width: usize,
+    offset: usize,
+    states: impl Iterator<Item = SymbolicState>,
+    d: usize,
+) {
+    for (row, z) in rows.chunks_mut(width).zip(states) {
+        z.write_f32(&mut row[offset..offset + d]);
+    }
+}
+
+fn states_tensor(states: impl Iterator<Item = SymbolicState>, d: usize, device: Device) -> Tensor {
+    let states: Vec<SymbolicState> = states.collect();
+    let n = states.len();
+    let mut data = vec![0.0f32; n * d];
+    write_bits(&mut data, d, 0, states.into_iter(), d);
+    Tensor::from_slice(&data)
+        .view([n as i64, d as i64])
+        .to_device(device)
+}
+
+/// The symbolic forward model (SPEC §3.4): an MLP on `[z_0, onehot(k)]` predicts per-bit flip
+/// probabilities; q(z_T | z_0, k) is the product of the resulting Bernoullis.
+#[derive(Debug)]
+pub struct ForwardModel {
+    d: usize,
+    k: usize,
+    device: Device,
+    vs: nn::VarStore,
+    net: Mlp,
+    opt: Adam,
+}
+
+impl ForwardModel {
+    /// A fresh model for `d`-bit states and `k` skills, initialised from `seed`.
+    pub fn new(d: usize, k: usize, config: &SkillModelConfig, device: Device, seed: u64) -> Self {
+        let vs = nn::VarStore::new(device);
+        let mut rng = ChaCha8Rng::seed_from_u64(seed);
+        let net = Mlp::new(
+            &(vs.root() / "forward_model"),
+            (d + k) as i64,
+            &config.hidden,
+            d as i64,
+            &mut rng,
+        );
+        let opt = Adam::new(&vs, config.lr);
+        Self {
+            d,
+            k,
+            device,
+            vs,
+            net,
+            opt,
+        }
+    }
+
+    /// Length D of the symbolic state.
+    pub fn symbolic_len(&self) -> usize {
+        self.d
+    }
+
+    /// The network, for fast inference elsewhere (the planner's successor function).
+    pub fn network(&self) -> &Mlp {
+        &self.net
+    }
+
+    /// Network input rows `[z_0, onehot(k)]`.
+    fn inputs(&self, z0: &[SymbolicState], skills: &[usize]) -> Tensor {
+        let width = self.d + self.k;
+        let mut data = vec![0.0f32; z0.len() * width];
+        write_bits(&mut data, width, 0, z0.iter().copied(), self.d);
+        for (row, &k) in data.chunks_mut(width).zip(skills) {
+            row[self.d + k] = 1.0;
+        }
+        Tensor::from_slice(&data)
+            .view([z0.len() as i64, width as i64])
+            .to_device(self.device)
+    }
+
+    /// Per-bit log-likelihood of the observed outcome, from flip logits and whether each bit
+    /// flipped (`flipped` = z_0 XOR z_T as 0/1). With p = σ(logit) the flip probability,
+    /// P(bit after = observed) is p for a flipped bit and 1 − p = σ(−logit) otherwise, so the
+    /// reference's clamped Bernoulli log-likelihood log clamp(α, ε, 1 − ε) equals
+    /// clamp(log σ(±logit), log ε, log(1 − ε)).
+    fn bit_log_likelihood(logits: &Tensor, flipped: &Tensor) -> Tensor {
+        let sign = flipped * 2.0 - 1.0;
+        (logits * sign)
+            .log_sigmoid()
+            .clamp(EPS.ln(), (1.0 - EPS).ln())
+    }
+
+    /// Flip logits of every state under every skill (n × K × D). The first layer is split into
+    /// its z_0 part, computed once per state, and the skill's column, added per skill.
+    pub fn flip_logits_all_skills(&self, z0: &Tensor) -> Tensor {
+        let layers = self.net.layers();
+        let first = &layers[0];
+        let (d, k) = (self.d as i64, self.k as i64);
+        let w_state = first.ws.narrow(1, 0, d);
+        let w_skill = first.ws.narrow(1, d, k).transpose(0, 1); // K × H
+        let bias = first.bs.as_ref().expect("layers have biases");
+        let per_state = z0.matmul(&w_state.transpose(0, 1)) + bias; // n × H
+        let hidden = (per_state.unsqueeze(1) + w_skill.unsqueeze(0)).relu(); // n × K × H
+        let n = z0.size()[0];
+        let mut h = hidden.reshape([n * k, -1]);
+        for (i, layer) in layers[1..].iter().enumerate() {
+            h = layer.forward(&h);
+            if i + 2 < layers.len() {
+                h = h.relu();
+            }
+        }
+        h.view([n, k, d])
+    }
+
+    /// Flip logits for each `(z_0, k)` (n × D): bit d flips in the mode iff its logit > 0.
+    pub fn flip_logits(&self, z0: &[SymbolicState], skills: &[usize]) -> Tensor {
+        tch::no_grad(|| self.net.forward(&self.inputs(z0, skills)))
+    }
+}
+
+impl SkillModel for ForwardModel {
+    fn num_skills(&self) -> usize {
+        self.k
+    }
+
+    fn scores(&self, pairs: &[(SymbolicState, SymbolicState)]) -> Vec<f32> {
+        if pairs.is_empty() {
+            return Vec::new();
+        }
+        tch::no_grad(|| {
+            let z0 = states_tensor(pairs.iter().map(|&(z0, _)| z0), self.d, self.device);
+            let flipped = states_tensor(pairs.iter().map(|&(z0, zt)| z0 ^ zt), self.d, self.device);
+            let logits = self.flip_logits_all_skills(&z0); // n × K × D
+            let ll = Self::bit_log_likelihood(&logits, &flipped.unsqueeze(1)).sum_dim_intlist(
+                2,
+                false,
+                Kind::Float,
+            );
+            Vec::<f32>::try_from(ll.view([-1]).to_device(Device::Cpu)).expect("float scores")
+        })
+    }
+
+    fn scores_are_likelihoods(&self) -> bool {
+        true
+    }
+
+    fn train_step(&mut self, batch: &[SkillTransition]) -> f32 {
+        let z0: Vec<SymbolicState> = batch.iter().map(|t| t.z0).collect();
+        let skills: Vec<usize> = batch.iter().map(|t| t.skill).collect();
+        let logits = self.net.forward(&self.inputs(&z0, &skills));
+        let flipped = states_tensor(batch.iter().map(|t| t.z0 ^ t.zt), self.d, self.device);
+        // The reference averages over the batch and the D bits.
+        let loss = -Self::bit_log_likelihood(&logits, &flipped).mean(Kind::Float);
+        self.opt.backward_step(&loss);
+        mean_f32(&loss)
+    }
+
+    fn save(&self, dir: &Path) -> Result<(), SkillModelError> {
+        save_stores(dir, "forward_model", &self.vs, self.opt.state())
+    }
+
+    fn load(&mut self, dir: &Path) -> Result<(), SkillModelError> {
+        load_stores(dir, "forward_model", &mut self.vs, self.opt.state_mut())
+    }
+}
+
+/// The VIC skill discriminator (SPEC §3.9): log q(k | z_0, z_T) from `[z_0, z_T, z_0 XOR z_T]`.
+#[derive(Debug)]
+pub struct SkillDiscriminator {
+    d: usize,
+    k: usize,
+    device: Device,
+    vs: nn::VarStore,
+    net: Mlp,
+    opt: Adam,
+}
+
+impl SkillDiscriminator {
+    /// A fresh discriminator for `d`-bit states and `k` skills, initialised from `seed`.
+    pub fn new(d: usize, k: usize, config: &SkillModelConfig, device: Device, seed: u64) -> Self {
+        let vs = nn::VarStore::new(device);
+        let mut rng = ChaCha8Rng::seed_from_u64(seed);
+        let net = Mlp::new(
+            &(vs.root() / "discriminator"),
+            (3 * d) as i64,
+            &config.hidden,
+            k as i64,
+            &mut rng,
+        );
+        let opt = Adam::new(&vs, config.lr);
+        Self {
+            d,
+            k,
+            device,
+            vs,
+            net,
+            opt,
+        }
+    }
+
+    fn log_posterior(
+        &self,
+        pairs: impl ExactSizeIterator<Item = (SymbolicState, SymbolicState)>,
+    ) -> Tensor {
+        let n = pairs.len();
+        let width = 3 * self.d;
+        let mut data = vec![0.0f32; n * width];
+        for (row, (z0, zt)) in data.chunks_mut(width).zip(pairs) {
+            z0.write_f32(&mut row[..self.d]);
+            zt.write_f32(&mut row[self.d..2 * self.d]);
+            (z0 ^ zt).write_f32(&mut row[2 * self.d..]);
+        }
+        let x = Tensor::from_slice(&data)
+            .view([n as i64, width as i64])
+            .to_device(self.device);
+        self.net.forward(&x).log_softmax(1, Kind::Float)
+    }
+}
+
+impl SkillModel for SkillDiscriminator {
+    fn num_skills(&self) -> usize {
+        self.k
+    }
+
+    fn scores(&self, pairs: &[(SymbolicState, SymbolicState)]) -> Vec<f32> {
+        if pairs.is_empty() {
+            return Vec::new();
+        }
+        let scores = tch::no_grad(|| self.log_posterior(pairs.iter().copied()));
+        Vec::<f32>::try_from(scores.view([-1]).to_device(Device::Cpu)).expect("float scores")
+    }
+
+    fn scores_are_likelihoods(&self) -> bool {
+        false
+    }
+
+    fn train_step(&mut self, batch: &[SkillTransition]) -> f32 {
+        let log_q = self.log_posterior(batch.iter().map(|t| (t.z0, t.zt)));
+        let labels = Tensor::from_slice(&batch.iter().map(|t| t.skill as i64).collect::<Vec<_>>())
+            .to_device(self.device);
+        let loss = log_q.nll_loss(&labels);
+        self.opt.backward_step(&loss);
+        mean_f32(&loss)
+    }
+
+    fn save(&self, dir: &Path) -> Result<(), SkillModelError> {
+        save_stores(dir, "discriminator", &self.vs, self.opt.state())
+    }
+
+    fn load(&mut self, dir: &Path) -> Result<(), SkillModelError> {
+        load_stores(dir, "discriminator", &mut self.vs, self.opt.state_mut())
+    }
+}
+
+fn save_stores(
+    dir: &Path,
+    name: &str,
+    vs: &nn::VarStore,
+    opt: &nn::VarStore,
+) -> Result<(), SkillModelError> {
+    vs.save(dir.join(format!("{name}.safetensors")))
+        .map_err(|e| SkillModelError::Io(e.to_string()))?;
+    opt.save(dir.join(format!("{name}_adam.safetensors")))
+        .map_err(|e| SkillModelError::Io(e.to_string()))
+}
+
+fn load_stores(
+    dir: &Path,
+    name: &str,
+    vs: &mut nn::VarStore,
+    opt: &mut nn::VarStore,
+) -> Result<(), SkillModelError> {
+    let path = dir.join(format!("{name}.safetensors"));
+    vs.load(&path).map_err(|e| SkillModelError::Checkpoint {
+        path: path.display().to_string(),
+        reason: e.to_string(),
+    })?;
+    let path = dir.join(format!("{name}_adam.safetensors"));
+    if path.exists() {
+        opt.load(&path).map_err(|e| SkillModelError::Checkpoint {
+            path: path.display().to_string(),
+            reason: e.to_string(),
+        })?;
+    }
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The reference's formula, written out: α = (1 − z_0)·p + z_0·(1 − p), clamped, Bernoulli
+    /// log-likelihood of z_T summed over bits.
+    fn reference_log_likelihood(logits: &[f32], z0: SymbolicState, zt: SymbolicState) -> f64 {
+        logits
+            .iter()
+            .enumerate()
+            .map(|(d, &x)| {
+                let p = 1.0 / (1.0 + (-(x as f64)).exp());
+                let z = z0.get(d) as u8 as f64;
+                let alpha = ((1.0 - z) * p + z * (1.0 - p)).clamp(EPS, 1.0 - EPS);
+                if zt.get(d) {
+                    alpha.ln()
+                } else {
+                    (1.0 - alpha).ln()
+                }
+            })
+            .sum()
+    }
+
+    #[test]
+    fn batched_scores_match_the_reference_formula() {
+        let model = ForwardModel::new(25, 25, &SkillModelConfig::default(), Device::Cpu, 9);
+        let pairs = [
+            (
+                SymbolicState::from_u64(0b1011),
+                SymbolicState::from_u64(0b0110_0011),
+            ),
+            (
+                SymbolicState::from_u64(1 << 24),
+                SymbolicState::from_u64(1 << 24),
+            ),
+        ];
+        let scores = model.scores(&pairs);
+        for (i, &(z0, zt)) in pairs.iter().enumerate() {
+            for k in 0..25 {
+                let logits =
+                    Vec::<f32>::try_from(model.flip_logits(&[z0], &[k]).view([-1])).unwrap();
+                let expected = reference_log_likelihood(&logits, z0, zt);
+                let got = scores[i * 25 + k] as f64;
+                assert!(
+                    (got - expected).abs() < 1e-3 * expected.abs().max(1.0),
+                    "k {k}: {got} vs {expected}"
+                );
+            }
+        }
+    }
+
+    #[test]
+    fn saturated_logits_are_clamped_like_the_reference() {
+        let logits = Tensor::from_slice(&[60.0f32, -60.0, 0.0]).view([1, 3]);
+        let flipped = Tensor::from_slice(&[0.0f32, 0.0, 1.0]).view([1, 3]);
+        let ll =
+            Vec::<f32>::try_from(ForwardModel::bit_log_likelihood(&logits, &flipped).view([-1]))
+                .unwrap();
+        assert!(
+            (ll[0] - EPS.ln() as f32).abs() < 1e-3,
+            "a confidently predicted flip that did not happen costs log ε"
+        );
+        assert!(ll[1].abs() < 1e-6);
+        assert!((ll[2] - 0.5f32.ln()).abs() < 1e-6);
+    }
+}

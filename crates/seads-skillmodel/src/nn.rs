@@ -1,0 +1,310 @@
+//! Small tch building blocks shared with `seads-rl`: MLPs with the reference's initialisation and
+//! an Adam whose state can be checkpointed.
+
+use rand::{Rng, RngExt};
+use tch::nn::{self, Module};
+use tch::{Kind, Tensor};
+
+/// A fully connected network: Linear → ReLU → … → Linear, Xavier-uniform weights (gain 1) and
+/// zero biases in every layer, as the reference initialises its networks. The weights are drawn
+/// from the caller's seeded RNG, never from libtorch's global generator, so that a seed fixes
+/// them whatever else runs in the process.
+#[derive(Debug)]
+pub struct Mlp {
+    layers: Vec<nn::Linear>,
+}
+
+impl Mlp {
+    /// An MLP `input → hidden[0] → … → output` with ReLU between layers, under `path`.
+    pub fn new<R: Rng + ?Sized>(
+        path: &nn::Path,
+        input: i64,
+        hidden: &[i64],
+        output: i64,
+        rng: &mut R,
+    ) -> Self {
+        let sizes: Vec<i64> = std::iter::once(input)
+            .chain(hidden.iter().copied())
+            .chain([output])
+            .collect();
+        let layers = sizes
+            .windows(2)
+            .enumerate()
+            .map(|(i, w)| xavier_linear(&(path / format!("layer{i}")), w[0], w[1], rng))
+            .collect();
+        Self { layers }
+    }
+
+    /// The last hidden activation (after its ReLU); `forward` applies the output layer to it.
+    pub fn features(&self, x: &Tensor) -> Tensor {
+        let (hidden, _) = self.layers.split_at(self.layers.len() - 1);
+        hidden
+            .iter()
+            .fold(x.shallow_clone(), |h, l| l.forward(&h).relu())
+    }
+
+    /// The output layer.
+    pub fn head(&self) -> &nn::Linear {
+        self.layers.last().expect("an MLP has an output layer")
+    }
+
+    /// The layers, input first.
+    pub fn layers(&self) -> &[nn::Linear] {
+        &self.layers
+    }
+}
+
+/// A linear layer with Xavier-uniform weights (gain 1) drawn from `rng` and zero bias.
+pub fn xavier_linear<R: Rng + ?Sized>(
+    path: &nn::Path,
+    input: i64,
+    output: i64,
+    rng: &mut R,
+) -> nn::Linear {
+    let config = nn::LinearConfig {
+        ws_init: nn::Init::Const(0.0),
+        bs_init: Some(nn::Init::Const(0.0)),
+        bias: true,
+    };
+    let mut layer = nn::linear(path, input, output, config);
+    let bound = (6.0 / (input + output) as f64).sqrt() as f32;
+    let values: Vec<f32> = (0..input * output)
+        .map(|_| rng.random_range(-bound..bound))
+        .collect();
+    tch::no_grad(|| {
+        layer.ws.copy_(
+            &Tensor::from_slice(&values)
+                .view([output, input])
+                .to_device(layer.ws.device()),
+        )
+    });
+    layer
+}
+
+impl Module for Mlp {
+    fn forward(&self, x: &Tensor) -> Tensor {
+        self.head().forward(&self.features(x))
+    }
+}
+
+/// Moves every trainable variable of `vs` into one flat buffer, in name order, and returns it:
+/// afterwards each variable is a view into the buffer, so whole-network updates (Adam, Polyak
+/// averaging) are a few operations on the buffer instead of a few per variable.
+pub fn flatten_parameters(vs: &nn::VarStore) -> Tensor {
+    let mut named = trainable(vs);
+    tch::no_grad(|| {
+        let flat = Tensor::cat(
+            &named.iter().map(|(_, p)| p.view([-1])).collect::<Vec<_>>(),
+            0,
+        );
+        let mut offset = 0;
+        for (_, p) in &mut named {
+            let n = p.numel() as i64;
+            p.set_data(&flat.narrow(0, offset, n).view(p.size().as_slice()));
+            offset += n;
+        }
+        flat
+    })
+}
+
+/// The trainable variables of `vs`, sorted by name.
+fn trainable(vs: &nn::VarStore) -> Vec<(String, Tensor)> {
+    let mut named: Vec<(String, Tensor)> = vs
+        .variables()
+        .into_iter()
+        .filter(|(_, t)| t.requires_grad())
+        .collect();
+    named.sort_by(|a, b| a.0.cmp(&b.0));
+    named
+}
+
+/// Adam (PyTorch's defaults: β = (0.9, 0.999), ε = 1e-8, no weight decay) over the trainable
+/// variables of a var store. Its moments live in a var store of their own, so a checkpoint of
+/// that store restores the optimiser exactly (tch's own optimisers cannot be saved). The
+/// parameters are flattened ([`flatten_parameters`]) so that a step is a few buffer operations.
+#[derive(Debug)]
+pub struct Adam {
+    lr: f64,
+    params: Vec<Tensor>,
+    flat: Tensor,
+    state: nn::VarStore,
+    m: Tensor,
+    v: Tensor,
+    step: Tensor,
+}
+
+impl Adam {
+    const BETA1: f64 = 0.9;
+    const BETA2: f64 = 0.999;
+    const EPS: f64 = 1e-8;
+
+    /// Adam with learning rate `lr` over every trainable variable of `vs` (flattened, name order).
+    pub fn new(vs: &nn::VarStore, lr: f64) -> Self {
+        let flat = flatten_parameters(vs);
+        let named = trainable(vs);
+        let state = nn::VarStore::new(vs.device());
+        let root = state.root();
+        let m = root.zeros_no_train("m", &flat.size());
+        let v = root.zeros_no_train("v", &flat.size());
+        let step = root.zeros_no_train("step", &[1]);
+        let params = named.into_iter().map(|(_, p)| p).collect();
+        Self {
+            lr,
+            params,
+            flat,
+            state,
+            m,
+            v,
+            step,
+        }
+    }
+
+    /// Clears the gradients of the parameters.
+    pub fn zero_grad(&mut self) {
+        for p in &mut self.params {
+            p.zero_grad();
+        }
+    }
+
+    /// One update from the gradients accumulated by `loss.backward()`.
+    pub fn step(&mut self) {
+        tch::no_grad(|| {
+            let grads: Vec<Tensor> = self
+                .params
+                .iter()
+                .map(|p| {
+                    let g = p.grad();
+                    if g.defined() {
+                        g.view([-1])
+                    } else {
+                        p.zeros_like().view([-1])
+                    }
+                })
+                .collect();
+            let g = Tensor::cat(&grads, 0);
+            let _ = self.step.g_add_scalar_(1.0);
+            let t = f64::try_from(&self.step).expect("scalar step count");
+            let (c1, c2) = (1.0 - Self::BETA1.powf(t), 1.0 - Self::BETA2.powf(t));
+            let _ = self
+                .m
+                .g_mul_scalar_(Self::BETA1)
+                .g_add_(&(&g * (1.0 - Self::BETA1)));
+            let _ = self
+                .v
+                .g_mul_scalar_(Self::BETA2)
+                .g_add_(&(g.square() * (1.0 - Self::BETA2)));
+            let denom = (&self.v / c2).sqrt() + Self::EPS;
+            let _ = self.flat.g_sub_(&(&self.m / denom * (self.lr / c1)));
+        });
+    }
+
+    /// The flat parameter buffer the optimised variables are views of.
+    pub fn parameters(&self) -> &Tensor {
+        &self.flat
+    }
+
+    /// Zero the gradients, back-propagate `loss`, update.
+    pub fn backward_step(&mut self, loss: &Tensor) {
+        self.zero_grad();
+        loss.backward();
+        self.step();
+    }
+
+    /// The optimiser state (moments and step count), for checkpoints.
+    pub fn state(&self) -> &nn::VarStore {
+        &self.state
+    }
+
+    /// The optimiser state, for restoring checkpoints.
+    pub fn state_mut(&mut self) -> &mut nn::VarStore {
+        &mut self.state
+    }
+}
+
+/// Mean over every element of a float tensor, as `f32`.
+pub fn mean_f32(t: &Tensor) -> f32 {
+    f32::try_from(t.mean(Kind::Float)).expect("a scalar")
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use rand::SeedableRng;
+    use rand_chacha::ChaCha8Rng;
+    use tch::Device;
+    use tch::nn::OptimizerConfig;
+
+    /// Our Adam follows the same trajectory as tch's (libtorch's) Adam. Inputs and initial weights
+    /// are shared copies, so the test does not depend on libtorch's global RNG.
+    #[test]
+    fn adam_matches_libtorch() {
+        let init = nn::VarStore::new(Device::Cpu);
+        let _ = Mlp::new(&init.root(), 3, &[8], 2, &mut ChaCha8Rng::seed_from_u64(1));
+        let x = Tensor::from_slice(
+            &(0..48)
+                .map(|i| ((i * 7 % 13) as f32 - 6.0) / 4.0)
+                .collect::<Vec<_>>(),
+        )
+        .view([16, 3]);
+        let y = Tensor::from_slice(
+            &(0..32)
+                .map(|i| ((i * 5 % 11) as f32 - 5.0) / 3.0)
+                .collect::<Vec<_>>(),
+        )
+        .view([16, 2]);
+        let run = |ours: bool| {
+            let mut vs = nn::VarStore::new(Device::Cpu);
+            let net = Mlp::new(&vs.root(), 3, &[8], 2, &mut ChaCha8Rng::seed_from_u64(2));
+            vs.copy(&init).unwrap();
+            let mut mine = Adam::new(&vs, 1e-2);
+            let mut theirs = nn::Adam::default().build(&vs, 1e-2).unwrap();
+            for _ in 0..20 {
+                let loss = (net.forward(&x) - &y).square().mean(Kind::Float);
+                if ours {
+                    mine.backward_step(&loss);
+                } else {
+                    theirs.backward_step(&loss);
+                }
+            }
+            net.forward(&x)
+        };
+        let diff = f64::try_from((run(true) - run(false)).abs().max()).unwrap();
+        assert!(diff < 1e-5, "{diff}");
+    }
+
+    #[test]
+    fn xavier_bounds_and_zero_bias() {
+        let vs = nn::VarStore::new(Device::Cpu);
+        let net = Mlp::new(
+            &vs.root(),
+            53,
+            &[256, 256],
+            3,
+            &mut ChaCha8Rng::seed_from_u64(0),
+        );
+        let bound = (6.0f64 / (53.0 + 256.0)).sqrt();
+        let w = &net.layers()[0].ws;
+        assert!(f64::try_from(w.abs().max()).unwrap() <= bound);
+        assert!(f64::try_from(w.abs().max()).unwrap() > 0.9 * bound);
+        assert_eq!(
+            f64::try_from(net.layers()[1].bs.as_ref().unwrap().abs().sum(Kind::Float)).unwrap(),
+            0.0
+        );
+        assert_eq!(
+            net.forward(&Tensor::zeros([4, 53], (Kind::Float, Device::Cpu)))
+                .size(),
+            [4, 3]
+        );
+        let again = Mlp::new(
+            &nn::VarStore::new(Device::Cpu).root(),
+            53,
+            &[256, 256],
+            3,
+            &mut ChaCha8Rng::seed_from_u64(0),
+        );
+        assert!(
+            again.layers()[2].ws.equal(&net.layers()[2].ws),
+            "the seed fixes the weights"
+        );
+    }
+}

@@ -1,0 +1,176 @@
+//! The skill models learn what they should, and relabelling is optimal.
+
+use proptest::prelude::*;
+use seads_games::{BoardGame, LightsOut, SymbolicState, TileSwap};
+use seads_skillmodel::{
+    SkillModel, SkillModelConfig, SkillModelKind, SkillTransition, relabel_assignment,
+};
+use tch::Device;
+
+/// Every permutation of 0..n (Heap's algorithm).
+fn permutations(n: usize) -> Vec<Vec<usize>> {
+    fn heap(k: usize, a: &mut Vec<usize>, out: &mut Vec<Vec<usize>>) {
+        if k <= 1 {
+            out.push(a.clone());
+            return;
+        }
+        for i in 0..k {
+            heap(k - 1, a, out);
+            a.swap(if k % 2 == 0 { i } else { 0 }, k - 1);
+        }
+    }
+    let mut out = Vec::new();
+    heap(n, &mut (0..n).collect(), &mut out);
+    out
+}
+
+proptest! {
+    /// The assignment is optimal (brute force over all permutations of the slots) and keeps the
+    /// multiset of labels.
+    #[test]
+    fn assignment_is_optimal(
+        n in 1usize..=6,
+        k in 2usize..=5,
+        seed_costs in proptest::collection::vec(-8.0f32..0.0, 36 * 5),
+        seed_labels in proptest::collection::vec(0usize..5, 6),
+    ) {
+        let labels: Vec<usize> = seed_labels[..n].iter().map(|&l| l % k).collect();
+        let clipped = &seed_costs[..n * k];
+        let new = relabel_assignment(clipped, k, &labels);
+        let total = |assigned: &[usize]| -> f32 { assigned.iter().enumerate().map(|(j, &l)| clipped[j * k + l]).sum() };
+        let best = permutations(n)
+            .into_iter()
+            .map(|p| total(&p.iter().map(|&slot| labels[slot]).collect::<Vec<_>>()))
+            .fold(f32::NEG_INFINITY, f32::max);
+        prop_assert!((total(&new) - best).abs() < 1e-4, "{} vs {}", total(&new), best);
+        let (mut a, mut b) = (labels.clone(), new.clone());
+        a.sort_unstable();
+        b.sort_unstable();
+        prop_assert_eq!(a, b);
+    }
+}
+
+/// Synthetic data of the ground-truth game: skill k performs move k (LightsOut 5×5 flip masks).
+fn lightsout_data(n: usize, seed: u64) -> Vec<SkillTransition> {
+    let game = LightsOut::new(5).unwrap();
+    let mut state = seed;
+    let mut next = || {
+        state = state
+            .wrapping_mul(6364136223846793005)
+            .wrapping_add(1442695040888963407);
+        state >> 33
+    };
+    (0..n)
+        .map(|_| {
+            let z0 = SymbolicState::from_u64(next() & ((1 << 25) - 1));
+            let skill = (next() % 25) as usize;
+            SkillTransition {
+                z0,
+                skill,
+                zt: game.apply(z0, skill),
+            }
+        })
+        .collect()
+}
+
+#[test]
+fn forward_model_learns_the_lightsout_flip_table() {
+    let config = SkillModelConfig::default();
+    let mut model = config.build(25, 25, Device::Cpu, 1);
+    let data = lightsout_data(4000, 7);
+    for epoch in 0..1500 {
+        let start = (epoch * 32) % (data.len() - 32);
+        model.train_step(&data[start..start + 32]);
+    }
+    // The true skill is the most likely explanation of held-out transitions.
+    let test = lightsout_data(200, 99);
+    let pairs: Vec<(SymbolicState, SymbolicState)> = test.iter().map(|t| (t.z0, t.zt)).collect();
+    let scores = model.scores(&pairs);
+    let correct = test
+        .iter()
+        .enumerate()
+        .filter(|(i, t)| {
+            let row = &scores[i * 25..(i + 1) * 25];
+            let best = (0..25).fold(0, |b, k| if row[k] > row[b] { k } else { b });
+            best == t.skill
+        })
+        .count();
+    assert!(
+        correct >= 195,
+        "{correct}/200 held-out transitions attributed to the right skill"
+    );
+    // And it predicts the successor with high likelihood: log q(z_T | z_0, k*) close to 0.
+    let mean_true: f32 = test
+        .iter()
+        .enumerate()
+        .map(|(i, t)| scores[i * 25 + t.skill])
+        .sum::<f32>()
+        / 200.0;
+    assert!(
+        mean_true > -1.0,
+        "mean log-likelihood of the true skill {mean_true}"
+    );
+}
+
+#[test]
+fn discriminator_learns_which_swap_happened() {
+    let config = SkillModelConfig {
+        kind: SkillModelKind::Vic,
+        ..SkillModelConfig::default()
+    };
+    let game = TileSwap::new();
+    let mut model = config.build(81, 12, Device::Cpu, 2);
+    let data: Vec<SkillTransition> = (0..600)
+        .map(|i| {
+            let z0 = game.apply_all(
+                game.goal(),
+                &[(i * 7) % 12, (i * 5 + 3) % 12, (i * 11 + 1) % 12],
+            );
+            let skill = i % 12;
+            SkillTransition {
+                z0,
+                skill,
+                zt: game.apply(z0, skill),
+            }
+        })
+        .collect();
+    for step in 0..600 {
+        let start = (step * 32) % (data.len() - 32);
+        model.train_step(&data[start..start + 32]);
+    }
+    let pairs: Vec<_> = data.iter().take(120).map(|t| (t.z0, t.zt)).collect();
+    let scores = model.scores(&pairs);
+    let correct = data.iter().take(120).enumerate().filter(|(i, t)| {
+        let row = &scores[i * 12..(i + 1) * 12];
+        (0..12).fold(0, |b, k| if row[k] > row[b] { k } else { b }) == t.skill
+    });
+    assert!(correct.count() >= 115);
+}
+
+#[test]
+fn checkpoints_round_trip_and_bad_files_are_errors() {
+    let dir = tempfile::tempdir().unwrap();
+    let config = SkillModelConfig::default();
+    let mut model = config.build(25, 25, Device::Cpu, 3);
+    model.train_step(&lightsout_data(32, 1));
+    model.save(dir.path()).unwrap();
+    let mut other = config.build(25, 25, Device::Cpu, 4);
+    let pairs = [(SymbolicState::from_u64(5), SymbolicState::from_u64(7))];
+    assert_ne!(model.scores(&pairs), other.scores(&pairs));
+    other.load(dir.path()).unwrap();
+    assert_eq!(model.scores(&pairs), other.scores(&pairs));
+    // The optimiser state came along: one more identical step gives identical models.
+    let batch = lightsout_data(32, 2);
+    model.train_step(&batch);
+    other.train_step(&batch);
+    assert_eq!(model.scores(&pairs), other.scores(&pairs));
+    std::fs::write(
+        dir.path().join("forward_model.safetensors"),
+        b"not a checkpoint",
+    )
+    .unwrap();
+    assert!(other.load(dir.path()).is_err());
+    let mut wrong_shape = config.build(81, 12, Device::Cpu, 5);
+    model.save(dir.path()).unwrap();
+    assert!(wrong_shape.load(dir.path()).is_err());
+}
