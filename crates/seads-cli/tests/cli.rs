@@ -256,3 +256,122 @@ fn env_bench_reports_steps_per_second() {
         "at least 1",
     );
 }
+
+/// A tiny training configuration (small networks, small budget) written into `dir`.
+fn tiny_config(dir: &std::path::Path) -> std::path::PathBuf {
+    let text = std::fs::read_to_string(concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../../configs/lightsout-cursor.toml"
+    ))
+    .unwrap()
+    .replace("env_steps = 500000", "env_steps = 600")
+    .replace("hidden = [256, 256]", "hidden = [32, 32]")
+    .replace("sampled_episodes = 256", "sampled_episodes = 32")
+    .replace("recent_episodes = 256", "recent_episodes = 16")
+    .replace("eval_every = 100", "eval_every = 5")
+    .replace("checkpoint_every = 100", "checkpoint_every = 5")
+    .replace("eval_seeds = 20", "eval_seeds = 1");
+    let path = dir.join("tiny.toml");
+    std::fs::write(&path, text).unwrap();
+    path
+}
+
+#[test]
+fn train_writes_a_run_directory_and_resumes() {
+    let dir = tempfile::tempdir().unwrap();
+    let run = dir.path().join("run");
+    let config = tiny_config(dir.path());
+    let out = seads(&[
+        "train",
+        "--config",
+        config.to_str().unwrap(),
+        "--out",
+        run.to_str().unwrap(),
+        "--seed",
+        "3",
+        "--quiet",
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        stdout.contains("coverage") && stdout.contains("time per phase"),
+        "{stdout}"
+    );
+    let saved = std::fs::read_to_string(run.join("config.toml")).unwrap();
+    assert!(saved.contains("seed = 3") && saved.contains("env_steps = 600"));
+    let metrics = std::fs::read_to_string(run.join("metrics.jsonl")).unwrap();
+    let last: serde_json::Value = serde_json::from_str(metrics.lines().last().unwrap()).unwrap();
+    for key in ["epoch", "env_steps", "skill_coverage", "wall_s"] {
+        assert!(last.get(key).is_some(), "metrics have {key}");
+    }
+    assert!(last["env_steps"].as_u64().unwrap() >= 600);
+    assert!(run.join("checkpoints/latest").exists());
+    // Resuming a finished run has nothing left to do but succeeds.
+    let out = seads(&["train", "--resume", run.to_str().unwrap(), "--quiet"]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    // The same directory cannot be trained into twice.
+    check_bad_input(
+        &[
+            "train",
+            "--config",
+            config.to_str().unwrap(),
+            "--out",
+            run.to_str().unwrap(),
+        ],
+        "already holds a run",
+    );
+}
+
+#[test]
+fn train_rejects_bad_input() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("x");
+    check_bad_input(
+        &[
+            "train",
+            "--env",
+            "lightsout-robot",
+            "--out",
+            out.to_str().unwrap(),
+        ],
+        "valid environments",
+    );
+    let bad = dir.path().join("bad.toml");
+    std::fs::write(&bad, "env = \"lightsout-cursor\"\n[sac]\nalpha = -1.0\n").unwrap();
+    check_bad_input(
+        &[
+            "train",
+            "--config",
+            bad.to_str().unwrap(),
+            "--out",
+            out.to_str().unwrap(),
+        ],
+        "sac.alpha",
+    );
+    std::fs::write(&bad, "env = \"lightsout-cursor\"\nlearning_rate = 3\n").unwrap();
+    check_bad_input(
+        &[
+            "train",
+            "--config",
+            bad.to_str().unwrap(),
+            "--out",
+            out.to_str().unwrap(),
+        ],
+        "unknown field",
+    );
+    let missing = seads(&[
+        "train",
+        "--resume",
+        dir.path().join("nothing").to_str().unwrap(),
+    ]);
+    assert_eq!(missing.status.code(), Some(1));
+    assert!(String::from_utf8_lossy(&missing.stderr).contains("config.toml"));
+}

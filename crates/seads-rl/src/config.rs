@@ -64,7 +64,8 @@ pub struct TrainConfig {
     pub eval_seeds: u64,
     /// Write a checkpoint every this many epochs (and at the end).
     pub checkpoint_every: u64,
-    /// libtorch intra-op threads (0: libtorch's default).
+    /// libtorch intra-op threads per training thread (0: libtorch's default; the presets use 1,
+    /// since SAC updates and skill-model scoring already run on two threads).
     pub threads: usize,
 }
 
@@ -133,7 +134,7 @@ impl TrainConfig {
             .map(|(_, text)| *text)
             .ok_or_else(|| {
                 RlError::Config(format!(
-                    "no preset for environment {env:?}; presets exist for {}",
+                    "unknown environment {env:?}; valid environments: {}",
                     env_names().join(", ")
                 ))
             })?;

@@ -86,6 +86,8 @@ pub struct Trainer {
     model: Box<dyn SkillModel>,
     episodes: VecDeque<Episode>,
     progress: Progress,
+    /// The next epoch's relabelled skill-model batch, prepared while SAC updates.
+    prepared: Option<Vec<SkillTransition>>,
 }
 
 impl Trainer {
@@ -151,6 +153,7 @@ impl Trainer {
             model,
             episodes: VecDeque::new(),
             progress,
+            prepared: None,
         })
     }
 
@@ -200,14 +203,20 @@ impl Trainer {
     }
 
     /// One epoch of Algorithm 3.
+    ///
+    /// Order within an epoch: collect the new episodes with the parameters of the start of the
+    /// epoch (the reference collects in the background while it updates); update the skill model
+    /// on a relabelled batch (p = 1); score and relabel an independent batch (p = 0.5, only
+    /// board-changing episodes) with the updated model; take the SAC steps. The new episodes join
+    /// the buffers after the updates. The next epoch's skill-model batch depends only on those
+    /// buffers and on the updated model, so it is sampled, scored and relabelled on a second
+    /// thread while SAC updates: the same computation as doing it at the start of the next epoch.
     pub fn run_epoch(&mut self) -> Result<EpochStats, RlError> {
         let mut stats = EpochStats {
             epoch: self.progress.epoch,
             ..EpochStats::default()
         };
 
-        // Collect with the parameters of the start of the epoch (the reference collects in the
-        // background while it updates; the new episodes join the buffers after the updates).
         let start = Instant::now();
         let skills: Vec<usize> = (0..self.envs.len())
             .map(|_| self.progress.streams.labels.random_range(0..self.k))
@@ -223,220 +232,94 @@ impl Trainer {
             Some(&mut self.progress.streams.collect),
         )?;
         self.progress.timings.collect += start.elapsed().as_secs_f64();
-
-        if self.episodes.len() >= self.config.sampled_episodes {
-            stats.updated = true;
-            let (loss, _) = self.update_skill_model();
-            stats.skill_model_loss = loss;
-            let (losses, reward) = self.update_sac();
-            stats.sac = losses;
-            stats.mean_reward = reward;
-        }
-
-        let a = self.spec.action_dim;
         stats.changed = new.iter().filter(|e| e.changed()).count() as f32 / new.len().max(1) as f32;
-        for episode in new {
-            self.progress.env_steps += episode.len(a) as u64;
-            if self.episodes.len() == self.config.buffer_capacity {
-                self.episodes.pop_front();
+
+        let new_steps: u64 = new.iter().map(|e| e.len(self.spec.action_dim) as u64).sum();
+        let mut buffers = Buffers {
+            config: &self.config,
+            k: self.k,
+            episodes: &mut self.episodes,
+            rng: &mut self.progress.streams.sample,
+        };
+        if buffers.ready() {
+            stats.updated = true;
+            // Step 3a: the skill model, on the batch prepared last epoch (or now, the first time).
+            let tuples = match self.prepared.take() {
+                Some(tuples) => tuples,
+                None => {
+                    let start = Instant::now();
+                    let tuples = buffers.skill_model_batch(self.model.as_ref());
+                    self.progress.timings.relabel += start.elapsed().as_secs_f64();
+                    tuples
+                }
+            };
+            let start = Instant::now();
+            let config = &self.config.skill_model;
+            let mut loss = 0.0;
+            for _ in 0..config.updates_per_epoch {
+                let minibatch: Vec<SkillTransition> = (0..config.batch_size)
+                    .map(|_| tuples[buffers.rng.random_range(0..tuples.len())])
+                    .collect();
+                loss += self.model.train_step(&minibatch);
             }
-            self.episodes.push_back(episode);
+            stats.skill_model_loss = loss / config.updates_per_epoch.max(1) as f32;
+            self.progress.timings.skill_model += start.elapsed().as_secs_f64();
+
+            // Step 3b: SAC minibatches from an independently relabelled batch.
+            let start = Instant::now();
+            let (minibatches, mean_reward) = buffers.sac_minibatches(
+                self.model.as_ref(),
+                &self.spec,
+                &self.config,
+                &mut self.progress.streams.sac,
+            );
+            stats.mean_reward = mean_reward;
+            self.progress.timings.relabel += start.elapsed().as_secs_f64();
+
+            let (sac, model, sac_rng) = (
+                &mut self.sac,
+                &mut self.model,
+                &mut self.progress.streams.sac,
+            );
+            let ((losses, sac_s), (prepared, prepare_s)) = std::thread::scope(|scope| {
+                let updates = scope.spawn(move || {
+                    let start = Instant::now();
+                    let mut total = SacLosses::default();
+                    for minibatch in &minibatches {
+                        let l = sac.update(minibatch, sac_rng);
+                        total.critic += l.critic;
+                        total.actor += l.actor;
+                        total.q += l.q;
+                    }
+                    let n = minibatches.len().max(1) as f32;
+                    (
+                        SacLosses {
+                            critic: total.critic / n,
+                            actor: total.actor / n,
+                            q: total.q / n,
+                        },
+                        start.elapsed().as_secs_f64(),
+                    )
+                });
+                let start = Instant::now();
+                buffers.push(new);
+                let prepared = buffers
+                    .ready()
+                    .then(|| buffers.skill_model_batch(model.as_ref()));
+                let prepare_s = start.elapsed().as_secs_f64();
+                (updates.join().expect("SAC thread"), (prepared, prepare_s))
+            });
+            stats.sac = losses;
+            self.prepared = prepared;
+            self.progress.timings.sac += sac_s;
+            self.progress.timings.relabel += prepare_s;
+        } else {
+            buffers.push(new);
         }
+        self.progress.env_steps += new_steps;
         self.progress.epoch += 1;
         stats.env_steps = self.progress.env_steps;
         Ok(stats)
-    }
-
-    /// Indices of an update batch: `sampled_episodes` drawn with replacement from the long-term
-    /// buffer (all of it if it holds exactly that many), followed by the recent episodes.
-    fn update_batch(&mut self) -> Vec<usize> {
-        let n = self.episodes.len();
-        let mut batch: Vec<usize> = if n == self.config.sampled_episodes {
-            (0..n).collect()
-        } else {
-            (0..self.config.sampled_episodes)
-                .map(|_| self.progress.streams.sample.random_range(0..n))
-                .collect()
-        };
-        batch.extend(n.saturating_sub(self.config.recent_episodes)..n);
-        batch
-    }
-
-    /// Scores, clipped posteriors C and rewards R of episodes (row-major, K per episode).
-    fn score(&self, batch: &[usize]) -> (Vec<f32>, Vec<f32>) {
-        let pairs: Vec<(SymbolicState, SymbolicState)> = batch
-            .iter()
-            .map(|&i| (self.episodes[i].z0, self.episodes[i].zt))
-            .collect();
-        let scores = self.model.scores(&pairs);
-        let likelihoods = self.model.scores_are_likelihoods();
-        let mut clipped = Vec::with_capacity(scores.len());
-        let mut rewards = Vec::with_capacity(scores.len());
-        for row in scores.chunks(self.k) {
-            let (c, r) = episode_rewards(row, likelihoods, &self.config.reward);
-            clipped.extend(c);
-            rewards.extend(r);
-        }
-        (clipped, rewards)
-    }
-
-    /// Final labels of a batch after relabelling: each episode is chosen with probability `p`
-    /// (only board-changing ones if `changed_only`) and the chosen ones are relabelled together.
-    fn relabelled(
-        &mut self,
-        batch: &[usize],
-        clipped: &[f32],
-        p: f64,
-        changed_only: bool,
-    ) -> Vec<usize> {
-        let mut labels: Vec<usize> = batch.iter().map(|&i| self.episodes[i].skill).collect();
-        if p <= 0.0 {
-            return labels;
-        }
-        let chosen: Vec<usize> = (0..batch.len())
-            .filter(|&j| {
-                let draw = self.progress.streams.sample.random::<f64>() < p;
-                draw && (!changed_only || self.episodes[batch[j]].changed())
-            })
-            .collect();
-        let k = self.k;
-        let chosen_clipped: Vec<f32> = chosen
-            .iter()
-            .flat_map(|&j| clipped[j * k..(j + 1) * k].iter().copied())
-            .collect();
-        let chosen_labels: Vec<usize> = chosen.iter().map(|&j| labels[j]).collect();
-        for (&j, new) in chosen.iter().zip(relabel(
-            self.config.relabel.kind,
-            &chosen_clipped,
-            k,
-            &chosen_labels,
-        )) {
-            labels[j] = new;
-        }
-        labels
-    }
-
-    /// Step 3a: relabel a batch with p = 1 and take the skill-model steps.
-    fn update_skill_model(&mut self) -> (f32, usize) {
-        let start = Instant::now();
-        let batch = self.update_batch();
-        let (clipped, _) = self.score(&batch);
-        let labels = self.relabelled(&batch, &clipped, self.config.relabel.skill_model_p, false);
-        let tuples: Vec<SkillTransition> = batch
-            .iter()
-            .zip(&labels)
-            .map(|(&i, &skill)| SkillTransition {
-                z0: self.episodes[i].z0,
-                skill,
-                zt: self.episodes[i].zt,
-            })
-            .collect();
-        self.progress.timings.relabel += start.elapsed().as_secs_f64();
-
-        let start = Instant::now();
-        let config = &self.config.skill_model;
-        let mut loss = 0.0;
-        for _ in 0..config.updates_per_epoch {
-            let minibatch: Vec<SkillTransition> = (0..config.batch_size)
-                .map(|_| tuples[self.progress.streams.sample.random_range(0..tuples.len())])
-                .collect();
-            loss += self.model.train_step(&minibatch);
-        }
-        self.progress.timings.skill_model += start.elapsed().as_secs_f64();
-        (loss / config.updates_per_epoch.max(1) as f32, tuples.len())
-    }
-
-    /// Step 3b: relabel an independent batch with p = 0.5 (board-changing episodes only), reward
-    /// each episode's last transition, and take the SAC steps on its transitions.
-    fn update_sac(&mut self) -> (SacLosses, f32) {
-        let start = Instant::now();
-        let batch = self.update_batch();
-        let (clipped, rewards) = self.score(&batch);
-        let labels = self.relabelled(&batch, &clipped, self.config.relabel.sac_p, true);
-        let min_reward = minimum_reward(self.k);
-        let finals: Vec<f32> = batch
-            .iter()
-            .enumerate()
-            .map(|(j, &i)| {
-                if self.episodes[i].changed() {
-                    rewards[j * self.k + labels[j]]
-                } else {
-                    min_reward
-                }
-            })
-            .collect();
-        self.progress.timings.relabel += start.elapsed().as_secs_f64();
-
-        let start = Instant::now();
-        let a = self.spec.action_dim;
-        // Every transition of the batch: (batch position, time step).
-        let transitions: Vec<(usize, usize)> = batch
-            .iter()
-            .enumerate()
-            .flat_map(|(j, &i)| (0..self.episodes[i].len(a)).map(move |t| (j, t)))
-            .collect();
-        let config = self.config.sac.clone();
-        let mut total = SacLosses::default();
-        for _ in 0..config.updates_per_epoch {
-            let picks: Vec<(usize, usize)> = (0..config.batch_size)
-                .map(|_| transitions[self.progress.streams.sac.random_range(0..transitions.len())])
-                .collect();
-            let minibatch = self.transition_batch(&batch, &labels, &finals, &picks);
-            let losses = self.sac.update(&minibatch, &mut self.progress.streams.sac);
-            total.critic += losses.critic;
-            total.actor += losses.actor;
-            total.q += losses.q;
-        }
-        self.progress.timings.sac += start.elapsed().as_secs_f64();
-        let n = config.updates_per_epoch.max(1) as f32;
-        let mean_reward = finals.iter().sum::<f32>() / finals.len().max(1) as f32;
-        (
-            SacLosses {
-                critic: total.critic / n,
-                actor: total.actor / n,
-                q: total.q / n,
-            },
-            mean_reward,
-        )
-    }
-
-    /// SAC inputs for the picked transitions: `[s, onehot(final label)]`, the reward only on an
-    /// episode's last transition, done = 1 there (moves and time-outs alike).
-    fn transition_batch(
-        &self,
-        batch: &[usize],
-        labels: &[usize],
-        finals: &[f32],
-        picks: &[(usize, usize)],
-    ) -> TransitionBatch {
-        let (o, a) = (self.spec.obs_dim, self.spec.action_dim);
-        let width = o + self.k;
-        let mut out = TransitionBatch {
-            obs: vec![0.0; picks.len() * width],
-            actions: Vec::with_capacity(picks.len() * a),
-            rewards: Vec::with_capacity(picks.len()),
-            next_obs: vec![0.0; picks.len() * width],
-            dones: Vec::with_capacity(picks.len()),
-        };
-        for (row, &(j, t)) in picks.iter().enumerate() {
-            let e = &self.episodes[batch[j]];
-            let last = t + 1 == e.len(a);
-            policy_input(
-                &e.obs[t * o..(t + 1) * o],
-                labels[j],
-                &mut out.obs[row * width..(row + 1) * width],
-            );
-            policy_input(
-                &e.obs[(t + 1) * o..(t + 2) * o],
-                labels[j],
-                &mut out.next_obs[row * width..(row + 1) * width],
-            );
-            out.actions
-                .extend_from_slice(&e.actions[t * a..(t + 1) * a]);
-            out.rewards.push(if last { finals[j] } else { 0.0 });
-            out.dones.push(if last { 1.0 } else { 0.0 });
-        }
-        out
     }
 
     /// Skill coverage (SPEC §4.5): distinct game moves made by the K skills from identical
@@ -477,6 +360,7 @@ impl Trainer {
         self.sac.load(dir, false)?;
         self.model.load(dir)?;
         self.load_buffer(&dir.join("episodes.safetensors"))?;
+        self.prepared = None;
         let path = dir.join("progress.json");
         let text = std::fs::read_to_string(&path).map_err(|e| RlError::io(&path, e))?;
         self.progress = serde_json::from_str(&text).map_err(|e| RlError::Checkpoint {
@@ -575,5 +459,207 @@ impl Trainer {
             return Err(corrupt("trailing episode data".into()));
         }
         Ok(())
+    }
+}
+
+/// The episode buffers with what an update needs to draw from them: the long-term buffer is the
+/// last `buffer_capacity` episodes, the short-term list its last `recent_episodes`.
+struct Buffers<'a> {
+    config: &'a TrainConfig,
+    k: usize,
+    episodes: &'a mut VecDeque<Episode>,
+    rng: &'a mut ChaCha8Rng,
+}
+
+impl Buffers<'_> {
+    /// Updates start once the buffer holds `sampled_episodes` episodes.
+    fn ready(&self) -> bool {
+        self.episodes.len() >= self.config.sampled_episodes
+    }
+
+    /// Appends new episodes, dropping the oldest beyond the capacity.
+    fn push(&mut self, new: Vec<Episode>) {
+        for episode in new {
+            if self.episodes.len() == self.config.buffer_capacity {
+                self.episodes.pop_front();
+            }
+            self.episodes.push_back(episode);
+        }
+    }
+
+    /// Indices of an update batch: `sampled_episodes` drawn with replacement from the long-term
+    /// buffer (all of it if it holds exactly that many), followed by the recent episodes.
+    fn update_batch(&mut self) -> Vec<usize> {
+        let n = self.episodes.len();
+        let mut batch: Vec<usize> = if n == self.config.sampled_episodes {
+            (0..n).collect()
+        } else {
+            (0..self.config.sampled_episodes)
+                .map(|_| self.rng.random_range(0..n))
+                .collect()
+        };
+        batch.extend(n.saturating_sub(self.config.recent_episodes)..n);
+        batch
+    }
+
+    /// Clipped posteriors C and rewards R (K per episode, row-major) of the given episodes.
+    fn score(&self, model: &dyn SkillModel, batch: &[usize]) -> (Vec<f32>, Vec<f32>) {
+        let pairs: Vec<(SymbolicState, SymbolicState)> = batch
+            .iter()
+            .map(|&i| (self.episodes[i].z0, self.episodes[i].zt))
+            .collect();
+        let scores = model.scores(&pairs);
+        let likelihoods = model.scores_are_likelihoods();
+        let mut clipped = Vec::with_capacity(scores.len());
+        let mut rewards = Vec::with_capacity(scores.len());
+        for row in scores.chunks(self.k) {
+            let (c, r) = episode_rewards(row, likelihoods, &self.config.reward);
+            clipped.extend(c);
+            rewards.extend(r);
+        }
+        (clipped, rewards)
+    }
+
+    /// Final labels: each episode of `batch` is chosen with probability `p` (among `eligible`),
+    /// and the chosen ones are relabelled together. `clipped` holds the K clipped posteriors of
+    /// each eligible episode, in `eligible` order.
+    fn relabelled(
+        &mut self,
+        batch: &[usize],
+        eligible: &[usize],
+        clipped: &[f32],
+        p: f64,
+    ) -> Vec<usize> {
+        let mut labels: Vec<usize> = batch.iter().map(|&i| self.episodes[i].skill).collect();
+        if p <= 0.0 {
+            return labels;
+        }
+        let k = self.k;
+        let chosen: Vec<usize> = (0..eligible.len())
+            .filter(|_| self.rng.random::<f64>() < p)
+            .collect();
+        let chosen_clipped: Vec<f32> = chosen
+            .iter()
+            .flat_map(|&e| clipped[e * k..(e + 1) * k].iter().copied())
+            .collect();
+        let chosen_labels: Vec<usize> = chosen.iter().map(|&e| labels[eligible[e]]).collect();
+        for (&e, new) in chosen.iter().zip(relabel(
+            self.config.relabel.kind,
+            &chosen_clipped,
+            k,
+            &chosen_labels,
+        )) {
+            labels[eligible[e]] = new;
+        }
+        labels
+    }
+
+    /// The skill-model batch: every episode of an update batch relabelled with p = 1 (episodes
+    /// that did not change the board take part), as (z_0, label, z_T) tuples.
+    fn skill_model_batch(&mut self, model: &dyn SkillModel) -> Vec<SkillTransition> {
+        let batch = self.update_batch();
+        let eligible: Vec<usize> = (0..batch.len()).collect();
+        let (clipped, _) = if self.config.relabel.skill_model_p > 0.0 {
+            self.score(model, &batch)
+        } else {
+            Default::default()
+        };
+        let labels = self.relabelled(
+            &batch,
+            &eligible,
+            &clipped,
+            self.config.relabel.skill_model_p,
+        );
+        batch
+            .iter()
+            .zip(labels)
+            .map(|(&i, skill)| SkillTransition {
+                z0: self.episodes[i].z0,
+                skill,
+                zt: self.episodes[i].zt,
+            })
+            .collect()
+    }
+
+    /// The SAC minibatches of an epoch: an update batch relabelled with p = 0.5 among the
+    /// board-changing episodes; each episode's last transition carries R of its final label (or
+    /// the minimum reward if the board did not change). Returns the minibatches and the mean
+    /// final reward.
+    fn sac_minibatches(
+        &mut self,
+        model: &dyn SkillModel,
+        spec: &EnvSpec,
+        config: &TrainConfig,
+        rng: &mut ChaCha8Rng,
+    ) -> (Vec<TransitionBatch>, f32) {
+        let batch = self.update_batch();
+        // Only board-changing episodes need scores: the others get the minimum reward and are
+        // never relabelled.
+        let eligible: Vec<usize> = (0..batch.len())
+            .filter(|&j| self.episodes[batch[j]].changed())
+            .collect();
+        let changed: Vec<usize> = eligible.iter().map(|&j| batch[j]).collect();
+        let (clipped, rewards) = self.score(model, &changed);
+        let labels = self.relabelled(&batch, &eligible, &clipped, config.relabel.sac_p);
+        let mut finals = vec![minimum_reward(self.k); batch.len()];
+        for (e, &j) in eligible.iter().enumerate() {
+            finals[j] = rewards[e * self.k + labels[j]];
+        }
+        let a = spec.action_dim;
+        let transitions: Vec<(usize, usize)> = batch
+            .iter()
+            .enumerate()
+            .flat_map(|(j, &i)| (0..self.episodes[i].len(a)).map(move |t| (j, t)))
+            .collect();
+        let minibatches = (0..config.sac.updates_per_epoch)
+            .map(|_| {
+                let picks: Vec<(usize, usize)> = (0..config.sac.batch_size)
+                    .map(|_| transitions[rng.random_range(0..transitions.len())])
+                    .collect();
+                self.transition_batch(spec, &batch, &labels, &finals, &picks)
+            })
+            .collect();
+        let mean_reward = finals.iter().sum::<f32>() / finals.len().max(1) as f32;
+        (minibatches, mean_reward)
+    }
+
+    /// SAC inputs for the picked transitions: `[s, onehot(final label)]`, the reward only on an
+    /// episode's last transition, done = 1 there (moves and time-outs alike).
+    fn transition_batch(
+        &self,
+        spec: &EnvSpec,
+        batch: &[usize],
+        labels: &[usize],
+        finals: &[f32],
+        picks: &[(usize, usize)],
+    ) -> TransitionBatch {
+        let (o, a) = (spec.obs_dim, spec.action_dim);
+        let width = o + self.k;
+        let mut out = TransitionBatch {
+            obs: vec![0.0; picks.len() * width],
+            actions: Vec::with_capacity(picks.len() * a),
+            rewards: Vec::with_capacity(picks.len()),
+            next_obs: vec![0.0; picks.len() * width],
+            dones: Vec::with_capacity(picks.len()),
+        };
+        for (row, &(j, t)) in picks.iter().enumerate() {
+            let e = &self.episodes[batch[j]];
+            let last = t + 1 == e.len(a);
+            policy_input(
+                &e.obs[t * o..(t + 1) * o],
+                labels[j],
+                &mut out.obs[row * width..(row + 1) * width],
+            );
+            policy_input(
+                &e.obs[(t + 1) * o..(t + 2) * o],
+                labels[j],
+                &mut out.next_obs[row * width..(row + 1) * width],
+            );
+            out.actions
+                .extend_from_slice(&e.actions[t * a..(t + 1) * a]);
+            out.rewards.push(if last { finals[j] } else { 0.0 });
+            out.dones.push(if last { 1.0 } else { 0.0 });
+        }
+        out
     }
 }

@@ -1,0 +1,217 @@
+//! SAC learns a toy task; SEADS trains, is deterministic, checkpoints and resumes; bad
+//! configurations are rejected.
+
+use rand::{RngExt, SeedableRng};
+use rand_chacha::ChaCha8Rng;
+use seads_rl::{
+    Run, Sac, SacConfig, TrainConfig, Trainer, TransitionBatch, checkpoints, latest_checkpoint,
+    read_metrics,
+};
+use tch::Device;
+
+/// A one-step task: observe s ∈ [−1, 1], act a ∈ [−1, 1], reward −(a − s)², then the episode
+/// ends. SAC must learn a ≈ s.
+#[test]
+fn sac_learns_to_track_a_target() {
+    let config = SacConfig {
+        hidden: vec![64, 64],
+        alpha: 0.01,
+        lr: 1e-3,
+        ..SacConfig::default()
+    };
+    let mut sac = Sac::new(1, &[-1.0], &[1.0], &config, Device::Cpu, 3);
+    let mut rng = ChaCha8Rng::seed_from_u64(5);
+    for _ in 0..1500 {
+        let obs: Vec<f32> = (0..64).map(|_| rng.random_range(-1.0..1.0)).collect();
+        let actions = sac.act(&obs, Some(&mut rng));
+        let rewards = obs
+            .iter()
+            .zip(&actions)
+            .map(|(s, a)| -(a - s) * (a - s))
+            .collect();
+        let batch = TransitionBatch {
+            next_obs: obs.clone(),
+            obs,
+            actions,
+            rewards,
+            dones: vec![1.0; 64],
+        };
+        sac.update(&batch, &mut rng);
+    }
+    let test = [-0.8f32, -0.3, 0.0, 0.4, 0.9];
+    let actions = sac.act(&test, None);
+    for (s, a) in test.iter().zip(&actions) {
+        assert!((s - a).abs() < 0.1, "state {s}: action {a}");
+    }
+}
+
+/// A small, fast configuration of LightsOutCursor.
+fn small(seed: u64, steps: u64) -> TrainConfig {
+    let mut config = TrainConfig::preset("lightsout-cursor").unwrap();
+    config.seed = seed;
+    config.env_steps = steps;
+    config.sac.hidden = vec![64, 64];
+    config.skill_model.hidden = vec![64, 64];
+    config.sampled_episodes = 64;
+    config.recent_episodes = 32;
+    config.eval_every = 10;
+    config.checkpoint_every = 10;
+    config.eval_seeds = 2;
+    config
+}
+
+/// A few epochs of LightsOutCursor (small networks, CI-sized): updates start once the buffer
+/// holds enough episodes, the forward model starts to explain the moves, and the deterministic
+/// skills, which push nowhere at initialisation, start making game moves. (Learning all 25 skills
+/// takes ~10⁴–10⁵ steps: see `seads train` and the README's results.)
+#[test]
+fn lightsout_cursor_smoke() {
+    let mut trainer = Trainer::new(small(7, 4000)).unwrap();
+    let first = trainer.skill_coverage().unwrap();
+    let mut updated = false;
+    let mut losses = Vec::new();
+    while !trainer.finished() {
+        let stats = trainer.run_epoch().unwrap();
+        updated |= stats.updated;
+        if stats.updated {
+            losses.push(stats.skill_model_loss);
+        }
+    }
+    assert!(updated);
+    let early: f32 = losses[..5].iter().sum::<f32>() / 5.0;
+    let late: f32 = losses[losses.len() - 5..].iter().sum::<f32>() / 5.0;
+    assert!(late < early, "forward-model loss falls: {early} -> {late}");
+    let coverage = trainer.skill_coverage().unwrap();
+    assert_eq!(first, 0.0, "untrained skills do not push");
+    assert!(coverage >= 1.0, "coverage {first} -> {coverage}");
+    assert!(trainer.env_steps() >= 4000);
+}
+
+/// The same seed gives the same run (metrics bit for bit), another seed another run.
+#[test]
+fn same_seed_same_run() {
+    let run = |seed| {
+        let mut trainer = Trainer::new(small(seed, 1200)).unwrap();
+        let mut trace = Vec::new();
+        while !trainer.finished() {
+            let s = trainer.run_epoch().unwrap();
+            trace.push((
+                s.env_steps,
+                s.mean_reward.to_bits(),
+                s.skill_model_loss.to_bits(),
+                s.sac.critic.to_bits(),
+            ));
+        }
+        trace.push((trainer.skill_coverage().unwrap().to_bits(), 0, 0, 0));
+        trace
+    };
+    assert_eq!(run(3), run(3));
+    assert_ne!(run(3), run(4));
+}
+
+/// A killed run resumes from its last checkpoint: the state is restored exactly, evaluations
+/// logged after the checkpoint are dropped, and training continues to the budget.
+#[test]
+fn resume_continues_from_the_last_checkpoint() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("run");
+    let mut run = Run::create(&path, small(11, 2500)).unwrap();
+    let mut at_checkpoint = None;
+    for _ in 0..25 {
+        let event = run.step().unwrap();
+        if event.checkpoint.is_some() {
+            at_checkpoint = Some((run.trainer().epoch(), run.trainer().env_steps()));
+        }
+    }
+    // "Kill" after epoch 25: the latest checkpoint is epoch 20; the epoch-1/10/20 evaluations stay.
+    let (epoch, steps) = at_checkpoint.unwrap();
+    assert_eq!(epoch, 20);
+    assert_eq!(
+        latest_checkpoint(&path).unwrap().unwrap(),
+        path.join("checkpoints/epoch-000020")
+    );
+    drop(run);
+    // Creating again in the same directory is refused.
+    assert!(Run::create(&path, small(11, 2500)).is_err());
+    let mut resumed = Run::resume(&path).unwrap();
+    assert_eq!(
+        (resumed.trainer().epoch(), resumed.trainer().env_steps()),
+        (epoch, steps)
+    );
+    assert!(read_metrics(&path).unwrap().iter().all(|m| m.epoch <= 20));
+    while !resumed.finished() {
+        resumed.step().unwrap();
+    }
+    let metrics = read_metrics(&path).unwrap();
+    assert!(metrics.last().unwrap().env_steps >= 2500);
+    let epochs: Vec<u64> = metrics.iter().map(|m| m.epoch).collect();
+    assert!(
+        epochs.windows(2).all(|w| w[0] < w[1]),
+        "metrics epochs increase: {epochs:?}"
+    );
+    // Older checkpoints keep only what evaluation needs.
+    let all = checkpoints(&path).unwrap();
+    assert!(all.len() >= 3);
+    assert!(!all[0].1.join("episodes.safetensors").exists());
+    assert!(all[0].1.join("sac_actor.safetensors").exists());
+    assert!(all.last().unwrap().1.join("episodes.safetensors").exists());
+}
+
+#[test]
+fn corrupt_checkpoints_are_errors_not_panics() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("run");
+    let mut run = Run::create(&path, small(2, 600)).unwrap();
+    while !run.finished() {
+        run.step().unwrap();
+    }
+    drop(run);
+    let latest = latest_checkpoint(&path).unwrap().unwrap();
+    std::fs::write(latest.join("episodes.safetensors"), b"garbage").unwrap();
+    let err = Run::resume(&path)
+        .err()
+        .expect("a corrupt checkpoint is an error");
+    assert!(err.to_string().contains("episodes.safetensors"), "{err}");
+    std::fs::remove_dir_all(&latest).unwrap();
+    assert!(Run::resume(&path).is_err());
+}
+
+#[test]
+fn bad_configurations_are_rejected_with_a_reason() {
+    let cases: [(&str, fn(&mut TrainConfig)); 8] = [
+        ("unknown environment", |c| c.env = "lightsout-robot".into()),
+        ("sac.hidden", |c| c.sac.hidden = vec![64, -1]),
+        ("sac.alpha", |c| c.sac.alpha = 0.0),
+        ("sac.gamma", |c| c.sac.gamma = 1.5),
+        ("skill_model.lr", |c| c.skill_model.lr = -1.0),
+        ("relabel.sac_p", |c| c.relabel.sac_p = 2.0),
+        ("episodes_per_epoch", |c| c.episodes_per_epoch = 0),
+        ("buffer_capacity", |c| {
+            c.sampled_episodes = c.buffer_capacity + 1
+        }),
+    ];
+    for (needle, edit) in cases {
+        let mut config = TrainConfig::default();
+        edit(&mut config);
+        let err = config
+            .validate()
+            .err()
+            .unwrap_or_else(|| panic!("{needle} accepted"));
+        assert!(err.to_string().contains(needle), "{needle}: {err}");
+    }
+    assert!(
+        TrainConfig::from_toml("env = \"lightsout-cursor\"\nalpha = 0.1").is_err(),
+        "unknown fields are errors"
+    );
+}
+
+#[test]
+fn presets_parse_and_round_trip() {
+    for (env, text) in TrainConfig::presets() {
+        let config = TrainConfig::from_toml(text).unwrap();
+        assert_eq!(&config.env, env);
+        assert_eq!(TrainConfig::from_toml(&config.to_toml()).unwrap(), config);
+        let expected_alpha = if env.contains("cursor") { 0.1 } else { 0.01 };
+        assert_eq!(config.sac.alpha, expected_alpha, "{env}");
+    }
+}
