@@ -212,8 +212,8 @@ impl Run {
         let epoch = self.trainer.epoch();
         let done = self.trainer.finished();
         let config = self.trainer.config();
-        let eval_due = first || epoch % config.eval_every == 0 || done;
-        let checkpoint_due = epoch % config.checkpoint_every == 0 || done;
+        let eval_due = first || epoch.is_multiple_of(config.eval_every) || done;
+        let checkpoint_due = epoch.is_multiple_of(config.checkpoint_every) || done;
         let metrics = if eval_due {
             Some(self.evaluate(&stats)?)
         } else {

@@ -178,7 +178,8 @@ fn corrupt_checkpoints_are_errors_not_panics() {
 
 #[test]
 fn bad_configurations_are_rejected_with_a_reason() {
-    let cases: [(&str, fn(&mut TrainConfig)); 8] = [
+    type Edit = fn(&mut TrainConfig);
+    let cases: [(&str, Edit); 8] = [
         ("unknown environment", |c| c.env = "lightsout-robot".into()),
         ("sac.hidden", |c| c.sac.hidden = vec![64, -1]),
         ("sac.alpha", |c| c.sac.alpha = 0.0),

@@ -3,7 +3,7 @@
 use proptest::prelude::*;
 use seads_games::{BoardGame, LightsOut, SymbolicState, TileSwap};
 use seads_skillmodel::{
-    SkillModel, SkillModelConfig, SkillModelKind, SkillTransition, relabel_assignment,
+    SkillModelConfig, SkillModelKind, SkillTransition, relabel_assignment,
 };
 use tch::Device;
 
@@ -16,7 +16,7 @@ fn permutations(n: usize) -> Vec<Vec<usize>> {
         }
         for i in 0..k {
             heap(k - 1, a, out);
-            a.swap(if k % 2 == 0 { i } else { 0 }, k - 1);
+            a.swap(if k.is_multiple_of(2) { i } else { 0 }, k - 1);
         }
     }
     let mut out = Vec::new();
