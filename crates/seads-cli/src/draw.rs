@@ -1,18 +1,22 @@
-//! Drawing with plotters: the embedded font and top views of environment scenes.
+//! Drawing with plotters: the embedded font, top views of scenes, end-effector paths, and a
+//! helper that writes the same figure as PNG or SVG.
 
-use std::path::Path;
 use std::sync::Once;
 
-use anyhow::{Context, Result};
+use anyhow::Result;
 use plotters::coord::Shift;
+use plotters::coord::types::RangedCoordf64;
 use plotters::prelude::*;
-use seads_embodiment::{Scene, Shape};
+use seads_embodiment::{Scene, Shape, SkillRun};
+
+/// A chart in board coordinates.
+pub type BoardChart<'a, DB> = ChartContext<'a, DB, Cartesian2d<RangedCoordf64, RangedCoordf64>>;
 
 /// Registers DejaVu Sans as plotters' "sans-serif" (once per process).
 pub fn register_font() {
     static ONCE: Once = Once::new();
     ONCE.call_once(|| {
-        // The font is a valid TTF shipped by the `dejavu` crate; registration cannot fail.
+        // The fonts are valid TTFs shipped by the `dejavu` crate; registration cannot fail.
         let _ = plotters::style::register_font(
             "sans-serif",
             FontStyle::Normal,
@@ -22,41 +26,72 @@ pub fn register_font() {
     });
 }
 
-/// Lit LightsOut field.
-pub const LIT: RGBColor = RGBColor(245, 190, 40);
-/// Unlit LightsOut field.
-pub const UNLIT: RGBColor = RGBColor(70, 70, 80);
-/// TileSwap tile.
-pub const TILE: RGBColor = RGBColor(200, 215, 235);
+/// Converts a plotters drawing error into `anyhow`.
+pub fn plot_err<E: std::error::Error + Send + Sync>(e: DrawingAreaErrorKind<E>) -> anyhow::Error {
+    anyhow::anyhow!("drawing failed: {e}")
+}
 
-/// Draws `scene` onto `area` with `title` on top; returns the chart's coordinate mapping so that
-/// callers can draw more (trajectories) in board coordinates.
+/// Writes a figure to `$out` (PNG, or SVG by extension) of `$size` pixels: `$draw` is called
+/// with the white drawing area and returns `anyhow::Result<()>`.
+macro_rules! render_to {
+    ($out:expr, $size:expr, $draw:expr) => {{
+        let out: &std::path::Path = $out;
+        $crate::draw::register_font();
+        if out
+            .extension()
+            .is_some_and(|e| e.eq_ignore_ascii_case("svg"))
+        {
+            let area = plotters::prelude::SVGBackend::new(out, $size).into_drawing_area();
+            area.fill(&plotters::prelude::WHITE)
+                .map_err($crate::draw::plot_err)?;
+            ($draw)(&area)?;
+            area.present().map_err($crate::draw::plot_err)?;
+        } else {
+            let area = plotters::prelude::BitMapBackend::new(out, $size).into_drawing_area();
+            area.fill(&plotters::prelude::WHITE)
+                .map_err($crate::draw::plot_err)?;
+            ($draw)(&area)?;
+            area.present().map_err($crate::draw::plot_err)?;
+        }
+        anyhow::Ok(())
+    }};
+}
+pub(crate) use render_to;
+
+/// Lit LightsOut field.
+const LIT: RGBColor = RGBColor(245, 190, 40);
+/// Unlit LightsOut field.
+const UNLIT: RGBColor = RGBColor(70, 70, 80);
+/// TileSwap tile.
+const TILE: RGBColor = RGBColor(200, 215, 235);
+
+/// A square view around `extent`, so that the board keeps its proportions.
+fn square(extent: [f64; 4]) -> [f64; 4] {
+    let [u0, v0, u1, v1] = extent;
+    let half = (u1 - u0).max(v1 - v0) / 2.0;
+    let (cu, cv) = ((u0 + u1) / 2.0, (v0 + v1) / 2.0);
+    [cu - half, cv - half, cu + half, cv + half]
+}
+
+/// Draws `scene` onto `area` under `title` (font size `font`); returns the chart so that
+/// callers can draw more in board coordinates. `manipulator` draws the manipulator too.
 pub fn draw_scene<'a, DB: DrawingBackend + 'a>(
     area: &'a DrawingArea<DB, Shift>,
     scene: &Scene,
     title: &str,
-) -> Result<
-    ChartContext<
-        'a,
-        DB,
-        Cartesian2d<plotters::coord::types::RangedCoordf64, plotters::coord::types::RangedCoordf64>,
-    >,
->
+    font: u32,
+    manipulator: bool,
+) -> Result<BoardChart<'a, DB>>
 where
     DB::ErrorType: 'static,
 {
-    register_font();
-    // A square view, so that the board keeps its proportions.
-    let [u0, v0, u1, v1] = scene.extent;
-    let half = (u1 - u0).max(v1 - v0) / 2.0;
-    let (cu, cv) = ((u0 + u1) / 2.0, (v0 + v1) / 2.0);
-    let (u0, v0, u1, v1) = (cu - half, cv - half, cu + half, cv + half);
+    let [u0, v0, u1, v1] = square(scene.extent);
+    // v grows downwards (row 0 on top), as on the board.
     let chart = ChartBuilder::on(area)
-        .caption(title, ("sans-serif", 18))
-        .margin(8)
-        // v grows downwards (row 0 on top), as on the board.
+        .caption(title, ("sans-serif", font))
+        .margin(6)
         .build_cartesian_2d(u0..u1, v1..v0)
-        .map_err(|e| anyhow::anyhow!("{e}"))?;
+        .map_err(plot_err)?;
     let plot = chart.plotting_area();
     for field in &scene.fields {
         let [a, b, c, d] = field.rect;
@@ -66,62 +101,104 @@ where
             None => TILE,
         };
         plot.draw(&Rectangle::new([(a, b), (c, d)], fill.filled()))
-            .map_err(|e| anyhow::anyhow!("{e}"))?;
+            .map_err(plot_err)?;
         plot.draw(&Rectangle::new([(a, b), (c, d)], BLACK.stroke_width(1)))
-            .map_err(|e| anyhow::anyhow!("{e}"))?;
+            .map_err(plot_err)?;
         if let Some(label) = &field.label {
-            let style = TextStyle::from(("sans-serif", 22).into_font())
+            let pos = plotters::style::text_anchor::Pos::new(
+                plotters::style::text_anchor::HPos::Center,
+                plotters::style::text_anchor::VPos::Center,
+            );
+            let style = TextStyle::from(("sans-serif", font + 4).into_font())
                 .color(&BLACK)
-                .pos(plotters::style::text_anchor::Pos::new(
-                    plotters::style::text_anchor::HPos::Center,
-                    plotters::style::text_anchor::VPos::Center,
-                ));
+                .pos(pos);
             plot.draw(&Text::new(
                 label.clone(),
                 ((a + c) / 2.0, (b + d) / 2.0),
                 style,
             ))
-            .map_err(|e| anyhow::anyhow!("{e}"))?;
+            .map_err(plot_err)?;
         }
     }
     for &[u, v] in &scene.pivots {
         plot.draw(&Circle::new((u, v), 3, RGBColor(120, 120, 120).filled()))
-            .map_err(|e| anyhow::anyhow!("{e}"))?;
+            .map_err(plot_err)?;
     }
-    let arm = RGBColor(30, 60, 160);
-    for shape in &scene.shapes {
-        let result = match *shape {
-            Shape::Segment { from, to } => plot.draw(&PathElement::new(
-                vec![(from[0], from[1]), (to[0], to[1])],
-                arm.stroke_width(5),
-            )),
-            Shape::Joint { at } => plot.draw(&Circle::new((at[0], at[1]), 5, arm.filled())),
-            Shape::Marker { at } => plot.draw(&Cross::new((at[0], at[1]), 9, RED.stroke_width(4))),
-        };
-        result.map_err(|e| anyhow::anyhow!("{e}"))?;
+    if manipulator {
+        let arm = RGBColor(30, 60, 160);
+        for shape in &scene.shapes {
+            match *shape {
+                Shape::Segment { from, to } => plot.draw(&PathElement::new(
+                    vec![(from[0], from[1]), (to[0], to[1])],
+                    arm.stroke_width(5),
+                )),
+                Shape::Joint { at } => plot.draw(&Circle::new((at[0], at[1]), 5, arm.filled())),
+                Shape::Marker { at } => {
+                    plot.draw(&Cross::new((at[0], at[1]), 9, RED.stroke_width(4)))
+                }
+            }
+            .map_err(plot_err)?;
+        }
     }
     Ok(chart)
 }
 
-/// Renders a scene to a PNG or SVG file (by extension).
-pub fn render_scene(scene: &Scene, title: &str, out: &Path) -> Result<()> {
-    let svg = out
-        .extension()
-        .is_some_and(|e| e.eq_ignore_ascii_case("svg"));
-    if svg {
-        let area = SVGBackend::new(out, (600, 640)).into_drawing_area();
-        area.fill(&WHITE).map_err(|e| anyhow::anyhow!("{e}"))?;
-        draw_scene(&area, scene, title)?;
-        area.present()
-            .map_err(|e| anyhow::anyhow!("{e}"))
-            .with_context(|| format!("writing {}", out.display()))?;
-    } else {
-        let area = BitMapBackend::new(out, (600, 640)).into_drawing_area();
-        area.fill(&WHITE).map_err(|e| anyhow::anyhow!("{e}"))?;
-        draw_scene(&area, scene, title)?;
-        area.present()
-            .map_err(|e| anyhow::anyhow!("{e}"))
-            .with_context(|| format!("writing {}", out.display()))?;
+/// A colour per skill, distinguishable for up to ~30 skills.
+pub fn skill_colour(k: usize) -> RGBColor {
+    let (r, g, b) = HSLColor(((k * 7) % 30) as f64 / 30.0, 0.75, 0.42).rgb();
+    RGBColor(r, g, b)
+}
+
+/// Draws end-effector paths in board coordinates, each in the colour of its key: a line, a
+/// hollow circle where it started, a filled dot at a push that moved the board and a cross at a
+/// push that did not.
+pub fn draw_paths<DB: DrawingBackend>(
+    chart: &mut BoardChart<'_, DB>,
+    runs: &[(usize, &SkillRun)],
+) -> Result<()>
+where
+    DB::ErrorType: 'static,
+{
+    let plot = chart.plotting_area();
+    for &(key, run) in runs {
+        let colour = skill_colour(key);
+        let points: Vec<(f64, f64)> = run.path.iter().map(|p| (p[0], p[1])).collect();
+        plot.draw(&PathElement::new(points.clone(), colour.stroke_width(2)))
+            .map_err(plot_err)?;
+        plot.draw(&Circle::new(points[0], 4, colour.stroke_width(2)))
+            .map_err(plot_err)?;
+        for (i, &step) in run.pushes.iter().enumerate() {
+            let moved = i + 1 == run.pushes.len() && run.outcome.moved();
+            if moved {
+                plot.draw(&Circle::new(points[step], 6, colour.filled()))
+                    .map_err(plot_err)?;
+            } else {
+                plot.draw(&Cross::new(points[step], 5, colour.stroke_width(2)))
+                    .map_err(plot_err)?;
+            }
+        }
     }
     Ok(())
+}
+
+/// Renders a scene to a PNG or SVG file (by extension).
+pub fn render_scene(scene: &Scene, title: &str, out: &std::path::Path) -> Result<()> {
+    render_to!(out, (600, 640), |area: &DrawingArea<_, Shift>| draw_scene(
+        area, scene, title, 18, true
+    )
+    .map(|_| ()))
+}
+
+/// The board before solving with the paths of the executed skills (`seads solve --render`).
+pub fn render_solution(
+    before: &Scene,
+    runs: &[SkillRun],
+    title: &str,
+    out: &std::path::Path,
+) -> Result<()> {
+    let keyed: Vec<(usize, &SkillRun)> = runs.iter().enumerate().collect();
+    render_to!(out, (600, 640), |area: &DrawingArea<_, Shift>| {
+        let mut chart = draw_scene(area, before, title, 18, false)?;
+        draw_paths(&mut chart, &keyed)
+    })
 }

@@ -72,27 +72,6 @@ pub fn run(cmd: GamesCommand) -> Result<()> {
     }
 }
 
-/// The main job for now: both depth tables and an optimal solution of a sample board.
-pub fn demo() -> Result<()> {
-    for (game, size) in [(GameKind::LightsOut, 5), (GameKind::TileSwap, 3)] {
-        println!("{}", depths(game, size)?.table());
-    }
-    println!(
-        "{}",
-        solve(
-            GameKind::LightsOut,
-            5,
-            "1,1,0,0,0,1,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0"
-        )?
-        .table()
-    );
-    println!(
-        "{}",
-        solve(GameKind::TileSwap, 3, "3,1,2,0,4,5,6,7,8")?.table()
-    );
-    Ok(())
-}
-
 fn print_report<T: Serialize>(report: &T, json: bool, table: impl Fn(&T) -> String) -> Result<()> {
     if json {
         println!("{}", serde_json::to_string(report)?);

@@ -1,9 +1,12 @@
 //! `seads`: the command line of the SEADS workspace — the only crate that prints.
 #![allow(clippy::print_stdout, clippy::print_stderr)] // printing is this crate's job
 
+mod demo;
 mod draw;
 mod envs;
 mod games;
+mod plan;
+mod plot;
 mod train;
 
 use std::process::ExitCode;
@@ -23,8 +26,9 @@ enum Command {
     /// The discrete board games: depth tables, train/test splits, optimal solutions.
     #[command(subcommand)]
     Games(games::GamesCommand),
-    /// The main job on embedded defaults: print both depth tables and solve a sample board.
-    Run,
+    /// The main job on embedded defaults: train a small agent on lightsout-cursor, evaluate it
+    /// by planning on test boards, and write the figures.
+    Run(demo::RunArgs),
     /// List the embodied environments with their dimensions.
     Envs {
         /// Print JSON.
@@ -37,6 +41,14 @@ enum Command {
     EnvBench(envs::BenchArgs),
     /// Train SEADS skills and their forward model on an environment (no task reward).
     Train(train::TrainArgs),
+    /// Solve one board with a trained agent: plan with its forward model, execute its skills.
+    Solve(plan::SolveArgs),
+    /// Task success of a trained agent per solution depth on test boards (the paper's protocol).
+    Evaluate(plan::EvaluateArgs),
+    /// Figures of a run: skill coverage, success per depth, skill trajectories, push points.
+    Plot(plot::PlotArgs),
+    /// Planner speed: BFS with a forward model fitted to the LightsOut move table.
+    PlanBench(plan::PlanBenchArgs),
 }
 
 /// Input the user gave that cannot be used (exit code 2, like a usage error).
@@ -64,11 +76,15 @@ fn main() -> ExitCode {
     let cli = Cli::parse();
     let result = match cli.command {
         Command::Games(cmd) => games::run(cmd),
-        Command::Run => games::demo(),
+        Command::Run(args) => demo::run(args),
         Command::Envs { json } => envs::envs(json),
         Command::Render(args) => envs::render(args),
         Command::EnvBench(args) => envs::env_bench(args),
         Command::Train(args) => train::train(args),
+        Command::Solve(args) => plan::solve_board(args),
+        Command::Evaluate(args) => plan::evaluate_run(args),
+        Command::Plot(args) => plot::plot(args),
+        Command::PlanBench(args) => plan::plan_bench(args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

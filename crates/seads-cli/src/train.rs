@@ -74,8 +74,13 @@ pub fn train(args: TrainArgs) -> Result<()> {
             })?
         }
     };
+    drive(&mut run, args.quiet)
+}
+
+/// Trains `run` to its budget, showing progress, and prints a summary.
+pub fn drive(run: &mut Run, quiet: bool) -> Result<()> {
     let budget = run.trainer().config().env_steps;
-    let bar = if args.quiet {
+    let bar = if quiet {
         ProgressBar::hidden()
     } else {
         ProgressBar::new(budget)
@@ -96,7 +101,7 @@ pub fn train(args: TrainArgs) -> Result<()> {
                 "epoch {:>6}  steps {:>9}  coverage {:>5.2}/{}  reward {:>6.2}  {:>6.0} steps/s",
                 m.epoch, m.env_steps, m.skill_coverage, k, m.mean_reward, m.steps_per_s
             );
-            if args.quiet {
+            if quiet {
                 println!("{line}");
             } else {
                 bar.println(line);

@@ -375,3 +375,127 @@ fn train_rejects_bad_input() {
     assert_eq!(missing.status.code(), Some(1));
     assert!(String::from_utf8_lossy(&missing.stderr).contains("config.toml"));
 }
+
+/// One tiny trained run shared by the planning tests.
+fn tiny_run() -> &'static std::path::Path {
+    static RUN: std::sync::OnceLock<tempfile::TempDir> = std::sync::OnceLock::new();
+    RUN.get_or_init(|| {
+        let dir = tempfile::tempdir().unwrap();
+        let config = tiny_config(dir.path());
+        let run = dir.path().join("run");
+        let out = seads(&[
+            "train",
+            "--config",
+            config.to_str().unwrap(),
+            "--out",
+            run.to_str().unwrap(),
+            "--quiet",
+        ]);
+        assert!(
+            out.status.success(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        dir
+    })
+    .path()
+}
+
+#[test]
+fn solve_evaluate_and_plot_a_trained_run() {
+    let run = tiny_run().join("run");
+    let run = run.to_str().unwrap();
+    let board = "1,1,0,0,0,1,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0";
+    let v = json(&[
+        "solve",
+        "--run",
+        run,
+        "--board",
+        board,
+        "--replan",
+        "--timeout",
+        "0.5",
+        "--json",
+    ]);
+    assert_eq!(v["board"], board);
+    for key in [
+        "solved",
+        "plan_found",
+        "executed",
+        "skill_steps",
+        "manipulator_steps",
+        "planning_s",
+    ] {
+        assert!(v.get(key).is_some(), "solve reports {key}");
+    }
+    let v = json(&[
+        "evaluate",
+        "--run",
+        run,
+        "--depths",
+        "1-2",
+        "--boards",
+        "2",
+        "--timeout",
+        "0.5",
+        "--json",
+    ]);
+    for key in [
+        "success_rate",
+        "plan_found",
+        "planning_s",
+        "solution_steps",
+        "skill_steps",
+    ] {
+        assert_eq!(
+            v[key].as_object().unwrap().len(),
+            2,
+            "{key} has depths 1 and 2"
+        );
+    }
+    let rate = v["success_rate"]["1"].as_f64().unwrap();
+    assert!((0.0..=1.0).contains(&rate));
+    let figures = tiny_run().join("figures");
+    let out = seads(&[
+        "plot",
+        "--run",
+        run,
+        "--out",
+        figures.to_str().unwrap(),
+        "--boards",
+        "1",
+        "--timeout",
+        "0.5",
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    for name in ["coverage", "success", "trajectories", "pushes"] {
+        assert_eq!(
+            &std::fs::read(figures.join(format!("{name}.png"))).unwrap()[1..4],
+            b"PNG"
+        );
+        assert!(
+            std::fs::read_to_string(figures.join(format!("{name}.svg")))
+                .unwrap()
+                .contains("<svg")
+        );
+    }
+}
+
+#[test]
+fn planning_commands_reject_bad_input() {
+    let run = tiny_run().join("run");
+    let run = run.to_str().unwrap();
+    check_bad_input(
+        &["solve", "--run", run, "--board", "1,0"],
+        "has 25 fields, got 2",
+    );
+    check_bad_input(&["evaluate", "--run", run, "--depths", "five"], "--depths");
+    check_bad_input(&["evaluate", "--run", run, "--depths", "0-2"], "--depths");
+    let missing = seads(&["solve", "--run", "/nonexistent/run", "--board", "0,0"]);
+    assert_eq!(missing.status.code(), Some(1));
+    assert!(String::from_utf8_lossy(&missing.stderr).contains("loading the agent"));
+}

@@ -73,6 +73,10 @@ impl Manipulator for Cursor {
         Ok(())
     }
 
+    fn end_effector(&self) -> [f64; 2] {
+        [self.x, self.y]
+    }
+
     fn draw(&self, shapes: &mut Vec<Shape>, _extent: &mut [f64; 4]) {
         shapes.push(Shape::Marker {
             at: [self.x, self.y],

@@ -36,6 +36,9 @@ pub trait Environment: Send + Sync {
     fn restore_manipulator(&mut self, state: &[f32]) -> Result<(), EnvError>;
     /// A top view of the board and the manipulator.
     fn scene(&self) -> Scene;
+    /// Where the end effector (cursor, fingertip, tool centre point) is above the board, in
+    /// normalised board coordinates (u to the right, v down the rows).
+    fn end_effector(&self) -> [f64; 2];
     /// A boxed copy (same state, same random streams).
     fn box_clone(&self) -> Box<dyn Environment>;
 
@@ -95,6 +98,8 @@ pub trait Manipulator: Clone + Send + Sync + 'static {
     fn can_restore(&self) -> bool {
         true
     }
+    /// The end effector in normalised board coordinates.
+    fn end_effector(&self) -> [f64; 2];
     /// Draws the manipulator and widens `extent` to what it can reach.
     fn draw(&self, shapes: &mut Vec<Shape>, extent: &mut [f64; 4]);
 }
@@ -314,6 +319,10 @@ impl<M: Manipulator> Environment for Embodied<M> {
         };
         self.manipulator.draw(&mut scene.shapes, &mut scene.extent);
         scene
+    }
+
+    fn end_effector(&self) -> [f64; 2] {
+        self.manipulator.end_effector()
     }
 
     fn box_clone(&self) -> Box<dyn Environment> {

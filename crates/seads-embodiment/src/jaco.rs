@@ -726,6 +726,12 @@ impl Manipulator for Jaco {
         false
     }
 
+    fn end_effector(&self) -> [f64; 2] {
+        let w = 2.0 * self.board.half_width();
+        let [x, y, _] = self.tcp();
+        [((x + w / 2.0) / w) as f64, (1.0 - (y + w / 2.0) / w) as f64]
+    }
+
     fn draw(&self, shapes: &mut Vec<Shape>, extent: &mut [f64; 4]) {
         // Top view: links projected on the board plane, board coordinates with the y flip.
         let w = 2.0 * self.board.half_width();

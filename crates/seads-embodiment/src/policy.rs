@@ -19,10 +19,9 @@ pub struct SkillRun {
     pub steps: usize,
     /// The last step's outcome (a move, a miss or a time-out).
     pub outcome: StepOutcome,
-    /// Manipulator positions visited, for trajectory figures: the observation's manipulator
-    /// part before the first step and after every step.
-    pub manipulator: Vec<Vec<f32>>,
-    /// Steps at which a push happened (a move or a miss), as indices into `manipulator`.
+    /// End-effector positions (board coordinates) before the first step and after every step.
+    pub path: Vec<[f64; 2]>,
+    /// Steps at which a push happened (a move or a miss), as indices into `path`.
     pub pushes: Vec<usize>,
 }
 
@@ -41,7 +40,7 @@ pub fn execute_skill(
     let mut run = SkillRun {
         steps: 0,
         outcome: StepOutcome::default(),
-        manipulator: vec![obs[..spec.manipulator_dim].to_vec()],
+        path: vec![env.end_effector()],
         pushes: Vec::new(),
     };
     let Some(limit) = spec.step_limit else {
@@ -54,7 +53,7 @@ pub fn execute_skill(
         run.outcome = env.step(&action)?;
         run.steps += 1;
         env.observe(&mut obs);
-        run.manipulator.push(obs[..spec.manipulator_dim].to_vec());
+        run.path.push(env.end_effector());
         if run.outcome.push != crate::Push::None {
             run.pushes.push(run.steps);
         }

@@ -190,6 +190,10 @@ impl Manipulator for Reacher {
         Ok(())
     }
 
+    fn end_effector(&self) -> [f64; 2] {
+        to_board(self.links().1)
+    }
+
     fn draw(&self, shapes: &mut Vec<Shape>, extent: &mut [f64; 4]) {
         let (elbow, tip) = self.links();
         let (base, elbow, tip) = (to_board([0.0, 0.0]), to_board(elbow), to_board(tip));

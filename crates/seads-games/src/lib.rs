@@ -16,6 +16,7 @@ mod enumerate;
 mod gf2;
 mod lightsout;
 mod split;
+mod successor;
 pub mod tables;
 mod tileswap;
 
@@ -25,6 +26,7 @@ pub use enumerate::{DepthTable, Enumerable, Enumeration, enumerate};
 pub use gf2::Gf2Solver;
 pub use lightsout::LightsOut;
 pub use split::{Split, board_string, split_of};
+pub use successor::{GameSuccessor, Successor};
 pub use tileswap::TileSwap;
 
 /// Identifier of a game move (SPEC §1: LightsOut `row·N + col`, TileSwap ids 0..11).

@@ -148,7 +148,8 @@ impl TrainConfig {
 
     /// Parses and validates a TOML configuration.
     pub fn from_toml(text: &str) -> Result<Self, RlError> {
-        let config: Self = toml::from_str(text).map_err(|e| RlError::Config(e.to_string()))?;
+        let config: Self =
+            toml::from_str(text).map_err(|e| RlError::Config(one_line_toml_error(text, &e)))?;
         config.validate()?;
         Ok(config)
     }
@@ -204,5 +205,19 @@ impl TrainConfig {
             }
         }
         Ok(())
+    }
+}
+
+/// A TOML error as one line: "line L, column C: message".
+fn one_line_toml_error(text: &str, e: &toml::de::Error) -> String {
+    let message = e.message().trim().replace('\n', " ");
+    match e.span() {
+        Some(span) => {
+            let before = &text[..span.start.min(text.len())];
+            let line = before.matches('\n').count() + 1;
+            let column = before.len() - before.rfind('\n').map_or(0, |i| i + 1) + 1;
+            format!("line {line}, column {column}: {message}")
+        }
+        None => message,
     }
 }

@@ -8,6 +8,7 @@
 //! choice comes from streams seeded by the run's seed (network initialisation included), never
 //! from libtorch's global generator.
 
+mod agent;
 mod config;
 mod episode;
 mod run;
@@ -16,11 +17,17 @@ mod trainer;
 
 use std::path::Path;
 
+pub use agent::{Agent, AgentPolicy};
 pub use config::{RelabelConfig, TrainConfig};
 pub use episode::{Episode, policy_input, run_episodes, skill_coverage};
 pub use run::{Metrics, Run, RunEvent, checkpoints, latest_checkpoint, load_config, read_metrics};
 pub use sac::{Sac, SacConfig, SacLosses, TransitionBatch};
 pub use trainer::{COVERAGE_SEED, EpochStats, Timings, Trainer};
+
+/// Sets the number of libtorch intra-op threads of the process.
+pub fn set_threads(n: usize) {
+    tch::set_num_threads(n as i32);
+}
 
 /// Errors of training and checkpoints.
 #[derive(Debug, thiserror::Error)]

@@ -6,11 +6,13 @@
 //! Architecture invariant: with `seads-rl`, the only crate that links libtorch. Rewards and
 //! relabelling are plain functions on slices, testable without a network.
 
+mod groundtruth;
 mod model;
 pub mod nn;
 mod relabel;
 mod reward;
 
+pub use groundtruth::{agreement_with_game, fit_to_game};
 pub use model::{
     ForwardModel, SkillDiscriminator, SkillModel, SkillModelConfig, SkillModelKind, SkillTransition,
 };

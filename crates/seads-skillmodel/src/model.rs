@@ -464,3 +464,75 @@ mod tests {
         assert!((ll[2] - 0.5f32.ln()).abs() < 1e-6);
     }
 }
+
+impl seads_games::Successor for ForwardModel {
+    fn num_skills(&self) -> usize {
+        self.k
+    }
+
+    fn symbolic_len(&self) -> usize {
+        self.d
+    }
+
+    /// The mode of q(· | z, k) for every state and skill (SPEC §4.1): bit d is 1 afterwards iff
+    /// α_d > 0.5, i.e. a 0 flips iff its flip logit is > 0 and a 1 flips iff it is ≥ 0.
+    fn successors(&mut self, states: &[SymbolicState], out: &mut Vec<SymbolicState>) {
+        if states.is_empty() {
+            return;
+        }
+        let flips = tch::no_grad(|| {
+            let z0 = states_tensor(states.iter().copied(), self.d, self.device);
+            let logits = self.flip_logits_all_skills(&z0); // n × K × D
+            let ones = z0.unsqueeze(1).gt(0.5);
+            let flip = logits
+                .gt(0.0)
+                .logical_or(&ones.logical_and(&logits.eq(0.0)));
+            Vec::<u8>::try_from(flip.to_kind(Kind::Uint8).view([-1]).to_device(Device::Cpu))
+                .expect("flip table")
+        });
+        out.reserve(states.len() * self.k);
+        for (i, &z) in states.iter().enumerate() {
+            for k in 0..self.k {
+                let row = &flips[(i * self.k + k) * self.d..(i * self.k + k + 1) * self.d];
+                let mut next = z;
+                for (d, &f) in row.iter().enumerate() {
+                    if f != 0 {
+                        next.flip(d);
+                    }
+                }
+                out.push(next);
+            }
+        }
+    }
+}
+
+#[cfg(test)]
+mod successor_tests {
+    use super::*;
+    use seads_games::Successor;
+
+    /// The batched successor agrees with the per-pair mode computed from `flip_logits`.
+    #[test]
+    fn successors_are_the_mode_of_the_model() {
+        let mut model = ForwardModel::new(25, 25, &SkillModelConfig::default(), Device::Cpu, 4);
+        let states: Vec<SymbolicState> = (0..7u64)
+            .map(|i| SymbolicState::from_u64(i * 0x15_4321 % (1 << 25)))
+            .collect();
+        let mut out = Vec::new();
+        model.successors(&states, &mut out);
+        assert_eq!(out.len(), 7 * 25);
+        for (i, &z) in states.iter().enumerate() {
+            for k in 0..25 {
+                let logits =
+                    Vec::<f32>::try_from(model.flip_logits(&[z], &[k]).view([-1])).unwrap();
+                let mut expected = z;
+                for (d, &x) in logits.iter().enumerate() {
+                    let p = 1.0 / (1.0 + (-x).exp());
+                    let alpha = if z.get(d) { 1.0 - p } else { p };
+                    expected.set(d, alpha > 0.5);
+                }
+                assert_eq!(out[i * 25 + k], expected, "state {i}, skill {k}");
+            }
+        }
+    }
+}

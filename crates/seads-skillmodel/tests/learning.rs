@@ -2,9 +2,7 @@
 
 use proptest::prelude::*;
 use seads_games::{BoardGame, LightsOut, SymbolicState, TileSwap};
-use seads_skillmodel::{
-    SkillModelConfig, SkillModelKind, SkillTransition, relabel_assignment,
-};
+use seads_skillmodel::{SkillModelConfig, SkillModelKind, SkillTransition, relabel_assignment};
 use tch::Device;
 
 /// Every permutation of 0..n (Heap's algorithm).
@@ -173,4 +171,18 @@ fn checkpoints_round_trip_and_bad_files_are_errors() {
     let mut wrong_shape = config.build(81, 12, Device::Cpu, 5);
     model.save(dir.path()).unwrap();
     assert!(wrong_shape.load(dir.path()).is_err());
+}
+
+/// A model fitted to the LightsOut move table predicts every successor exactly, so BFS on it
+/// finds the same shortest plans as on the real rules.
+#[test]
+fn fitted_model_reproduces_the_move_table() {
+    let game = LightsOut::new(5).unwrap();
+    let config = SkillModelConfig {
+        batch_size: 256,
+        ..SkillModelConfig::default()
+    };
+    let mut model = seads_skillmodel::fit_to_game(&game, &config, 600, 1);
+    let agreement = seads_skillmodel::agreement_with_game(&mut model, &game, 400, 2);
+    assert!(agreement > 0.999, "{agreement}");
 }

@@ -1,0 +1,92 @@
+//! `seads run`: the whole mission in one command on embedded defaults — train a small agent,
+//! evaluate it on test boards with and without re-planning, and write the figures.
+
+use std::path::PathBuf;
+
+use anyhow::{Context, Result};
+use clap::Args;
+use seads_games::Split;
+use seads_planner::summarise;
+use seads_rl::{Run, TrainConfig};
+
+use crate::BadInput;
+use crate::plan::{Tasks, run_evaluation};
+
+/// Arguments of `seads run`.
+#[derive(Debug, Args)]
+pub struct RunArgs {
+    /// Run directory (an existing one is resumed and re-evaluated).
+    #[arg(long, default_value = "runs/demo")]
+    out: PathBuf,
+    /// Environment (its preset supplies every other setting).
+    #[arg(long, default_value = "lightsout-cursor")]
+    env: String,
+    /// Training budget in environment steps (the paper's Cursor budget is 500000; skills appear
+    /// after a few ten thousand).
+    #[arg(long, default_value_t = 50_000)]
+    env_steps: u64,
+    /// Seed of the run.
+    #[arg(long, default_value_t = 1)]
+    seed: u64,
+    /// Boards per solution depth (1–5) in the evaluation.
+    #[arg(long, default_value_t = 20)]
+    boards: usize,
+}
+
+/// `seads run`.
+pub fn run(args: RunArgs) -> Result<()> {
+    let mut run = if args.out.join("config.toml").exists() {
+        println!("resuming the run in {}", args.out.display());
+        Run::resume(&args.out).with_context(|| format!("resuming {}", args.out.display()))?
+    } else {
+        let mut config = TrainConfig::preset(&args.env).map_err(|e| BadInput(e.into()))?;
+        config.env_steps = args.env_steps;
+        config.seed = args.seed;
+        println!(
+            "training SEADS on {} for {} environment steps into {}",
+            config.env,
+            config.env_steps,
+            args.out.display()
+        );
+        Run::create(&args.out, config)?
+    };
+    crate::train::drive(&mut run, false)?;
+    drop(run);
+
+    let mut agent = crate::plan::load_agent(&args.out, None)?;
+    let seeds = crate::plan::task_seeds(args.boards, None);
+    println!(
+        "\nsolving {} test boards per depth 1–5 by planning with the learned forward model:",
+        args.boards
+    );
+    println!(" depth   with re-planning   plan once   median steps (re-planning)");
+    let tasks = |replan| Tasks {
+        depths: (1..=5).collect(),
+        seeds: seeds.clone(),
+        split: Split::Test,
+        replan,
+        timeout: 60.0,
+    };
+    let replan = run_evaluation(&mut agent, &args.out, tasks(true), false)?;
+    let once = run_evaluation(&mut agent, &args.out, tasks(false), false)?;
+    let (a, b) = (summarise(&replan), summarise(&once));
+    for r in &replan {
+        let key = r.depth.to_string();
+        let steps = a.solution_steps[&key].map_or("-".to_owned(), |s| format!("{s:.0}"));
+        println!(
+            "{:>6}   {:>15.0}%   {:>8.0}%   {:>10}",
+            r.depth,
+            a.success_rate[&key] * 100.0,
+            b.success_rate[&key] * 100.0,
+            steps
+        );
+    }
+    let figures = args.out.join("figures");
+    let written = crate::plot::write_figures(&args.out, &figures, None, args.boards, 60.0, true)?;
+    println!("\nfigures ({}): {}", written.len(), figures.display());
+    println!(
+        "next: seads solve --run {} --board \"…\" --replan   (see seads --help)",
+        args.out.display()
+    );
+    Ok(())
+}

@@ -1,0 +1,439 @@
+//! `seads solve`, `seads evaluate`, `seads plan-bench`: planning with a trained agent.
+
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+use anyhow::{Context, Result, bail};
+use clap::Args;
+use indicatif::ProgressBar;
+use rand::{RngExt, SeedableRng};
+use rand_chacha::ChaCha8Rng;
+use seads_games::{BoardDataset, BoardGame, LightsOut, Split};
+use seads_planner::{
+    DepthResult, EVALUATION_SEEDS, Evaluation, PlannerConfig, SolveConfig, bfs_plan, evaluate,
+    solve, summarise,
+};
+use seads_rl::Agent;
+use seads_skillmodel::{SkillModelConfig, agreement_with_game, fit_to_game};
+use serde::Serialize;
+
+use crate::BadInput;
+use crate::envs::build_env;
+
+/// Loads the agent of a run, turning a missing or foreign directory into a clear error.
+pub fn load_agent(run: &Path, checkpoint: Option<u64>) -> Result<Agent> {
+    Agent::load(run, checkpoint)
+        .with_context(|| format!("loading the agent of run {}", run.display()))
+}
+
+/// Arguments of `seads solve`.
+#[derive(Debug, Args)]
+pub struct SolveArgs {
+    /// Run directory of a trained agent (from `seads train`).
+    #[arg(long)]
+    run: PathBuf,
+    /// The board to solve, comma-separated field values (see `seads games solve --help`).
+    #[arg(long)]
+    board: String,
+    /// Re-plan when the board deviates from the prediction (Algorithm 2); otherwise plan once.
+    #[arg(long)]
+    replan: bool,
+    /// Use the checkpoint of this epoch instead of the latest.
+    #[arg(long)]
+    checkpoint: Option<u64>,
+    /// Seed of the manipulator's initial state.
+    #[arg(long, default_value_t = 0)]
+    seed: u64,
+    /// Time limit per search, seconds.
+    #[arg(long, default_value_t = 300.0)]
+    timeout: f64,
+    /// Draw the board and the executed skills' paths into this image (.png or .svg).
+    #[arg(long)]
+    render: Option<PathBuf>,
+    /// Print JSON.
+    #[arg(long)]
+    json: bool,
+}
+
+/// `seads solve`.
+pub fn solve_board(args: SolveArgs) -> Result<()> {
+    let mut agent = load_agent(&args.run, args.checkpoint)?;
+    let mut env = build_env(&agent.config.env, &agent.config.env_config)?;
+    let game = env.spec().game.build(env.spec().board_size)?;
+    let board = game.parse(&args.board).map_err(|e| BadInput(e.into()))?;
+    env.seed(args.seed);
+    env.reset();
+    env.set_board(board).map_err(|e| BadInput(e.into()))?;
+    let before = env.scene();
+    let config = SolveConfig {
+        replan: args.replan,
+        planner: PlannerConfig {
+            timeout_s: Some(args.timeout),
+            ..PlannerConfig::default()
+        },
+        ..SolveConfig::default()
+    };
+    let (policy, model) = agent.parts()?;
+    let outcome = solve(env.as_mut(), policy, model, game.goal(), &config)?;
+    if let Some(out) = &args.render {
+        let status = if outcome.solved {
+            "solved"
+        } else {
+            "not solved"
+        };
+        let title = format!(
+            "{}: {} in {} steps",
+            agent.config.env, status, outcome.manipulator_steps
+        );
+        crate::draw::render_solution(&before, &outcome.runs, &title, out)?;
+    }
+    if args.json {
+        #[derive(Serialize)]
+        struct Report<'a> {
+            board: String,
+            checkpoint: String,
+            #[serde(flatten)]
+            outcome: &'a seads_planner::SolveOutcome,
+        }
+        let report = Report {
+            board: game.format(board),
+            checkpoint: agent.checkpoint.display().to_string(),
+            outcome: &outcome,
+        };
+        println!("{}", serde_json::to_string(&report)?);
+    } else {
+        let list = |v: &[usize]| {
+            v.iter()
+                .map(|s| s.to_string())
+                .collect::<Vec<_>>()
+                .join(" ")
+        };
+        if outcome.plan_found {
+            println!(
+                "plan ({} skills): {}   search {:.3} s over {} plan(s)",
+                outcome.first_plan.len(),
+                list(&outcome.first_plan),
+                outcome.planning_s,
+                outcome.plans
+            );
+        }
+        println!(
+            "executed skills: {}   manipulator steps per skill: {}",
+            list(&outcome.executed),
+            list(&outcome.skill_steps)
+        );
+        match &outcome.failure {
+            None => println!("solved in {} manipulator steps", outcome.manipulator_steps),
+            Some(why) => println!("not solved: {why}"),
+        }
+    }
+    Ok(())
+}
+
+/// Parses "1-5", "6,8,10" or "3".
+fn parse_depths(text: &str) -> Result<Vec<usize>> {
+    let bad = || {
+        BadInput(anyhow::anyhow!(
+            "--depths takes a range like 1-5 or a list like 1,3,5, got {text:?}"
+        ))
+    };
+    let depths: Vec<usize> = if let Some((a, b)) = text.split_once('-') {
+        let (a, b): (usize, usize) = (
+            a.trim().parse().map_err(|_| bad())?,
+            b.trim().parse().map_err(|_| bad())?,
+        );
+        (a..=b).collect()
+    } else {
+        text.split(',')
+            .map(|d| d.trim().parse().map_err(|_| bad()))
+            .collect::<Result<_, _>>()?
+    };
+    if depths.is_empty() || depths.contains(&0) {
+        return Err(bad().into());
+    }
+    Ok(depths)
+}
+
+/// Arguments of `seads evaluate`.
+#[derive(Debug, Args)]
+pub struct EvaluateArgs {
+    /// Run directory of a trained agent.
+    #[arg(long)]
+    run: PathBuf,
+    /// Solution depths of the boards: a range (1-5; 6-12 for the deep study) or a list.
+    #[arg(long, default_value = "1-5")]
+    depths: String,
+    /// Boards per depth.
+    #[arg(long, default_value_t = 20)]
+    boards: usize,
+    /// Board split.
+    #[arg(long, default_value = "test")]
+    split: Split,
+    /// Re-plan when the board deviates from the prediction (Algorithm 2).
+    #[arg(long)]
+    replan: bool,
+    /// Seed of the task list (default: the 20 seeds of the authors' evaluation).
+    #[arg(long)]
+    seed: Option<u64>,
+    /// Use the checkpoint of this epoch instead of the latest.
+    #[arg(long)]
+    checkpoint: Option<u64>,
+    /// Time limit per search, seconds (the authors' evaluation used 60).
+    #[arg(long, default_value_t = 60.0)]
+    timeout: f64,
+    /// Print JSON.
+    #[arg(long)]
+    json: bool,
+}
+
+/// Environment seeds of the tasks: the authors' 20 by default, else drawn from `seed`.
+pub fn task_seeds(boards: usize, seed: Option<u64>) -> Vec<u64> {
+    match seed {
+        None if boards <= EVALUATION_SEEDS.len() => EVALUATION_SEEDS[..boards].to_vec(),
+        _ => {
+            let mut rng = ChaCha8Rng::seed_from_u64(seed.unwrap_or(4343));
+            (0..boards)
+                .map(|_| rng.random_range(0..100_000_000))
+                .collect()
+        }
+    }
+}
+
+/// The tasks of an evaluation.
+pub struct Tasks {
+    /// Solution depths.
+    pub depths: Vec<usize>,
+    /// Environment seeds (one task per seed and depth).
+    pub seeds: Vec<u64>,
+    /// Board split.
+    pub split: Split,
+    /// Re-plan on deviations.
+    pub replan: bool,
+    /// Seconds per search.
+    pub timeout: f64,
+}
+
+/// Evaluates the agent and saves the per-depth results into the run directory
+/// (`evaluation-replan.json` or `evaluation-plan-once.json`).
+pub fn run_evaluation(
+    agent: &mut Agent,
+    run: &Path,
+    tasks: Tasks,
+    quiet: bool,
+) -> Result<Vec<DepthResult>> {
+    let Tasks {
+        depths,
+        seeds,
+        split,
+        replan,
+        timeout,
+    } = tasks;
+    let evaluation = Evaluation {
+        env: agent.config.env.clone(),
+        env_config: agent.config.env_config.clone(),
+        depths: depths.clone(),
+        seeds: seeds.clone(),
+        split,
+        solve: SolveConfig {
+            replan,
+            planner: PlannerConfig {
+                timeout_s: Some(timeout),
+                ..PlannerConfig::default()
+            },
+            ..SolveConfig::default()
+        },
+    };
+    let bar = if quiet {
+        ProgressBar::hidden()
+    } else {
+        ProgressBar::new((depths.len() * seeds.len()) as u64)
+    };
+    let (policy, model) = agent.parts()?;
+    let results = evaluate(&evaluation, policy, model, |depth, _| {
+        bar.set_message(format!("depth {depth}"));
+        bar.inc(1);
+    })
+    .map_err(|e| BadInput(e.into()))?;
+    bar.finish_and_clear();
+    let name = if replan {
+        "evaluation-replan.json"
+    } else {
+        "evaluation-plan-once.json"
+    };
+    let path = run.join(name);
+    let tmp = path.with_extension("tmp");
+    std::fs::write(&tmp, serde_json::to_string_pretty(&results)?)?;
+    std::fs::rename(&tmp, &path)?;
+    Ok(results)
+}
+
+/// `seads evaluate`.
+pub fn evaluate_run(args: EvaluateArgs) -> Result<()> {
+    let depths = parse_depths(&args.depths)?;
+    if args.boards == 0 {
+        bail!(BadInput(anyhow::anyhow!("--boards must be at least 1")));
+    }
+    let mut agent = load_agent(&args.run, args.checkpoint)?;
+    let seeds = task_seeds(args.boards, args.seed);
+    let tasks = Tasks {
+        depths,
+        seeds,
+        split: args.split,
+        replan: args.replan,
+        timeout: args.timeout,
+    };
+    let results = run_evaluation(&mut agent, &args.run, tasks, args.json)?;
+    let summary = summarise(&results);
+    if args.json {
+        println!("{}", serde_json::to_string(&summary)?);
+    } else {
+        println!(
+            "{} (epoch {}), {}, {} boards per depth",
+            agent.config.env,
+            agent.epoch,
+            if args.replan {
+                "with re-planning"
+            } else {
+                "plan once"
+            },
+            args.boards
+        );
+        println!(" depth  success  plan found  search s  median steps  median skill steps");
+        for r in &results {
+            let key = r.depth.to_string();
+            let fmt = |v: Option<f64>| v.map_or("-".to_owned(), |x| format!("{x:.1}"));
+            println!(
+                "{:>6}  {:>6.0}%  {:>9.0}%  {:>8.3}  {:>12}  {:>18}",
+                r.depth,
+                summary.success_rate[&key] * 100.0,
+                summary.plan_found[&key] * 100.0,
+                summary.planning_s[&key],
+                fmt(summary.solution_steps[&key]),
+                fmt(summary.skill_steps[&key])
+            );
+        }
+    }
+    Ok(())
+}
+
+/// Arguments of `seads plan-bench`.
+#[derive(Debug, Args)]
+pub struct PlanBenchArgs {
+    /// Hidden layer sizes of the forward model (the paper's: 256,256).
+    #[arg(long, default_value = "256,256", value_delimiter = ',')]
+    hidden: Vec<i64>,
+    /// Solution depths of the benchmark boards.
+    #[arg(long, default_value = "5,7,9", value_delimiter = ',')]
+    depths: Vec<usize>,
+    /// Boards per depth (test split).
+    #[arg(long, default_value_t = 3)]
+    boards: usize,
+    /// libtorch threads (1: the one-core figure).
+    #[arg(long, default_value_t = 1)]
+    threads: usize,
+    /// Print JSON.
+    #[arg(long)]
+    json: bool,
+}
+
+#[derive(Serialize)]
+struct PlanBenchReport {
+    hidden: Vec<i64>,
+    model_agreement: f64,
+    depths: Vec<PlanBenchDepth>,
+    peak_rss_mib: f64,
+}
+
+#[derive(Serialize)]
+struct PlanBenchDepth {
+    depth: usize,
+    seconds: Vec<f64>,
+    mean_s: f64,
+    plan_lengths: Vec<usize>,
+    expanded: Vec<usize>,
+}
+
+/// Peak resident memory of this process (Linux `VmHWM`), MiB.
+fn peak_rss_mib() -> f64 {
+    std::fs::read_to_string("/proc/self/status")
+        .ok()
+        .and_then(|s| {
+            s.lines()
+                .find(|l| l.starts_with("VmHWM:"))
+                .and_then(|l| l.split_whitespace().nth(1)?.parse::<f64>().ok())
+        })
+        .map_or(f64::NAN, |kib| kib / 1024.0)
+}
+
+/// `seads plan-bench`: BFS with a forward model fitted to the LightsOut 5×5 move table.
+pub fn plan_bench(args: PlanBenchArgs) -> Result<()> {
+    if args.hidden.is_empty()
+        || args.hidden.iter().any(|&h| h <= 0)
+        || args.depths.contains(&0)
+        || args.boards == 0
+    {
+        bail!(BadInput(anyhow::anyhow!(
+            "--hidden, --depths and --boards must be positive"
+        )));
+    }
+    seads_rl::set_threads(args.threads.max(1));
+    let game = LightsOut::new(5)?;
+    let config = SkillModelConfig {
+        hidden: args.hidden.clone(),
+        batch_size: 256,
+        ..SkillModelConfig::default()
+    };
+    let mut model = fit_to_game(&game, &config, 1500, 1);
+    let agreement = agreement_with_game(&mut model, &game, 2000, 2);
+    let max_depth = *args.depths.iter().max().expect("non-empty");
+    let boards = BoardDataset::build(&game, max_depth)?;
+    let mut rng = ChaCha8Rng::seed_from_u64(7);
+    let mut report = PlanBenchReport {
+        hidden: args.hidden.clone(),
+        model_agreement: agreement,
+        depths: Vec::new(),
+        peak_rss_mib: 0.0,
+    };
+    for &depth in &args.depths {
+        let mut row = PlanBenchDepth {
+            depth,
+            seconds: Vec::new(),
+            mean_s: 0.0,
+            plan_lengths: Vec::new(),
+            expanded: Vec::new(),
+        };
+        for _ in 0..args.boards {
+            let board = boards
+                .sample(depth, Split::Test, &mut rng)
+                .context("no board of that depth")?;
+            let start = Instant::now();
+            let plan = bfs_plan(&mut model, board, game.goal(), &PlannerConfig::default());
+            row.seconds.push(start.elapsed().as_secs_f64());
+            match plan {
+                Ok(plan) => {
+                    row.plan_lengths.push(plan.skills.len());
+                    row.expanded.push(plan.expanded);
+                }
+                Err(e) => bail!("depth {depth}: {e}"),
+            }
+        }
+        row.mean_s = row.seconds.iter().sum::<f64>() / row.seconds.len() as f64;
+        if !args.json {
+            println!(
+                "depth {depth}: mean {:.3} s per plan over {} boards (plan lengths {:?})",
+                row.mean_s, args.boards, row.plan_lengths
+            );
+        }
+        report.depths.push(row);
+    }
+    report.peak_rss_mib = peak_rss_mib();
+    if args.json {
+        println!("{}", serde_json::to_string(&report)?);
+    } else {
+        println!(
+            "model hidden {:?}, agreement with the move table {:.5}, peak memory {:.0} MiB",
+            args.hidden, agreement, report.peak_rss_mib
+        );
+    }
+    Ok(())
+}

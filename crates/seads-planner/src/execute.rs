@@ -1,0 +1,154 @@
+//! Executing plans with the skill policy: Algorithm 1 (plan once) and Algorithm 2 (re-plan
+//! when the observed symbolic state differs from the prediction), SPEC §4.3.
+
+use std::time::Instant;
+
+use seads_embodiment::{EnvError, Environment, SkillPolicy, SkillRun, execute_skill};
+use seads_games::{Successor, SymbolicState};
+use serde::{Deserialize, Serialize};
+
+use crate::{PlanError, PlannerConfig, bfs_plan};
+
+/// How a task is solved. `Default` = with re-planning, at most 10 plans (the reference).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct SolveConfig {
+    /// Re-plan when the board deviates from the prediction (Algorithm 2).
+    pub replan: bool,
+    /// Most plans (searches) per task with re-planning.
+    pub max_plans: usize,
+    /// Search limits.
+    pub planner: PlannerConfig,
+}
+
+impl Default for SolveConfig {
+    fn default() -> Self {
+        Self {
+            replan: true,
+            max_plans: 10,
+            planner: PlannerConfig::default(),
+        }
+    }
+}
+
+/// What happened while solving one task.
+#[derive(Debug, Clone, Serialize)]
+pub struct SolveOutcome {
+    /// The board reached the goal.
+    pub solved: bool,
+    /// The first search found a plan.
+    pub plan_found: bool,
+    /// The first plan.
+    pub first_plan: Vec<usize>,
+    /// Searches run.
+    pub plans: usize,
+    /// Skills executed, in order.
+    pub executed: Vec<usize>,
+    /// Manipulator steps of every executed skill.
+    pub skill_steps: Vec<usize>,
+    /// Total manipulator steps.
+    pub manipulator_steps: usize,
+    /// Seconds spent searching.
+    pub planning_s: f64,
+    /// Why the task failed, if it did.
+    pub failure: Option<String>,
+    /// What each executed skill did (manipulator path and pushes), for figures.
+    #[serde(skip)]
+    pub runs: Vec<SkillRun>,
+}
+
+/// Solves the task in `env` (its current board towards `goal`) with `policy`, planning with
+/// `successor`.
+pub fn solve(
+    env: &mut dyn Environment,
+    policy: &dyn SkillPolicy,
+    successor: &mut dyn Successor,
+    goal: SymbolicState,
+    config: &SolveConfig,
+) -> Result<SolveOutcome, EnvError> {
+    let mut outcome = SolveOutcome {
+        solved: false,
+        plan_found: false,
+        first_plan: Vec::new(),
+        plans: 0,
+        executed: Vec::new(),
+        skill_steps: Vec::new(),
+        manipulator_steps: 0,
+        planning_s: 0.0,
+        failure: None,
+        runs: Vec::new(),
+    };
+    let mut plan = match search(env.board(), successor, goal, config, &mut outcome) {
+        Ok(plan) => plan,
+        Err(e) => {
+            outcome.failure = Some(e.to_string());
+            return Ok(outcome);
+        }
+    };
+    outcome.plan_found = true;
+    outcome.first_plan = plan.skills.clone();
+    if !config.replan {
+        // Algorithm 1: execute the whole plan; only the final board counts.
+        for &skill in &plan.skills {
+            run(env, policy, skill, &mut outcome)?;
+        }
+        outcome.solved = env.board() == goal;
+        if !outcome.solved {
+            outcome.failure = Some("the board differs from the goal after the plan".into());
+        }
+        return Ok(outcome);
+    }
+    // Algorithm 2: execute skill by skill, re-planning on a deviation from the prediction.
+    let mut step = 0;
+    loop {
+        run(env, policy, plan.skills[step], &mut outcome)?;
+        let board = env.board();
+        if board == goal {
+            outcome.solved = true;
+            return Ok(outcome);
+        }
+        step += 1;
+        if board != plan.predicted[step - 1] || step == plan.skills.len() {
+            if outcome.plans >= config.max_plans {
+                outcome.failure = Some(format!("not solved after {} plans", outcome.plans));
+                return Ok(outcome);
+            }
+            plan = match search(board, successor, goal, config, &mut outcome) {
+                Ok(plan) => plan,
+                Err(e) => {
+                    outcome.failure = Some(e.to_string());
+                    return Ok(outcome);
+                }
+            };
+            step = 0;
+        }
+    }
+}
+
+fn search(
+    start: SymbolicState,
+    successor: &mut dyn Successor,
+    goal: SymbolicState,
+    config: &SolveConfig,
+    outcome: &mut SolveOutcome,
+) -> Result<crate::Plan, PlanError> {
+    let began = Instant::now();
+    outcome.plans += 1;
+    let plan = bfs_plan(successor, start, goal, &config.planner);
+    outcome.planning_s += began.elapsed().as_secs_f64();
+    plan
+}
+
+fn run(
+    env: &mut dyn Environment,
+    policy: &dyn SkillPolicy,
+    skill: usize,
+    outcome: &mut SolveOutcome,
+) -> Result<(), EnvError> {
+    let r = execute_skill(env, policy, skill)?;
+    outcome.executed.push(skill);
+    outcome.skill_steps.push(r.steps);
+    outcome.manipulator_steps += r.steps;
+    outcome.runs.push(r);
+    Ok(())
+}

@@ -1,0 +1,297 @@
+//! The planner against brute force on the ground-truth games, its limits, and plan execution
+//! with and without re-planning.
+
+use proptest::prelude::*;
+use rand::{RngExt, SeedableRng};
+use seads_embodiment::{EnvConfig, Environment, SkillPolicy, make_env};
+use seads_games::{
+    BoardGame, DepthTable, GameSuccessor, Gf2Solver, LightsOut, Split, Successor, SymbolicState,
+    TileSwap,
+};
+use seads_planner::{
+    Evaluation, PlanError, PlannerConfig, SolveConfig, bfs_plan, evaluate, solve, summarise,
+};
+use std::sync::LazyLock;
+
+static LIGHTSOUT: LazyLock<LightsOut> = LazyLock::new(|| LightsOut::new(5).unwrap());
+static TILESWAP_DEPTHS: LazyLock<DepthTable> =
+    LazyLock::new(|| DepthTable::build(&TileSwap::new()).unwrap());
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(24))]
+
+    /// On the real rules, BFS finds a shortest plan (length = the GF(2) / table depth) that
+    /// reaches the goal, and predicts every intermediate state correctly.
+    #[test]
+    fn plans_on_the_ground_truth_are_optimal(moves in proptest::collection::vec(0usize..25, 1..7), swaps in proptest::collection::vec(0usize..12, 1..8)) {
+        let lo = &*LIGHTSOUT;
+        let board = lo.apply_all(lo.goal(), &moves);
+        let depth = Gf2Solver::new(lo).depth(board).unwrap();
+        prop_assume!(depth > 0);
+        let plan = bfs_plan(&mut GameSuccessor::new(lo), board, lo.goal(), &PlannerConfig::default()).unwrap();
+        prop_assert_eq!(plan.skills.len(), depth);
+        prop_assert!(lo.is_goal(lo.apply_all(board, &plan.skills)));
+        let ts = TileSwap::new();
+        let board = ts.apply_all(ts.goal(), &swaps);
+        let depth = TILESWAP_DEPTHS.depth(&ts, board).unwrap() as usize;
+        prop_assume!(depth > 0);
+        let plan = bfs_plan(&mut GameSuccessor::new(&ts), board, ts.goal(), &PlannerConfig::default()).unwrap();
+        prop_assert_eq!(plan.skills.len(), depth);
+        let mut z = board;
+        for (&skill, &predicted) in plan.skills.iter().zip(&plan.predicted) {
+            z = ts.apply(z, skill);
+            prop_assert_eq!(z, predicted);
+        }
+        prop_assert!(ts.is_goal(z));
+    }
+}
+
+/// Only the first `k` skills of a game: some boards become unreachable.
+struct FirstSkills<'a>(GameSuccessor<'a>, usize);
+
+impl Successor for FirstSkills<'_> {
+    fn num_skills(&self) -> usize {
+        self.1
+    }
+    fn symbolic_len(&self) -> usize {
+        self.0.symbolic_len()
+    }
+    fn successors(&mut self, states: &[SymbolicState], out: &mut Vec<SymbolicState>) {
+        let mut all = Vec::new();
+        self.0.successors(states, &mut all);
+        let k = self.0.num_skills();
+        for row in all.chunks(k) {
+            out.extend_from_slice(&row[..self.1]);
+        }
+    }
+}
+
+#[test]
+fn limits_end_the_search_with_a_reason() {
+    let lo = &*LIGHTSOUT;
+    let board = lo.apply_all(lo.goal(), &[24]);
+    // With skills 0..3 only, pressing field 24 cannot be undone: the 8 reachable states run out.
+    let err = bfs_plan(
+        &mut FirstSkills(GameSuccessor::new(lo), 3),
+        board,
+        lo.goal(),
+        &PlannerConfig::default(),
+    )
+    .unwrap_err();
+    assert_eq!(
+        err,
+        PlanError::NotFound {
+            layers: 20,
+            discovered: 8
+        }
+    );
+    let deep = lo.apply_all(lo.goal(), &[0, 3, 7, 12, 18, 21, 24]);
+    let tight = PlannerConfig {
+        max_layers: 6,
+        ..PlannerConfig::default()
+    };
+    assert!(matches!(
+        bfs_plan(&mut GameSuccessor::new(lo), deep, lo.goal(), &tight),
+        Err(PlanError::NotFound { layers: 6, .. })
+    ));
+    let tiny = PlannerConfig {
+        memory_limit_mib: 1,
+        ..PlannerConfig::default()
+    };
+    assert!(matches!(
+        bfs_plan(&mut GameSuccessor::new(lo), deep, lo.goal(), &tiny),
+        Err(PlanError::MemoryLimit { limit_mib: 1, .. })
+    ));
+    let hasty = PlannerConfig {
+        timeout_s: Some(0.0),
+        ..PlannerConfig::default()
+    };
+    assert!(matches!(
+        bfs_plan(&mut GameSuccessor::new(lo), deep, lo.goal(), &hasty),
+        Err(PlanError::Timeout { .. })
+    ));
+}
+
+#[test]
+fn goal_test_at_generation_prefers_the_first_skill() {
+    // Board = move 3: skill 3 solves it in one step, found before any other candidate.
+    let lo = &*LIGHTSOUT;
+    let plan = bfs_plan(
+        &mut GameSuccessor::new(lo),
+        lo.apply(lo.goal(), 3),
+        lo.goal(),
+        &PlannerConfig::default(),
+    )
+    .unwrap();
+    assert_eq!(plan.skills, vec![3]);
+    assert_eq!(plan.expanded, 1);
+}
+
+/// A scripted Cursor policy: skill k moves straight to field k's centre and pushes on arrival.
+/// `slip` makes one skill press the neighbouring field the first time it is used (a transient
+/// failure, as a learned skill sometimes has).
+struct CursorPolicy {
+    targets: Vec<[f32; 2]>,
+    slip: Option<usize>,
+    slipped: std::cell::Cell<bool>,
+}
+
+impl CursorPolicy {
+    fn lightsout(slip: Option<usize>) -> Self {
+        let targets = (0..25)
+            .map(|m| [(m % 5) as f32 * 0.2 + 0.1, (m / 5) as f32 * 0.2 + 0.1])
+            .collect();
+        Self {
+            targets,
+            slip,
+            slipped: std::cell::Cell::new(false),
+        }
+    }
+}
+
+impl SkillPolicy for CursorPolicy {
+    fn num_skills(&self) -> usize {
+        self.targets.len()
+    }
+    fn act(&self, observations: &[f32], skills: &[usize], actions: &mut [f32]) {
+        let width = observations.len() / skills.len();
+        for ((obs, &k), act) in observations
+            .chunks(width)
+            .zip(skills)
+            .zip(actions.chunks_mut(3))
+        {
+            let slipping = self.slip == Some(k) && !self.slipped.get();
+            let target = if slipping {
+                self.targets[(k + 1) % 25]
+            } else {
+                self.targets[k]
+            };
+            let d = [target[0] - obs[0], target[1] - obs[1]];
+            let arrive = d[0].abs() <= 0.2 && d[1].abs() <= 0.2;
+            if slipping && arrive {
+                self.slipped.set(true);
+            }
+            act.copy_from_slice(&[
+                d[0].clamp(-0.2, 0.2),
+                d[1].clamp(-0.2, 0.2),
+                if arrive { 1.0 } else { -1.0 },
+            ]);
+        }
+    }
+}
+
+fn test_env(depth: usize, seed: u64) -> Box<dyn Environment> {
+    let config = EnvConfig {
+        reset_split: Split::Test,
+        max_solution_depth: depth,
+        random_solution_depth: false,
+        ..EnvConfig::default()
+    };
+    let mut env = make_env("lightsout-cursor", &config).unwrap();
+    env.seed(seed);
+    env.reset();
+    env
+}
+
+#[test]
+fn a_perfect_policy_solves_with_and_without_replanning() {
+    let lo = &*LIGHTSOUT;
+    for replan in [false, true] {
+        for seed in 0..5 {
+            let mut env = test_env(5, seed);
+            let config = SolveConfig {
+                replan,
+                ..SolveConfig::default()
+            };
+            let out = solve(
+                env.as_mut(),
+                &CursorPolicy::lightsout(None),
+                &mut GameSuccessor::new(lo),
+                lo.goal(),
+                &config,
+            )
+            .unwrap();
+            assert!(out.solved && out.plan_found && out.plans == 1, "{out:?}");
+            assert_eq!(out.executed.len(), 5);
+            assert_eq!(out.manipulator_steps, out.skill_steps.iter().sum::<usize>());
+            assert!(lo.is_goal(env.board()));
+        }
+    }
+}
+
+#[test]
+fn replanning_recovers_from_a_slip() {
+    let lo = &*LIGHTSOUT;
+    // Skill 12 presses field 13 the first time. Find tasks whose plan uses skill 12.
+    let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(3);
+    let (mut without, mut with) = (0, 0);
+    let mut tasks = 0;
+    while tasks < 10 {
+        let seed = rng.random_range(0..1_000_000);
+        let probe = bfs_plan(
+            &mut GameSuccessor::new(lo),
+            test_env(4, seed).board(),
+            lo.goal(),
+            &PlannerConfig::default(),
+        )
+        .unwrap();
+        if !probe.skills.contains(&12) {
+            continue;
+        }
+        tasks += 1;
+        for (replan, count) in [(false, &mut without), (true, &mut with)] {
+            let mut env = test_env(4, seed);
+            let config = SolveConfig {
+                replan,
+                ..SolveConfig::default()
+            };
+            let out = solve(
+                env.as_mut(),
+                &CursorPolicy::lightsout(Some(12)),
+                &mut GameSuccessor::new(lo),
+                lo.goal(),
+                &config,
+            )
+            .unwrap();
+            *count += out.solved as usize;
+            if replan && out.solved {
+                assert!(out.plans > 1, "a deviation triggers a new plan");
+            }
+        }
+    }
+    assert_eq!(without, 0, "plan once: the slip is never corrected");
+    assert_eq!(with, 10, "re-planning corrects the slip");
+}
+
+#[test]
+fn evaluation_protocol_reports_per_depth() {
+    let lo = &*LIGHTSOUT;
+    let evaluation = Evaluation {
+        env: "lightsout-cursor".into(),
+        env_config: EnvConfig::default(),
+        depths: vec![1, 3],
+        seeds: vec![1, 2, 3, 4],
+        split: Split::Test,
+        solve: SolveConfig::default(),
+    };
+    let mut calls = 0;
+    let results = evaluate(
+        &evaluation,
+        &CursorPolicy::lightsout(None),
+        &mut GameSuccessor::new(lo),
+        |_, _| calls += 1,
+    )
+    .unwrap();
+    assert_eq!(calls, 8);
+    assert_eq!(
+        results
+            .iter()
+            .map(|r| (r.depth, r.tasks, r.solved))
+            .collect::<Vec<_>>(),
+        vec![(1, 4, 4), (3, 4, 4)]
+    );
+    let summary = summarise(&results);
+    assert_eq!(summary.success_rate["3"], 1.0);
+    assert_eq!(summary.plan_found["1"], 1.0);
+    assert!(summary.solution_steps["3"].unwrap() >= 3.0);
+}

@@ -1,0 +1,123 @@
+//! A trained agent loaded from a run directory: the skill policy (for executing skills) and the
+//! forward model (for planning).
+
+use std::path::{Path, PathBuf};
+
+use seads_embodiment::{EnvSpec, SkillPolicy, make_env};
+use seads_skillmodel::{ForwardModel, SkillModel, SkillModelKind};
+use tch::Device;
+
+use crate::{RlError, Sac, TrainConfig, checkpoints, latest_checkpoint, load_config, policy_input};
+
+/// The skill policy π(a | s, k) of a trained agent, executed deterministically.
+pub struct AgentPolicy {
+    sac: Sac,
+    k: usize,
+}
+
+impl SkillPolicy for AgentPolicy {
+    fn num_skills(&self) -> usize {
+        self.k
+    }
+
+    fn act(&self, observations: &[f32], skills: &[usize], actions: &mut [f32]) {
+        let obs_dim = observations.len() / skills.len();
+        let width = obs_dim + self.k;
+        let mut inputs = vec![0.0; skills.len() * width];
+        for ((obs, &k), row) in observations
+            .chunks(obs_dim)
+            .zip(skills)
+            .zip(inputs.chunks_mut(width))
+        {
+            policy_input(obs, k, row);
+        }
+        actions.copy_from_slice(&self.sac.act(&inputs, None));
+    }
+}
+
+/// A trained SEADS agent.
+pub struct Agent {
+    /// The run's configuration.
+    pub config: TrainConfig,
+    /// The environment's dimensions.
+    pub spec: EnvSpec,
+    /// The checkpoint loaded.
+    pub checkpoint: PathBuf,
+    /// Epoch of the checkpoint.
+    pub epoch: u64,
+    /// The skill policy.
+    pub policy: AgentPolicy,
+    /// The forward model (`None` for a VIC agent, which cannot plan).
+    pub model: Option<ForwardModel>,
+}
+
+impl Agent {
+    /// Loads the latest checkpoint of the run in `dir`, or the one of epoch `epoch`.
+    pub fn load(dir: &Path, epoch: Option<u64>) -> Result<Self, RlError> {
+        let config = load_config(dir)?;
+        let checkpoint = match epoch {
+            Some(e) => checkpoints(dir)?
+                .into_iter()
+                .find(|(ce, _)| *ce == e)
+                .map(|(_, p)| p)
+                .ok_or_else(|| RlError::Checkpoint {
+                    path: dir.display().to_string(),
+                    reason: format!("no checkpoint of epoch {e}"),
+                })?,
+            None => latest_checkpoint(dir)?.ok_or_else(|| RlError::Checkpoint {
+                path: dir.display().to_string(),
+                reason: "the run has no checkpoint yet".into(),
+            })?,
+        };
+        Self::load_checkpoint(config, &checkpoint)
+    }
+
+    /// Loads the agent saved in `checkpoint` by a run with `config`.
+    pub fn load_checkpoint(config: TrainConfig, checkpoint: &Path) -> Result<Self, RlError> {
+        let spec = make_env(&config.env, &config.env_config)?.spec().clone();
+        let k = config.num_skills.unwrap_or(spec.num_skills);
+        let mut sac = Sac::new(
+            spec.obs_dim + k,
+            &spec.action_low,
+            &spec.action_high,
+            &config.sac,
+            Device::Cpu,
+            0,
+        );
+        sac.load(checkpoint, true)?;
+        let model = match config.skill_model.kind {
+            SkillModelKind::Forward => {
+                let mut model =
+                    ForwardModel::new(spec.symbolic_len, k, &config.skill_model, Device::Cpu, 0);
+                model.load(checkpoint)?;
+                Some(model)
+            }
+            SkillModelKind::Vic => None,
+        };
+        let epoch = checkpoint
+            .file_name()
+            .and_then(|n| n.to_str())
+            .and_then(|n| n.strip_prefix("epoch-"))
+            .and_then(|n| n.parse().ok())
+            .unwrap_or(0);
+        Ok(Self {
+            config,
+            spec,
+            checkpoint: checkpoint.to_path_buf(),
+            epoch,
+            policy: AgentPolicy { sac, k },
+            model,
+        })
+    }
+
+    /// The policy and the forward model, borrowed together (planning executes with one and
+    /// searches with the other). Errors for a VIC agent.
+    pub fn parts(&mut self) -> Result<(&AgentPolicy, &mut ForwardModel), RlError> {
+        match &mut self.model {
+            Some(model) => Ok((&self.policy, model)),
+            None => Err(RlError::Config(
+                "this agent learned a VIC skill discriminator, which cannot plan".into(),
+            )),
+        }
+    }
+}

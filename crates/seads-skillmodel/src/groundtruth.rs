@@ -1,0 +1,80 @@
+//! Forward models fitted to a game's true move table (skill k = move k): the planner's benches
+//! and tests need a learned model whose mode is known.
+
+use rand::seq::SliceRandom;
+use rand::{RngExt, SeedableRng};
+use rand_chacha::ChaCha8Rng;
+use seads_games::{BoardGame, GameKind, Successor, SymbolicState};
+use tch::Device;
+
+use crate::{ForwardModel, SkillModel, SkillModelConfig, SkillTransition};
+
+/// A uniformly random board of `game` (LightsOut: any bits, TileSwap: any permutation).
+fn random_board(game: &dyn BoardGame, rng: &mut ChaCha8Rng) -> SymbolicState {
+    match game.kind() {
+        GameKind::LightsOut => {
+            let mut z = SymbolicState::ZERO;
+            for d in 0..game.symbolic_len() {
+                z.set(d, rng.random::<bool>());
+            }
+            z
+        }
+        GameKind::TileSwap => {
+            let mut tiles: Vec<u8> = (0..9).collect();
+            tiles.shuffle(rng);
+            game.board_from_values(&tiles).expect("a permutation")
+        }
+    }
+}
+
+/// Fits a forward model to `game`'s moves from `steps` batches of random boards and moves.
+pub fn fit_to_game(
+    game: &dyn BoardGame,
+    config: &SkillModelConfig,
+    steps: usize,
+    seed: u64,
+) -> ForwardModel {
+    let mut rng = ChaCha8Rng::seed_from_u64(seed);
+    let mut model = ForwardModel::new(
+        game.symbolic_len(),
+        game.num_moves(),
+        config,
+        Device::Cpu,
+        seed,
+    );
+    for _ in 0..steps {
+        let batch: Vec<SkillTransition> = (0..config.batch_size)
+            .map(|_| {
+                let z0 = random_board(game, &mut rng);
+                let skill = rng.random_range(0..game.num_moves());
+                SkillTransition {
+                    z0,
+                    skill,
+                    zt: game.apply(z0, skill),
+                }
+            })
+            .collect();
+        model.train_step(&batch);
+    }
+    model
+}
+
+/// Fraction of (random board, move) pairs whose predicted successor is exactly the true one.
+pub fn agreement_with_game(
+    model: &mut ForwardModel,
+    game: &dyn BoardGame,
+    boards: usize,
+    seed: u64,
+) -> f64 {
+    let mut rng = ChaCha8Rng::seed_from_u64(seed);
+    let states: Vec<SymbolicState> = (0..boards).map(|_| random_board(game, &mut rng)).collect();
+    let mut out = Vec::new();
+    model.successors(&states, &mut out);
+    let k = game.num_moves();
+    let correct = out
+        .iter()
+        .enumerate()
+        .filter(|&(i, &next)| next == game.apply(states[i / k], i % k))
+        .count();
+    correct as f64 / out.len() as f64
+}
