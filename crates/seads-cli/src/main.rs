@@ -4,6 +4,7 @@
 mod demo;
 mod draw;
 mod envs;
+mod episodes;
 mod games;
 mod plan;
 mod plot;
@@ -49,6 +50,10 @@ enum Command {
     Plot(plot::PlotArgs),
     /// Planner speed: BFS with a forward model fitted to the LightsOut move table.
     PlanBench(plan::PlanBenchArgs),
+    /// Record episodes (random actions or a trained agent) as JSON Lines.
+    Record(episodes::RecordArgs),
+    /// Replay recorded episodes exactly and recompute their observations and moves.
+    Replay(episodes::ReplayArgs),
 }
 
 /// Input the user gave that cannot be used (exit code 2, like a usage error).
@@ -85,6 +90,8 @@ fn main() -> ExitCode {
         Command::Evaluate(args) => plan::evaluate_run(args),
         Command::Plot(args) => plot::plot(args),
         Command::PlanBench(args) => plan::plan_bench(args),
+        Command::Record(args) => episodes::record(args),
+        Command::Replay(args) => episodes::replay(args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

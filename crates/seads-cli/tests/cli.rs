@@ -499,3 +499,152 @@ fn planning_commands_reject_bad_input() {
     assert_eq!(missing.status.code(), Some(1));
     assert!(String::from_utf8_lossy(&missing.stderr).contains("loading the agent"));
 }
+
+#[test]
+fn record_and_replay_round_trip() {
+    let dir = tempfile::tempdir().unwrap();
+    for env in ["tileswap-cursor", "lightsout-reacher"] {
+        let rec = dir.path().join(format!("{env}.jsonl"));
+        let re = dir.path().join(format!("{env}.re.jsonl"));
+        let out = seads(&[
+            "record",
+            "--env",
+            env,
+            "--episodes",
+            "2",
+            "--steps",
+            "50",
+            "--seed",
+            "4",
+            "--out",
+            rec.to_str().unwrap(),
+        ]);
+        assert!(
+            out.status.success(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        let out = seads(&[
+            "replay",
+            "--env",
+            env,
+            "--input",
+            rec.to_str().unwrap(),
+            "--out",
+            re.to_str().unwrap(),
+            "--compare",
+        ]);
+        assert!(
+            out.status.success(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        assert!(String::from_utf8_lossy(&out.stdout).contains("0 board and 0 move mismatches"));
+        assert_eq!(
+            std::fs::read_to_string(&rec).unwrap(),
+            std::fs::read_to_string(&re).unwrap()
+        );
+        let first: serde_json::Value = serde_json::from_str(
+            std::fs::read_to_string(&rec)
+                .unwrap()
+                .lines()
+                .next()
+                .unwrap(),
+        )
+        .unwrap();
+        assert_eq!(first["steps"].as_array().unwrap().len(), 50);
+        assert!(first["steps"][0].get("move").is_some());
+    }
+}
+
+#[test]
+fn replay_reports_bad_lines_with_their_number() {
+    let dir = tempfile::tempdir().unwrap();
+    let good = dir.path().join("good.jsonl");
+    let out = seads(&[
+        "record",
+        "--env",
+        "lightsout-cursor",
+        "--episodes",
+        "1",
+        "--steps",
+        "3",
+        "--out",
+        good.to_str().unwrap(),
+    ]);
+    assert!(out.status.success());
+    let line = std::fs::read_to_string(&good).unwrap();
+    let line = line.trim();
+    let out_file = dir.path().join("out.jsonl");
+    let cases = [
+        (format!("{line}\n{{not json\n"), ":2: not an episode"),
+        (
+            format!(
+                "{line}\n\n{}\n",
+                line.replace("\"initial_obs\":[", "\"initial_obs\":[0.5,")
+            ),
+            ":3: initial_obs has 28 values",
+        ),
+        (
+            line.replace("lightsout-cursor", "tileswap-cursor"),
+            ":1: the episode is of environment \"tileswap-cursor\"",
+        ),
+    ];
+    for (content, needle) in cases {
+        let input = dir.path().join("bad.jsonl");
+        std::fs::write(&input, content).unwrap();
+        check_bad_input(
+            &[
+                "replay",
+                "--env",
+                "lightsout-cursor",
+                "--input",
+                input.to_str().unwrap(),
+                "--out",
+                out_file.to_str().unwrap(),
+            ],
+            needle,
+        );
+    }
+    check_bad_input(
+        &[
+            "replay",
+            "--env",
+            "chess-robot",
+            "--input",
+            good.to_str().unwrap(),
+            "--out",
+            out_file.to_str().unwrap(),
+        ],
+        "valid environments",
+    );
+    let jaco = dir.path().join("jaco.jsonl");
+    let out = seads(&[
+        "record",
+        "--env",
+        "lightsout-jaco",
+        "--episodes",
+        "1",
+        "--steps",
+        "1",
+        "--out",
+        jaco.to_str().unwrap(),
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    check_bad_input(
+        &[
+            "replay",
+            "--env",
+            "lightsout-jaco",
+            "--input",
+            jaco.to_str().unwrap(),
+            "--out",
+            out_file.to_str().unwrap(),
+        ],
+        "not supported",
+    );
+}

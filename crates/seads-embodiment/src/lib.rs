@@ -19,6 +19,7 @@ mod jaco;
 mod layout;
 mod policy;
 mod reacher;
+mod record;
 mod registry;
 mod runner;
 mod scene;
@@ -32,6 +33,9 @@ pub use jaco::{DEFAULT_SUBSTEPS as JACO_DEFAULT_SUBSTEPS, Jaco, JacoBoard};
 pub use layout::Layout;
 pub use policy::{SkillPolicy, SkillRun, execute_skill};
 pub use reacher::Reacher;
+pub use record::{
+    Comparison, EpisodeRecord, ReplayError, StepRecord, compare, record_episode, replay_episode,
+};
 pub use registry::{EnvInfo, env_names, list_envs, make_env};
 pub use runner::{VecEnv, random_rollout};
 pub use scene::{FieldView, Scene, Shape};
