@@ -9,6 +9,7 @@ mod games;
 mod plan;
 mod plot;
 mod train;
+mod uarm;
 
 use std::process::ExitCode;
 
@@ -54,6 +55,9 @@ enum Command {
     Record(episodes::RecordArgs),
     /// Replay recorded episodes exactly and recompute their observations and moves.
     Replay(episodes::ReplayArgs),
+    /// The real robot (uArm Swift Pro + LightsOut tablet) or its simulated twin (`--port sim`).
+    #[command(subcommand)]
+    Uarm(uarm::UarmCommand),
 }
 
 /// Input the user gave that cannot be used (exit code 2, like a usage error).
@@ -92,6 +96,8 @@ fn main() -> ExitCode {
         Command::PlanBench(args) => plan::plan_bench(args),
         Command::Record(args) => episodes::record(args),
         Command::Replay(args) => episodes::replay(args),
+        Command::Uarm(uarm::UarmCommand::Calibrate(args)) => uarm::calibrate(args),
+        Command::Uarm(uarm::UarmCommand::Train(args)) => uarm::train(args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

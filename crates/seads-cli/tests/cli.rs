@@ -648,3 +648,110 @@ fn replay_reports_bad_lines_with_their_number() {
         "not supported",
     );
 }
+
+#[test]
+fn uarm_twin_calibrates_and_trains() {
+    let dir = tempfile::tempdir().unwrap();
+    let cal = dir.path().join("cal.toml");
+    let out = seads(&[
+        "uarm",
+        "calibrate",
+        "--port",
+        "sim",
+        "--out",
+        cal.to_str().unwrap(),
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    assert!(
+        std::fs::read_to_string(&cal)
+            .unwrap()
+            .contains("corners = [[160.0, 108.5, 5.0]")
+    );
+    let run = dir.path().join("run");
+    let out = seads(&[
+        "uarm",
+        "train",
+        "--port",
+        "sim:3",
+        "--calibration",
+        cal.to_str().unwrap(),
+        "--env-steps",
+        "12",
+        "--boards",
+        "1",
+        "--timeout",
+        "0.2",
+        "--out",
+        run.to_str().unwrap(),
+        "--quiet",
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert!(stdout.contains("of 5 boards with re-planning"), "{stdout}");
+    assert!(
+        std::fs::read_to_string(run.join("config.toml"))
+            .unwrap()
+            .contains("uarm-lightsout-absolute")
+    );
+}
+
+#[test]
+fn uarm_rejects_bad_input() {
+    let dir = tempfile::tempdir().unwrap();
+    let cal = dir.path().join("cal.toml");
+    std::fs::write(&cal, "corners = [[0.0, 0.0, 0.0], [100.0, 0.0, 0.0], [200.0, 0.0, 0.0], [300.0, 0.0, 0.0]]\nd_max_mm = 100.0\n").unwrap();
+    let run = dir.path().join("run");
+    check_bad_input(
+        &[
+            "uarm",
+            "train",
+            "--port",
+            "sim",
+            "--calibration",
+            cal.to_str().unwrap(),
+            "--out",
+            run.to_str().unwrap(),
+        ],
+        "line",
+    );
+    let out = seads(&[
+        "uarm",
+        "train",
+        "--port",
+        "/dev/does-not-exist",
+        "--calibration",
+        cal.to_str().unwrap(),
+        "--out",
+        run.to_str().unwrap(),
+    ]);
+    assert!(!out.status.success());
+    let missing = seads(&[
+        "uarm",
+        "calibrate",
+        "--port",
+        "/dev/does-not-exist",
+        "--out",
+        cal.to_str().unwrap(),
+    ]);
+    assert_eq!(missing.status.code(), Some(1));
+    assert!(String::from_utf8_lossy(&missing.stderr).contains("/dev/does-not-exist"));
+    check_bad_input(
+        &[
+            "uarm",
+            "train",
+            "--port",
+            "/dev/ttyACM9",
+            "--out",
+            run.to_str().unwrap(),
+        ],
+        "needs --calibration",
+    );
+}

@@ -137,6 +137,7 @@ impl<M: Manipulator> Embodied<M> {
             action_high,
             num_skills: game.num_moves(),
             step_limit: Some(step_limit.unwrap_or(manipulator.default_step_limit())),
+            exclusive: false,
         };
         let mut env = Self {
             spec,

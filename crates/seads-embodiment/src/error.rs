@@ -70,6 +70,14 @@ pub enum EnvError {
         /// The operation.
         what: String,
     },
+    /// The robot hardware failed (the arm was left at hover height where possible).
+    #[error("{env}: hardware failure: {reason}")]
+    Hardware {
+        /// Environment name.
+        env: String,
+        /// What failed.
+        reason: String,
+    },
     /// A board that the game does not accept.
     #[error(transparent)]
     Game(#[from] GameError),

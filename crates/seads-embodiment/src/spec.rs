@@ -30,6 +30,9 @@ pub struct EnvSpec {
     pub num_skills: usize,
     /// Steps per skill execution T_max (`None`: unlimited).
     pub step_limit: Option<usize>,
+    /// The environment drives shared physical hardware: its clones are the same robot, so
+    /// episodes must run one at a time.
+    pub exclusive: bool,
 }
 
 impl EnvSpec {

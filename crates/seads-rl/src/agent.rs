@@ -75,6 +75,16 @@ impl Agent {
     /// Loads the agent saved in `checkpoint` by a run with `config`.
     pub fn load_checkpoint(config: TrainConfig, checkpoint: &Path) -> Result<Self, RlError> {
         let spec = make_env(&config.env, &config.env_config)?.spec().clone();
+        Self::load_for(config, spec, checkpoint)
+    }
+
+    /// Loads the agent saved in `checkpoint` for an environment of `spec` (also one outside the
+    /// registry, such as the robot).
+    pub fn load_for(
+        config: TrainConfig,
+        spec: EnvSpec,
+        checkpoint: &Path,
+    ) -> Result<Self, RlError> {
         let k = config.num_skills.unwrap_or(spec.num_skills);
         let mut sac = Sac::new(
             spec.obs_dim + k,

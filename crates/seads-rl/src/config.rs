@@ -146,11 +146,12 @@ impl TrainConfig {
         PRESETS
     }
 
-    /// Parses and validates a TOML configuration.
+    /// Parses a TOML configuration and validates its values (not the environment: see
+    /// [`TrainConfig::validate`]).
     pub fn from_toml(text: &str) -> Result<Self, RlError> {
         let config: Self =
             toml::from_str(text).map_err(|e| RlError::Config(one_line_toml_error(text, &e)))?;
-        config.validate()?;
+        config.validate_values()?;
         Ok(config)
     }
 
@@ -159,18 +160,24 @@ impl TrainConfig {
         toml::to_string(self).expect("a config serialises")
     }
 
-    /// Checks every value (the environment is built once to check its options).
+    /// Checks every value, and that the environment exists with these options.
     pub fn validate(&self) -> Result<(), RlError> {
-        let bad = |m: String| Err(RlError::Config(m));
         if !env_names().contains(&self.env.as_str()) {
-            return bad(format!(
+            return Err(RlError::Config(format!(
                 "unknown environment {:?}; valid environments: {}",
                 self.env,
                 env_names().join(", ")
-            ));
+            )));
         }
         seads_embodiment::make_env(&self.env, &self.env_config)
             .map_err(|e| RlError::Config(e.to_string()))?;
+        self.validate_values()
+    }
+
+    /// Checks every value except the environment (robot environments are not in the registry;
+    /// the trainer that gets one checks it).
+    pub fn validate_values(&self) -> Result<(), RlError> {
+        let bad = |m: String| Err(RlError::Config(m));
         self.sac.validate().map_err(RlError::Config)?;
         self.skill_model.validate().map_err(RlError::Config)?;
         if self.num_skills == Some(0) {

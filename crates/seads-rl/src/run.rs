@@ -84,13 +84,23 @@ fn atomic_write(path: &Path, text: &str) -> Result<(), RlError> {
 impl Run {
     /// Starts a run in `dir` (created; it must not already hold a run).
     pub fn create(dir: &Path, config: TrainConfig) -> Result<Self, RlError> {
+        Self::check_free(dir)?;
+        Self::with_trainer(dir, Trainer::new(config)?)
+    }
+
+    fn check_free(dir: &Path) -> Result<(), RlError> {
         if dir.join("config.toml").exists() {
             return Err(RlError::Config(format!(
                 "{} already holds a run; resume it with --resume or choose another directory",
                 dir.display()
             )));
         }
-        let trainer = Trainer::new(config)?;
+        Ok(())
+    }
+
+    /// Starts a run in `dir` with a trainer built elsewhere (e.g. on the robot's environment).
+    pub fn with_trainer(dir: &Path, trainer: Trainer) -> Result<Self, RlError> {
+        Self::check_free(dir)?;
         fs::create_dir_all(dir.join("checkpoints")).map_err(|e| RlError::io(dir, e))?;
         atomic_write(&dir.join("config.toml"), &trainer.config().to_toml())?;
         fs::write(dir.join("metrics.jsonl"), "").map_err(|e| RlError::io(dir, e))?;
@@ -104,8 +114,16 @@ impl Run {
 
     /// Continues the run in `dir` from its latest checkpoint (from scratch if it has none).
     pub fn resume(dir: &Path) -> Result<Self, RlError> {
+        Self::resume_with(dir, Trainer::new)
+    }
+
+    /// Continues the run in `dir`, building its trainer with `build` from the saved config.
+    pub fn resume_with(
+        dir: &Path,
+        build: impl FnOnce(TrainConfig) -> Result<Trainer, RlError>,
+    ) -> Result<Self, RlError> {
         let config = load_config(dir)?;
-        let mut trainer = Trainer::new(config)?;
+        let mut trainer = build(config)?;
         let mut wall_before = 0.0;
         let mut kept = Vec::new();
         if let Some(checkpoint) = latest_checkpoint(dir)? {

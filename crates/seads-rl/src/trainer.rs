@@ -94,14 +94,32 @@ impl Trainer {
     /// A fresh agent for `config` (validated).
     pub fn new(config: TrainConfig) -> Result<Self, RlError> {
         config.validate()?;
-        if config.threads > 0 {
-            tch::set_num_threads(config.threads as i32);
-        }
         let train_env = EnvConfig {
             reset_split: Split::Train,
             ..config.env_config.clone()
         };
         let template = make_env(&config.env, &train_env)?;
+        // Coverage is measured on test boards drawn as in training (random depth up to the max).
+        let eval_config = EnvConfig {
+            reset_split: Split::Test,
+            ..config.env_config.clone()
+        };
+        let eval_env = make_env(&config.env, &eval_config)?;
+        Self::with_environments(config, template, eval_env)
+    }
+
+    /// A fresh agent training on `template` (cloned per episode slot) and measuring skill
+    /// coverage on `eval_env`: for environments outside the registry, such as the robot.
+    /// `config.env` and `config.env_config` are not used to build environments.
+    pub fn with_environments(
+        config: TrainConfig,
+        template: Box<dyn Environment>,
+        eval_env: Box<dyn Environment>,
+    ) -> Result<Self, RlError> {
+        config.validate_values()?;
+        if config.threads > 0 {
+            tch::set_num_threads(config.threads as i32);
+        }
         let spec = template.spec().clone();
         let k = config.num_skills.unwrap_or(spec.num_skills);
         let envs = (0..config.episodes_per_epoch)
@@ -112,12 +130,6 @@ impl Trainer {
                 env
             })
             .collect();
-        // Coverage is measured on test boards drawn as in training (random depth up to the max).
-        let eval_config = EnvConfig {
-            reset_split: Split::Test,
-            ..config.env_config.clone()
-        };
-        let eval_env = make_env(&config.env, &eval_config)?;
         let device = Device::Cpu;
         let sac = Sac::new(
             spec.obs_dim + k,

@@ -1,2 +1,65 @@
-//! The real robot of SEADS (SPEC §7): a uArm Swift Pro serial driver, screen calibration, the
-//! tablet board reader and an environment over both, with a simulated twin for tests.
+//! The real robot of SEADS (SPEC §7): a uArm Swift Pro pressing LightsOut on an Android tablet.
+//!
+//! - [`protocol`]: the uArm's G-code line protocol (documented there).
+//! - [`Swift`]: the driver over a [`Transport`] — the serial port ([`SerialTransport`]) or the
+//!   simulated twin — with acknowledgements, timeouts and recovery from garbled lines.
+//! - [`Calibration`]: from four measured screen corners to arm coordinates.
+//! - [`Tablet`]: the board, read from the app's log lines over `adb logcat` ([`AdbTablet`]; the
+//!   line format is documented in [`tablet`]).
+//! - [`UarmEnv`]: both action spaces as a `seads_embodiment::Environment`.
+//! - [`Twin`]: an in-process arm and tablet, so that everything but the wire runs in tests,
+//!   including timeouts, disconnects and malformed replies.
+//!
+//! Architecture invariant: the only crate that opens a serial port.
+
+mod calibration;
+mod driver;
+mod env;
+pub mod protocol;
+pub mod tablet;
+mod twin;
+
+pub use calibration::{Calibration, CalibrationFile};
+pub use driver::{DriverConfig, SerialTransport, Swift, Transport};
+pub use env::{ActionSpace, UarmConfig, UarmEnv};
+pub use tablet::{AdbTablet, Tablet, TabletReport};
+pub use twin::{Faults, Twin, twin_screen_corners};
+
+/// What can go wrong with the robot.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum UarmError {
+    /// Opening, reading or writing a file or the serial port failed.
+    #[error("{0}")]
+    Io(String),
+    /// The arm did not acknowledge a command in time.
+    #[error("the arm did not answer `{command}` within {seconds:.1} s")]
+    Timeout {
+        /// The command.
+        command: String,
+        /// The time waited.
+        seconds: f64,
+    },
+    /// The serial line is gone.
+    #[error("the arm is disconnected")]
+    Disconnected,
+    /// The arm answered with an error code.
+    #[error("the arm refused `{command}` with error E{code}")]
+    CommandFailed {
+        /// The command.
+        command: String,
+        /// The error code.
+        code: u16,
+    },
+    /// An answer that does not fit the protocol.
+    #[error("protocol error: {0}")]
+    Protocol(String),
+    /// An environment setting that cannot be used.
+    #[error("invalid uArm setting: {0}")]
+    Config(String),
+    /// A calibration that cannot be used.
+    #[error("calibration: {0}")]
+    Calibration(String),
+    /// The tablet's board cannot be read or set.
+    #[error("tablet: {0}")]
+    Tablet(String),
+}

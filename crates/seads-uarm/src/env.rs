@@ -1,0 +1,372 @@
+//! The uArm environment (SPEC §7.3): the arm pushing on the tablet's LightsOut, with either the
+//! absolute-push or the displacement action space, over the real hardware or the twin.
+
+use std::sync::{Arc, Mutex, MutexGuard};
+use std::time::Duration;
+
+use rand::{RngExt, SeedableRng};
+use rand_chacha::ChaCha8Rng;
+use seads_embodiment::{
+    EnvError, EnvSpec, Environment, FieldView, Layout, Push, Scene, Shape, StepOutcome,
+};
+use seads_games::{BoardDataset, BoardGame, GameKind, LightsOut, Split, SymbolicState};
+use serde::{Deserialize, Serialize};
+
+use crate::UarmError;
+use crate::calibration::Calibration;
+use crate::driver::Swift;
+use crate::tablet::Tablet;
+
+/// How actions move the pen.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum ActionSpace {
+    /// a = (x, y) ∈ [0,1]²: hover at z = 0.2, press, hover (SPEC §7.3, seed S.5.1).
+    Absolute,
+    /// a = (Δx, Δy, p): move at z = 0.3 by at most 0.2 per axis, press when p > 0.6 (the
+    /// Cursor in hardware, seed S.5.2).
+    Displacement,
+}
+
+/// Settings of the uArm environment.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct UarmConfig {
+    /// The action space.
+    pub action_space: ActionSpace,
+    /// Steps per skill (not published; one press for absolute pushes, as many as the Cursor's
+    /// for displacements).
+    pub step_limit: usize,
+    /// How long to wait for the tablet to log a tap after a press, seconds.
+    pub tap_timeout_s: f64,
+    /// Reset draws a new board and pen position (the twin only: the real tablet's boards are the
+    /// app's, and the paper resets neither board nor arm).
+    pub reset_board: bool,
+}
+
+impl Default for UarmConfig {
+    fn default() -> Self {
+        Self {
+            action_space: ActionSpace::Absolute,
+            step_limit: 1,
+            tap_timeout_s: 2.0,
+            reset_board: false,
+        }
+    }
+}
+
+/// Normalised hover heights (z = 1 ≈ 10 cm above the screen).
+const HOVER_ABSOLUTE: f64 = 0.2;
+const HOVER_DISPLACEMENT: f64 = 0.3;
+
+struct Hardware {
+    arm: Swift,
+    tablet: Box<dyn Tablet>,
+    calibration: Calibration,
+    /// Pen position over the screen, normalised.
+    cursor: [f64; 2],
+    board: SymbolicState,
+    seq: u64,
+    rng: ChaCha8Rng,
+}
+
+/// The arm and the tablet as an [`Environment`]. Clones share the hardware (`spec().exclusive`):
+/// a trainer runs their episodes one after another.
+#[derive(Clone)]
+pub struct UarmEnv {
+    spec: EnvSpec,
+    config: UarmConfig,
+    hardware: Arc<Mutex<Hardware>>,
+    steps: usize,
+    boards: Arc<BoardDataset>,
+}
+
+impl UarmEnv {
+    /// Connects the environment: attaches the servos, lifts the pen to hover height over the
+    /// screen centre and reads the board.
+    pub fn new(
+        mut arm: Swift,
+        mut tablet: Box<dyn Tablet>,
+        calibration: Calibration,
+        config: UarmConfig,
+    ) -> Result<Self, UarmError> {
+        if config.step_limit == 0 || config.tap_timeout_s.is_nan() || config.tap_timeout_s < 0.0 {
+            return Err(UarmError::Calibration(
+                "step_limit must be at least 1 and tap_timeout_s non-negative".into(),
+            ));
+        }
+        let game = LightsOut::new(5).expect("5×5");
+        let (name, low, high) = match config.action_space {
+            ActionSpace::Absolute => ("uarm-lightsout-absolute", vec![0.0, 0.0], vec![1.0, 1.0]),
+            ActionSpace::Displacement => (
+                "uarm-lightsout-displacement",
+                vec![-0.2, -0.2, -1.0],
+                vec![0.2, 0.2, 1.0],
+            ),
+        };
+        let spec = EnvSpec {
+            name: name.into(),
+            game: GameKind::LightsOut,
+            board_size: 5,
+            manipulator_dim: 2,
+            symbolic_len: 25,
+            obs_dim: 2 + 25 + 1,
+            action_dim: low.len(),
+            action_low: low,
+            action_high: high,
+            num_skills: game.num_moves(),
+            step_limit: Some(config.step_limit),
+            exclusive: true,
+        };
+        arm.attach()?;
+        let calibration_centre = [0.5, 0.5];
+        arm.move_to(calibration.to_arm(0.5, 0.5, HOVER_DISPLACEMENT))?;
+        let report = tablet.latest(Duration::from_secs_f64(config.tap_timeout_s.max(1.0)))?;
+        let hardware = Hardware {
+            arm,
+            tablet,
+            calibration,
+            cursor: calibration_centre,
+            board: report.board,
+            seq: report.seq,
+            rng: ChaCha8Rng::seed_from_u64(0),
+        };
+        let boards = Arc::new(BoardDataset::build(&game, 5).expect("enumerable"));
+        Ok(Self {
+            spec,
+            config,
+            hardware: Arc::new(Mutex::new(hardware)),
+            steps: 0,
+            boards,
+        })
+    }
+
+    fn lock(&self) -> MutexGuard<'_, Hardware> {
+        self.hardware.lock().unwrap_or_else(|e| e.into_inner())
+    }
+
+    fn hover(&self) -> f64 {
+        match self.config.action_space {
+            ActionSpace::Absolute => HOVER_ABSOLUTE,
+            ActionSpace::Displacement => HOVER_DISPLACEMENT,
+        }
+    }
+
+    fn hardware_error(&self, e: UarmError) -> EnvError {
+        EnvError::Hardware {
+            env: self.spec.name.clone(),
+            reason: e.to_string(),
+        }
+    }
+
+    /// Presses at the pen's position and waits for the tablet's report.
+    fn press(&self, hw: &mut Hardware) -> Result<Push, UarmError> {
+        let [x, y] = hw.cursor;
+        hw.arm.move_to(hw.calibration.to_arm(x, y, 0.0))?;
+        hw.arm.move_to(hw.calibration.to_arm(x, y, self.hover()))?;
+        let report = hw
+            .tablet
+            .wait_for_report(hw.seq, Duration::from_secs_f64(self.config.tap_timeout_s))?;
+        Ok(match report {
+            Some(r) => {
+                hw.seq = r.seq;
+                let changed = r.board != hw.board;
+                hw.board = r.board;
+                match r.game_move {
+                    Some(m) if changed => Push::Move(m),
+                    _ => Push::Miss,
+                }
+            }
+            None => Push::Miss,
+        })
+    }
+
+    fn act(&self, action: &[f32]) -> Result<Push, UarmError> {
+        let mut guard = self.lock();
+        let hw = &mut *guard;
+        match self.config.action_space {
+            ActionSpace::Absolute => {
+                let (x, y) = (
+                    action[0].clamp(0.0, 1.0) as f64,
+                    action[1].clamp(0.0, 1.0) as f64,
+                );
+                hw.cursor = [x, y];
+                hw.arm
+                    .move_to(hw.calibration.to_arm(x, y, HOVER_ABSOLUTE))?;
+                self.press(hw)
+            }
+            ActionSpace::Displacement => {
+                let x = (hw.cursor[0] + action[0].clamp(-0.2, 0.2) as f64).clamp(0.0, 1.0);
+                let y = (hw.cursor[1] + action[1].clamp(-0.2, 0.2) as f64).clamp(0.0, 1.0);
+                hw.cursor = [x, y];
+                hw.arm
+                    .move_to(hw.calibration.to_arm(x, y, HOVER_DISPLACEMENT))?;
+                if action[2] > 0.6 {
+                    self.press(hw)
+                } else {
+                    Ok(Push::None)
+                }
+            }
+        }
+    }
+}
+
+impl Environment for UarmEnv {
+    fn spec(&self) -> &EnvSpec {
+        &self.spec
+    }
+
+    fn seed(&mut self, seed: u64) {
+        self.lock().rng = ChaCha8Rng::seed_from_u64(seed);
+    }
+
+    fn reset(&mut self) {
+        self.steps = 0;
+        if !self.config.reset_board {
+            return;
+        }
+        let mut hw = self.lock();
+        let depth = hw.rng.random_range(1..=5);
+        let board = self
+            .boards
+            .sample(depth, Split::Train, &mut hw.rng)
+            .expect("LightsOut has boards of depth 1..5");
+        let cursor = [hw.rng.random::<f64>(), hw.rng.random::<f64>()];
+        if hw.tablet.set_board(board).is_ok() {
+            hw.board = board;
+            if let Ok(r) = hw.tablet.latest(Duration::ZERO) {
+                hw.seq = r.seq;
+            }
+        }
+        let target = hw.calibration.to_arm(cursor[0], cursor[1], self.hover());
+        if hw.arm.move_to(target).is_ok() {
+            hw.cursor = cursor;
+        }
+    }
+
+    fn step(&mut self, action: &[f32]) -> Result<StepOutcome, EnvError> {
+        if action.len() != self.spec.action_dim {
+            return Err(EnvError::ActionLength {
+                env: self.spec.name.clone(),
+                expected: self.spec.action_dim,
+                found: action.len(),
+            });
+        }
+        if let Some(index) = action.iter().position(|a| !a.is_finite()) {
+            return Err(EnvError::NonFiniteAction {
+                env: self.spec.name.clone(),
+                index,
+                value: action[index],
+            });
+        }
+        if let Some(limit) = self.spec.step_limit
+            && self.steps >= limit
+        {
+            return Err(EnvError::StepLimitReached {
+                env: self.spec.name.clone(),
+                limit,
+            });
+        }
+        let push = match self.act(action) {
+            Ok(push) => push,
+            Err(e) => {
+                // Leave the arm safe: lift the pen to hover height where it is, if the line allows.
+                let mut hw = self.lock();
+                let [x, y] = hw.cursor;
+                let safe = hw.calibration.to_arm(x, y, self.hover());
+                let _ = hw.arm.move_to(safe);
+                return Err(self.hardware_error(e));
+            }
+        };
+        self.steps += 1;
+        let truncated = self.spec.step_limit.is_some_and(|l| self.steps >= l);
+        Ok(StepOutcome { push, truncated })
+    }
+
+    fn observe(&self, out: &mut [f32]) {
+        let hw = self.lock();
+        out[0] = hw.cursor[0] as f32;
+        out[1] = hw.cursor[1] as f32;
+        hw.board.write_f32(&mut out[2..27]);
+        let limit = self.spec.step_limit.unwrap_or(1);
+        out[27] = limit.saturating_sub(self.steps) as f32 / limit as f32;
+    }
+
+    fn board(&self) -> SymbolicState {
+        self.lock().board
+    }
+
+    fn set_board(&mut self, board: SymbolicState) -> Result<(), EnvError> {
+        let mut hw = self.lock();
+        hw.tablet
+            .set_board(board)
+            .map_err(|e| EnvError::Unsupported {
+                env: self.spec.name.clone(),
+                what: e.to_string(),
+            })?;
+        hw.board = board;
+        if let Ok(r) = hw.tablet.latest(Duration::ZERO) {
+            hw.seq = r.seq;
+        }
+        Ok(())
+    }
+
+    fn reset_step_counter(&mut self) {
+        self.steps = 0;
+    }
+
+    fn set_step_limit(&mut self, limit: Option<usize>) {
+        self.spec.step_limit = limit;
+    }
+
+    fn restore_manipulator(&mut self, state: &[f32]) -> Result<(), EnvError> {
+        let invalid = |reason: String| EnvError::InvalidState {
+            env: self.spec.name.clone(),
+            reason,
+        };
+        if state.len() != 2 || state.iter().any(|v| !(0.0..=1.0).contains(v)) {
+            return Err(invalid(format!(
+                "a pen position is 2 values in [0, 1], got {state:?}"
+            )));
+        }
+        let mut hw = self.lock();
+        let target = hw
+            .calibration
+            .to_arm(state[0] as f64, state[1] as f64, self.hover());
+        hw.arm.move_to(target).map_err(|e| EnvError::Hardware {
+            env: self.spec.name.clone(),
+            reason: e.to_string(),
+        })?;
+        hw.cursor = [state[0] as f64, state[1] as f64];
+        Ok(())
+    }
+
+    fn scene(&self) -> Scene {
+        let hw = self.lock();
+        let fields = Layout::Grid { n: 5 }
+            .fields()
+            .into_iter()
+            .enumerate()
+            .map(|(d, rect)| FieldView {
+                rect,
+                lit: Some(hw.board.get(d)),
+                label: None,
+            })
+            .collect();
+        Scene {
+            title: self.spec.name.clone(),
+            extent: [0.0, 0.0, 1.0, 1.0],
+            fields,
+            pivots: Vec::new(),
+            shapes: vec![Shape::Marker { at: hw.cursor }],
+        }
+    }
+
+    fn end_effector(&self) -> [f64; 2] {
+        self.lock().cursor
+    }
+
+    fn box_clone(&self) -> Box<dyn Environment> {
+        Box::new(self.clone())
+    }
+}

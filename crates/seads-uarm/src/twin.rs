@@ -1,0 +1,344 @@
+//! The simulated twin: an arm that speaks the uArm protocol and a tablet running LightsOut, in
+//! one in-process world, so that the driver, the calibration and the environment run end to end
+//! without hardware — faults included.
+//!
+//! The arm moves instantly to commanded points; the pen cannot go below the screen (it rests on
+//! the glass). When the pen comes within 0.5 mm of the screen inside its area, the tablet
+//! registers a tap at that point (once per touch: the pen must lift by 1 mm before the next),
+//! presses the LightsOut field under it and logs a report. When a tap solves the board, the app
+//! shows a new random board (1–5 moves from the goal), as a game app starts a new level.
+
+use std::collections::VecDeque;
+use std::sync::{Arc, Mutex, MutexGuard};
+use std::time::Duration;
+
+use rand::seq::SliceRandom;
+use rand::{RngExt, SeedableRng};
+use rand_chacha::ChaCha8Rng;
+use seads_games::{BoardGame, LightsOut, SymbolicState};
+
+use seads_embodiment::Layout;
+
+use crate::UarmError;
+use crate::calibration::{Calibration, CalibrationFile};
+use crate::driver::Transport;
+use crate::tablet::{Tablet, TabletReport};
+
+/// Faults the twin can inject, counted in commands received.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct Faults {
+    /// Never answer the n-th command (the driver times out).
+    pub silent_at: Option<usize>,
+    /// Send a garbled line and a stale reply before the answer to the n-th command.
+    pub garble_at: Option<usize>,
+    /// Answer the n-th command with a malformed position (for `P2220`) or an error code.
+    pub bad_reply_at: Option<usize>,
+    /// Drop the connection when the n-th command arrives.
+    pub disconnect_at: Option<usize>,
+}
+
+struct World {
+    /// Pen tip position, arm coordinates (mm).
+    pen: [f64; 3],
+    attached: bool,
+    connected: bool,
+    touching: bool,
+    commands: usize,
+    faults: Faults,
+    replies: VecDeque<String>,
+    screen: Calibration,
+    game: LightsOut,
+    board: SymbolicState,
+    seq: u64,
+    last_move: Option<usize>,
+    rng: ChaCha8Rng,
+    /// Every G0 target received (for tests: where the arm was sent).
+    trail: Vec<[f64; 3]>,
+}
+
+/// The shared simulated world; hand out its arm transport and its tablet.
+#[derive(Clone)]
+pub struct Twin {
+    world: Arc<Mutex<World>>,
+}
+
+/// The twin's screen: a 217 × 136 mm display (a 10.1" tablet's usable area) lying in front of the
+/// arm, slightly tilted.
+pub fn twin_screen_corners() -> [[f64; 3]; 4] {
+    [
+        [160.0, 108.5, 5.0],
+        [160.0, -108.5, 5.0],
+        [296.0, -108.5, 12.0],
+        [296.0, 108.5, 12.0],
+    ]
+}
+
+impl Twin {
+    /// A twin with a random board drawn from `seed`.
+    pub fn new(seed: u64) -> Self {
+        let screen = Calibration::fit(CalibrationFile {
+            corners: twin_screen_corners(),
+            d_max_mm: 100.0,
+        })
+        .expect("the twin's screen is valid");
+        let game = LightsOut::new(5).expect("5×5");
+        let mut rng = ChaCha8Rng::seed_from_u64(seed);
+        let board = scramble(&game, &mut rng);
+        let world = World {
+            pen: [150.0, 0.0, 150.0],
+            attached: true,
+            connected: true,
+            touching: false,
+            commands: 0,
+            faults: Faults::default(),
+            replies: VecDeque::new(),
+            screen,
+            game,
+            board,
+            seq: 0,
+            last_move: None,
+            rng,
+            trail: Vec::new(),
+        };
+        Self {
+            world: Arc::new(Mutex::new(world)),
+        }
+    }
+
+    fn lock(&self) -> MutexGuard<'_, World> {
+        self.world.lock().unwrap_or_else(|e| e.into_inner())
+    }
+
+    /// The arm's serial line.
+    pub fn transport(&self) -> Box<dyn Transport> {
+        Box::new(SimTransport { twin: self.clone() })
+    }
+
+    /// The tablet's log.
+    pub fn tablet(&self) -> Box<dyn Tablet> {
+        Box::new(SimTablet { twin: self.clone() })
+    }
+
+    /// Arms `faults` (command counts from now on).
+    pub fn inject(&self, faults: Faults) {
+        let mut w = self.lock();
+        let now = w.commands;
+        let shift = |n: Option<usize>| n.map(|n| now + n);
+        w.faults = Faults {
+            silent_at: shift(faults.silent_at),
+            garble_at: shift(faults.garble_at),
+            bad_reply_at: shift(faults.bad_reply_at),
+            disconnect_at: shift(faults.disconnect_at),
+        };
+    }
+
+    /// Reconnects after an injected disconnect.
+    pub fn reconnect(&self) {
+        self.lock().connected = true;
+    }
+
+    /// The pen tip, arm coordinates.
+    pub fn pen(&self) -> [f64; 3] {
+        self.lock().pen
+    }
+
+    /// The pen's height above the screen, mm.
+    pub fn pen_height_mm(&self) -> f64 {
+        let w = self.lock();
+        w.screen.to_screen(w.pen)[2] * w.screen.file().d_max_mm
+    }
+
+    /// The board the tablet shows.
+    pub fn board(&self) -> SymbolicState {
+        self.lock().board
+    }
+
+    /// Every G0 target the arm received.
+    pub fn trail(&self) -> Vec<[f64; 3]> {
+        self.lock().trail.clone()
+    }
+
+    /// Moves the detached arm by hand (calibration: a person places the pen on a corner).
+    pub fn move_by_hand(&self, to: [f64; 3]) {
+        let mut w = self.lock();
+        w.pen = to;
+    }
+}
+
+/// A board 1–5 distinct moves from the goal, not the goal.
+fn scramble(game: &LightsOut, rng: &mut ChaCha8Rng) -> SymbolicState {
+    loop {
+        let mut moves: Vec<usize> = (0..game.num_moves()).collect();
+        moves.shuffle(rng);
+        let depth = rng.random_range(1..=5);
+        let board = game.apply_all(game.goal(), &moves[..depth]);
+        if !game.is_goal(board) {
+            return board;
+        }
+    }
+}
+
+impl World {
+    fn answer(&mut self, line: &str) {
+        let Some((id, command)) = line.strip_prefix('#').and_then(|l| l.split_once(' ')) else {
+            return; // the firmware ignores lines without a sequence number
+        };
+        self.commands += 1;
+        let n = self.commands;
+        if self.faults.disconnect_at == Some(n) {
+            self.connected = false;
+            return;
+        }
+        if self.faults.silent_at == Some(n) {
+            return;
+        }
+        if self.faults.garble_at == Some(n) {
+            self.replies.push_back("\u{fffd}$#@!ok".into());
+            self.replies.push_back("$9999 ok".into());
+        }
+        let bad = self.faults.bad_reply_at == Some(n);
+        let reply = match command.split_whitespace().next().unwrap_or("") {
+            "G0" if bad => format!("${id} E22"),
+            "G0" => match parse_move(command) {
+                Some(target) => {
+                    self.trail.push(target);
+                    if self.attached {
+                        self.move_pen(target);
+                        format!("${id} ok")
+                    } else {
+                        format!("${id} E21")
+                    }
+                }
+                None => format!("${id} E20"),
+            },
+            "P2220" if bad => format!("${id} ok X1.0 Y?? Z3"),
+            "P2220" => format!(
+                "${id} ok X{:.2} Y{:.2} Z{:.2}",
+                self.pen[0], self.pen[1], self.pen[2]
+            ),
+            "M17" => {
+                self.attached = true;
+                format!("${id} ok")
+            }
+            "M2019" => {
+                self.attached = false;
+                format!("${id} ok")
+            }
+            "M2210" | "M2400" | "P2234" | "P2201" | "P2202" | "P2203" | "P2204" | "P2205" => {
+                format!("${id} ok")
+            }
+            _ => format!("${id} E20"),
+        };
+        self.replies.push_back(reply);
+    }
+
+    /// Moves the pen, stopping on the glass, and registers a tap when it touches the screen.
+    fn move_pen(&mut self, target: [f64; 3]) {
+        let d_max = self.screen.file().d_max_mm;
+        let [x, y, h] = self.screen.to_screen(target);
+        self.pen = if h < 0.0 {
+            self.screen
+                .to_arm(x.clamp(0.0, 1.0), y.clamp(0.0, 1.0), 0.0)
+        } else {
+            target
+        };
+        let height_mm = h.max(0.0) * d_max;
+        let inside = (0.0..=1.0).contains(&x) && (0.0..=1.0).contains(&y);
+        if inside && height_mm <= 0.5 && !self.touching {
+            self.touching = true;
+            // The app's fields tile the screen as the Cursor's board does.
+            let mv = Layout::Grid { n: 5 }
+                .locate(x, y)
+                .expect("a grid push always hits a field");
+            self.board = self.game.apply(self.board, mv);
+            self.seq += 1;
+            self.last_move = Some(mv);
+            if self.game.is_goal(self.board) {
+                self.board = scramble(&self.game, &mut self.rng);
+            }
+        } else if height_mm > 1.0 {
+            self.touching = false;
+        }
+    }
+}
+
+fn parse_move(command: &str) -> Option<[f64; 3]> {
+    let mut xyz = [None; 3];
+    for token in command.split_whitespace().skip(1) {
+        let (axis, value) = token.split_at(1);
+        let v: f64 = value.parse().ok()?;
+        match axis {
+            "X" => xyz[0] = Some(v),
+            "Y" => xyz[1] = Some(v),
+            "Z" => xyz[2] = Some(v),
+            "F" => {}
+            _ => return None,
+        }
+    }
+    Some([xyz[0]?, xyz[1]?, xyz[2]?])
+}
+
+/// The arm's end of the simulated serial line (instant replies, virtual time).
+struct SimTransport {
+    twin: Twin,
+}
+
+impl Transport for SimTransport {
+    fn write_line(&mut self, line: &str) -> Result<(), UarmError> {
+        let mut w = self.twin.lock();
+        if !w.connected {
+            return Err(UarmError::Disconnected);
+        }
+        w.answer(line);
+        Ok(())
+    }
+
+    fn read_line(&mut self, _timeout: Duration) -> Result<Option<String>, UarmError> {
+        let mut w = self.twin.lock();
+        if !w.connected {
+            return Err(UarmError::Disconnected);
+        }
+        Ok(w.replies.pop_front())
+    }
+}
+
+/// The simulated tablet's log.
+struct SimTablet {
+    twin: Twin,
+}
+
+impl SimTablet {
+    fn report(w: &World) -> TabletReport {
+        TabletReport {
+            seq: w.seq,
+            board: w.board,
+            game_move: w.last_move,
+        }
+    }
+}
+
+impl Tablet for SimTablet {
+    fn latest(&mut self, _timeout: Duration) -> Result<TabletReport, UarmError> {
+        Ok(Self::report(&self.twin.lock()))
+    }
+
+    fn wait_for_report(
+        &mut self,
+        after: u64,
+        _timeout: Duration,
+    ) -> Result<Option<TabletReport>, UarmError> {
+        let w = self.twin.lock();
+        Ok((w.seq > after).then(|| Self::report(&w)))
+    }
+
+    fn set_board(&mut self, board: SymbolicState) -> Result<(), UarmError> {
+        let mut w = self.twin.lock();
+        if !w.game.is_valid(board) {
+            return Err(UarmError::Tablet("not a LightsOut 5×5 board".into()));
+        }
+        w.board = board;
+        w.seq += 1;
+        w.last_move = None;
+        Ok(())
+    }
+}

@@ -1,0 +1,233 @@
+//! The driver, the calibration and the environment end to end on the simulated twin, faults
+//! included: every failure is a clear error, and the pen is left at hover height.
+
+use seads_embodiment::{EnvError, Environment, Push, record_episode, replay_episode};
+use seads_games::{BoardGame, LightsOut};
+use seads_uarm::{
+    ActionSpace, Calibration, CalibrationFile, DriverConfig, Faults, Swift, Twin, UarmConfig,
+    UarmEnv, UarmError, twin_screen_corners,
+};
+
+fn driver(twin: &Twin) -> Swift {
+    Swift::new(
+        twin.transport(),
+        DriverConfig {
+            ack_timeout: std::time::Duration::from_millis(50),
+            ..DriverConfig::default()
+        },
+    )
+}
+
+/// Calibrates the way a person does with the twin: detach, place the pen on each corner by
+/// hand, read the position.
+fn calibrate(twin: &Twin) -> Calibration {
+    let mut arm = driver(twin);
+    arm.detach().unwrap();
+    let mut corners = [[0.0; 3]; 4];
+    for (i, corner) in twin_screen_corners().iter().enumerate() {
+        twin.move_by_hand(*corner);
+        corners[i] = arm.position().unwrap();
+    }
+    arm.attach().unwrap();
+    Calibration::fit(CalibrationFile {
+        corners,
+        d_max_mm: 100.0,
+    })
+    .unwrap()
+}
+
+fn env(twin: &Twin, space: ActionSpace) -> UarmEnv {
+    let config = UarmConfig {
+        action_space: space,
+        step_limit: if space == ActionSpace::Absolute {
+            1
+        } else {
+            10
+        },
+        tap_timeout_s: 0.0,
+        reset_board: true,
+    };
+    UarmEnv::new(driver(twin), twin.tablet(), calibrate(twin), config).unwrap()
+}
+
+#[test]
+fn driver_moves_reads_and_recovers_from_noise() {
+    let twin = Twin::new(1);
+    let mut arm = driver(&twin);
+    arm.attach().unwrap();
+    arm.move_to([200.0, 10.0, 80.0]).unwrap();
+    let p = arm.position().unwrap();
+    assert!((p[0] - 200.0).abs() < 0.01 && (p[2] - 80.0).abs() < 0.01);
+    twin.inject(Faults {
+        garble_at: Some(1),
+        ..Faults::default()
+    });
+    arm.move_to([210.0, 0.0, 90.0]).unwrap();
+    assert!(
+        arm.skipped_lines() >= 2,
+        "a garbled line and a stale reply were skipped"
+    );
+    assert_eq!(twin.pen(), [210.0, 0.0, 90.0]);
+}
+
+#[test]
+fn driver_faults_are_clear_errors() {
+    let twin = Twin::new(2);
+    let mut arm = driver(&twin);
+    twin.inject(Faults {
+        silent_at: Some(1),
+        ..Faults::default()
+    });
+    assert!(matches!(arm.command("M17"), Err(UarmError::Timeout { .. })));
+    // The late line of a timed-out command would not confuse the next one.
+    arm.attach().unwrap();
+    twin.inject(Faults {
+        bad_reply_at: Some(1),
+        ..Faults::default()
+    });
+    assert!(matches!(
+        arm.move_to([200.0, 0.0, 50.0]),
+        Err(UarmError::CommandFailed { code: 22, .. })
+    ));
+    twin.inject(Faults {
+        bad_reply_at: Some(1),
+        ..Faults::default()
+    });
+    assert!(matches!(arm.position(), Err(UarmError::Protocol(_))));
+    twin.inject(Faults {
+        disconnect_at: Some(1),
+        ..Faults::default()
+    });
+    assert_eq!(arm.position(), Err(UarmError::Disconnected));
+    assert_eq!(arm.attach(), Err(UarmError::Disconnected));
+    assert!(arm.move_to([f64::NAN, 0.0, 0.0]).is_err());
+}
+
+#[test]
+fn calibration_from_the_twin_recovers_its_screen() {
+    let twin = Twin::new(3);
+    let cal = calibrate(&twin);
+    for (i, &(x, y)) in [(0.0, 0.0), (1.0, 0.0), (1.0, 1.0), (0.0, 1.0)]
+        .iter()
+        .enumerate()
+    {
+        let p = cal.to_arm(x, y, 0.0);
+        let c = twin_screen_corners()[i];
+        assert!(
+            (0..3).all(|k| (p[k] - c[k]).abs() < 0.02),
+            "corner {i}: {p:?} vs {c:?}"
+        );
+    }
+}
+
+#[test]
+fn absolute_pushes_press_the_field_under_the_pen() {
+    let twin = Twin::new(4);
+    let mut env = env(&twin, ActionSpace::Absolute);
+    let game = LightsOut::new(5).unwrap();
+    env.seed(5);
+    for field in 0..25 {
+        env.reset();
+        let before = env.board();
+        let (x, y) = (
+            (field % 5) as f32 * 0.2 + 0.1,
+            (field / 5) as f32 * 0.2 + 0.1,
+        );
+        let out = env.step(&[x, y]).unwrap();
+        assert_eq!(out.push, Push::Move(field));
+        assert!(out.done() && out.truncated);
+        assert_eq!(env.board(), game.apply(before, field));
+        assert_eq!(twin.board(), env.board());
+        assert!(
+            (twin.pen_height_mm() - 20.0).abs() < 0.01,
+            "back at hover height"
+        );
+    }
+}
+
+#[test]
+fn displacements_move_and_press_like_the_cursor() {
+    let twin = Twin::new(6);
+    let mut env = env(&twin, ActionSpace::Displacement);
+    env.seed(1);
+    env.reset();
+    env.restore_manipulator(&[0.5, 0.5]).unwrap();
+    let before = env.board();
+    let out = env.step(&[0.2, 0.0, -1.0]).unwrap();
+    assert_eq!(out.push, Push::None);
+    assert_eq!(env.observation()[..2], [0.7, 0.5]);
+    assert!((twin.pen_height_mm() - 30.0).abs() < 0.01);
+    let out = env.step(&[0.0, 0.0, 1.0]).unwrap();
+    assert_eq!(out.push, Push::Move(13));
+    assert_eq!(env.board(), LightsOut::new(5).unwrap().apply(before, 13));
+}
+
+#[test]
+fn faults_mid_move_end_in_an_error_with_the_pen_lifted() {
+    let twin = Twin::new(7);
+    let mut env = env(&twin, ActionSpace::Absolute);
+    env.seed(2);
+    env.reset();
+    // The press is commanded but its acknowledgement never comes.
+    twin.inject(Faults {
+        silent_at: Some(3),
+        ..Faults::default()
+    });
+    let err = env.step(&[0.5, 0.5]).unwrap_err();
+    assert!(matches!(err, EnvError::Hardware { .. }), "{err}");
+    assert!(err.to_string().contains("did not answer"), "{err}");
+    assert!(
+        (twin.pen_height_mm() - 20.0).abs() < 0.01,
+        "the pen is lifted to hover height"
+    );
+    // A malformed reply to a position request.
+    env.reset_step_counter();
+    twin.inject(Faults {
+        bad_reply_at: Some(2),
+        ..Faults::default()
+    });
+    assert!(matches!(
+        env.step(&[0.3, 0.3]),
+        Err(EnvError::Hardware { .. })
+    ));
+    // A disconnect: an error, no panic, and the environment stays usable for the caller.
+    env.reset_step_counter();
+    twin.inject(Faults {
+        disconnect_at: Some(1),
+        ..Faults::default()
+    });
+    let err = env.step(&[0.3, 0.3]).unwrap_err();
+    assert!(err.to_string().contains("disconnected"), "{err}");
+    twin.reconnect();
+    env.reset_step_counter();
+    assert!(env.step(&[0.9, 0.9]).is_ok());
+    assert!(matches!(
+        env.step(&[0.0]),
+        Err(EnvError::ActionLength { .. })
+    ));
+}
+
+#[test]
+fn the_simulated_arm_records_and_replays_exactly() {
+    let twin = Twin::new(8);
+    let mut env = env(&twin, ActionSpace::Displacement);
+    env.seed(3);
+    let mut k = 0.0f32;
+    let recorded = record_episode(&mut env, 40, |_, a| {
+        k += 1.0;
+        a.copy_from_slice(&[
+            0.15 * k.sin(),
+            0.12 * k.cos(),
+            if (k as usize).is_multiple_of(4) {
+                1.0
+            } else {
+                -1.0
+            },
+        ]);
+    })
+    .unwrap();
+    assert!(recorded.steps.iter().any(|s| s.game_move.is_some()));
+    env.reset();
+    let replayed = replay_episode(&mut env, &recorded).unwrap();
+    assert_eq!(replayed, recorded);
+}
