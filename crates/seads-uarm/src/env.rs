@@ -91,7 +91,7 @@ impl UarmEnv {
         config: UarmConfig,
     ) -> Result<Self, UarmError> {
         if config.step_limit == 0 || config.tap_timeout_s.is_nan() || config.tap_timeout_s < 0.0 {
-            return Err(UarmError::Calibration(
+            return Err(UarmError::Config(
                 "step_limit must be at least 1 and tap_timeout_s non-negative".into(),
             ));
         }
@@ -119,14 +119,14 @@ impl UarmEnv {
             exclusive: true,
         };
         arm.attach()?;
-        let calibration_centre = [0.5, 0.5];
+        let centre = [0.5, 0.5];
         arm.move_to(calibration.to_arm(0.5, 0.5, HOVER_DISPLACEMENT))?;
         let report = tablet.latest(Duration::from_secs_f64(config.tap_timeout_s.max(1.0)))?;
         let hardware = Hardware {
             arm,
             tablet,
             calibration,
-            cursor: calibration_centre,
+            cursor: centre,
             board: report.board,
             seq: report.seq,
             rng: ChaCha8Rng::seed_from_u64(0),
