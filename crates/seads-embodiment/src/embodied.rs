@@ -156,24 +156,6 @@ impl<M: Manipulator> Embodied<M> {
     pub fn manipulator(&self) -> &M {
         &self.manipulator
     }
-
-    fn check_action(&self, action: &[f32]) -> Result<(), EnvError> {
-        if action.len() != self.spec.action_dim {
-            return Err(EnvError::ActionLength {
-                env: self.spec.name.clone(),
-                expected: self.spec.action_dim,
-                found: action.len(),
-            });
-        }
-        if let Some(index) = action.iter().position(|a| !a.is_finite()) {
-            return Err(EnvError::NonFiniteAction {
-                env: self.spec.name.clone(),
-                index,
-                value: action[index],
-            });
-        }
-        Ok(())
-    }
 }
 
 impl<M: Manipulator> Environment for Embodied<M> {
@@ -193,7 +175,7 @@ impl<M: Manipulator> Environment for Embodied<M> {
     }
 
     fn step(&mut self, action: &[f32]) -> Result<StepOutcome, EnvError> {
-        self.check_action(action)?;
+        self.spec.check_action(action)?;
         if let Some(limit) = self.spec.step_limit
             && self.steps >= limit
         {

@@ -36,6 +36,25 @@ pub struct EnvSpec {
 }
 
 impl EnvSpec {
+    /// Checks an action's length and that every entry is finite.
+    pub fn check_action(&self, action: &[f32]) -> Result<(), crate::EnvError> {
+        if action.len() != self.action_dim {
+            return Err(crate::EnvError::ActionLength {
+                env: self.name.clone(),
+                expected: self.action_dim,
+                found: action.len(),
+            });
+        }
+        if let Some(index) = action.iter().position(|a| !a.is_finite()) {
+            return Err(crate::EnvError::NonFiniteAction {
+                env: self.name.clone(),
+                index,
+                value: action[index],
+            });
+        }
+        Ok(())
+    }
+
     /// The ground-truth symbolic mapping Φ(s): the D entries before ρ, non-zero → 1.
     pub fn phi(&self, obs: &[f32]) -> SymbolicState {
         SymbolicState::from_observation(

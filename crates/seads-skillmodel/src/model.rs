@@ -140,31 +140,17 @@ pub struct ForwardModel {
     d: usize,
     k: usize,
     device: Device,
-    vs: nn::VarStore,
-    net: Mlp,
-    opt: Adam,
+    network: Trainable,
 }
 
 impl ForwardModel {
     /// A fresh model for `d`-bit states and `k` skills, initialised from `seed`.
     pub fn new(d: usize, k: usize, config: &SkillModelConfig, device: Device, seed: u64) -> Self {
-        let vs = nn::VarStore::new(device);
-        let mut rng = ChaCha8Rng::seed_from_u64(seed);
-        let net = Mlp::new(
-            &(vs.root() / "forward_model"),
-            (d + k) as i64,
-            &config.hidden,
-            d as i64,
-            &mut rng,
-        );
-        let opt = Adam::new(&vs, config.lr);
         Self {
             d,
             k,
             device,
-            vs,
-            net,
-            opt,
+            network: Trainable::new("forward_model", d + k, d, config, device, seed),
         }
     }
 
@@ -175,7 +161,7 @@ impl ForwardModel {
 
     /// The network, for fast inference elsewhere (the planner's successor function).
     pub fn network(&self) -> &Mlp {
-        &self.net
+        &self.network.net
     }
 
     /// Network input rows `[z_0, onehot(k)]`.
@@ -206,7 +192,7 @@ impl ForwardModel {
     /// Flip logits of every state under every skill (n × K × D). The first layer is split into
     /// its z_0 part, computed once per state, and the skill's column, added per skill.
     pub fn flip_logits_all_skills(&self, z0: &Tensor) -> Tensor {
-        let layers = self.net.layers();
+        let layers = self.network.net.layers();
         let first = &layers[0];
         let (d, k) = (self.d as i64, self.k as i64);
         let w_state = first.ws.narrow(1, 0, d);
@@ -227,7 +213,7 @@ impl ForwardModel {
 
     /// Flip logits for each `(z_0, k)` (n × D): bit d flips in the mode iff its logit > 0.
     pub fn flip_logits(&self, z0: &[SymbolicState], skills: &[usize]) -> Tensor {
-        tch::no_grad(|| self.net.forward(&self.inputs(z0, skills)))
+        tch::no_grad(|| self.network.net.forward(&self.inputs(z0, skills)))
     }
 }
 
@@ -260,20 +246,20 @@ impl SkillModel for ForwardModel {
     fn train_step(&mut self, batch: &[SkillTransition]) -> f32 {
         let z0: Vec<SymbolicState> = batch.iter().map(|t| t.z0).collect();
         let skills: Vec<usize> = batch.iter().map(|t| t.skill).collect();
-        let logits = self.net.forward(&self.inputs(&z0, &skills));
+        let logits = self.network.net.forward(&self.inputs(&z0, &skills));
         let flipped = states_tensor(batch.iter().map(|t| t.z0 ^ t.zt), self.d, self.device);
         // The reference averages over the batch and the D bits.
         let loss = -Self::bit_log_likelihood(&logits, &flipped).mean(Kind::Float);
-        self.opt.backward_step(&loss);
+        self.network.opt.backward_step(&loss);
         mean_f32(&loss)
     }
 
     fn save(&self, dir: &Path) -> Result<(), SkillModelError> {
-        save_stores(dir, "forward_model", &self.vs, self.opt.state())
+        self.network.save(dir)
     }
 
     fn load(&mut self, dir: &Path) -> Result<(), SkillModelError> {
-        load_stores(dir, "forward_model", &mut self.vs, self.opt.state_mut())
+        self.network.load(dir)
     }
 }
 
@@ -283,31 +269,17 @@ pub struct SkillDiscriminator {
     d: usize,
     k: usize,
     device: Device,
-    vs: nn::VarStore,
-    net: Mlp,
-    opt: Adam,
+    network: Trainable,
 }
 
 impl SkillDiscriminator {
     /// A fresh discriminator for `d`-bit states and `k` skills, initialised from `seed`.
     pub fn new(d: usize, k: usize, config: &SkillModelConfig, device: Device, seed: u64) -> Self {
-        let vs = nn::VarStore::new(device);
-        let mut rng = ChaCha8Rng::seed_from_u64(seed);
-        let net = Mlp::new(
-            &(vs.root() / "discriminator"),
-            (3 * d) as i64,
-            &config.hidden,
-            k as i64,
-            &mut rng,
-        );
-        let opt = Adam::new(&vs, config.lr);
         Self {
             d,
             k,
             device,
-            vs,
-            net,
-            opt,
+            network: Trainable::new("discriminator", 3 * d, k, config, device, seed),
         }
     }
 
@@ -326,7 +298,7 @@ impl SkillDiscriminator {
         let x = Tensor::from_slice(&data)
             .view([n as i64, width as i64])
             .to_device(self.device);
-        self.net.forward(&x).log_softmax(1, Kind::Float)
+        self.network.net.forward(&x).log_softmax(1, Kind::Float)
     }
 }
 
@@ -352,50 +324,78 @@ impl SkillModel for SkillDiscriminator {
         let labels = Tensor::from_slice(&batch.iter().map(|t| t.skill as i64).collect::<Vec<_>>())
             .to_device(self.device);
         let loss = log_q.nll_loss(&labels);
-        self.opt.backward_step(&loss);
+        self.network.opt.backward_step(&loss);
         mean_f32(&loss)
     }
 
     fn save(&self, dir: &Path) -> Result<(), SkillModelError> {
-        save_stores(dir, "discriminator", &self.vs, self.opt.state())
+        self.network.save(dir)
     }
 
     fn load(&mut self, dir: &Path) -> Result<(), SkillModelError> {
-        load_stores(dir, "discriminator", &mut self.vs, self.opt.state_mut())
+        self.network.load(dir)
     }
 }
 
-fn save_stores(
-    dir: &Path,
-    name: &str,
-    vs: &nn::VarStore,
-    opt: &nn::VarStore,
-) -> Result<(), SkillModelError> {
-    vs.save(dir.join(format!("{name}.safetensors")))
-        .map_err(|e| SkillModelError::Io(e.to_string()))?;
-    opt.save(dir.join(format!("{name}_adam.safetensors")))
-        .map_err(|e| SkillModelError::Io(e.to_string()))
+/// A named network with its own var store and optimiser, saved as `<name>.safetensors` and
+/// `<name>_adam.safetensors` (the optimiser file is optional when loading, for evaluation).
+#[derive(Debug)]
+struct Trainable {
+    name: &'static str,
+    vs: nn::VarStore,
+    net: Mlp,
+    opt: Adam,
 }
 
-fn load_stores(
-    dir: &Path,
-    name: &str,
-    vs: &mut nn::VarStore,
-    opt: &mut nn::VarStore,
-) -> Result<(), SkillModelError> {
-    let path = dir.join(format!("{name}.safetensors"));
-    vs.load(&path).map_err(|e| SkillModelError::Checkpoint {
-        path: path.display().to_string(),
-        reason: e.to_string(),
-    })?;
-    let path = dir.join(format!("{name}_adam.safetensors"));
-    if path.exists() {
-        opt.load(&path).map_err(|e| SkillModelError::Checkpoint {
+impl Trainable {
+    fn new(
+        name: &'static str,
+        input: usize,
+        output: usize,
+        config: &SkillModelConfig,
+        device: Device,
+        seed: u64,
+    ) -> Self {
+        let vs = nn::VarStore::new(device);
+        let mut rng = ChaCha8Rng::seed_from_u64(seed);
+        let net = Mlp::new(
+            &(vs.root() / name),
+            input as i64,
+            &config.hidden,
+            output as i64,
+            &mut rng,
+        );
+        let opt = Adam::new(&vs, config.lr);
+        Self { name, vs, net, opt }
+    }
+
+    fn save(&self, dir: &Path) -> Result<(), SkillModelError> {
+        let io = |e: tch::TchError| SkillModelError::Io(e.to_string());
+        self.vs
+            .save(dir.join(format!("{}.safetensors", self.name)))
+            .map_err(io)?;
+        self.opt
+            .state()
+            .save(dir.join(format!("{}_adam.safetensors", self.name)))
+            .map_err(io)
+    }
+
+    fn load(&mut self, dir: &Path) -> Result<(), SkillModelError> {
+        let corrupt = |path: &Path, e: tch::TchError| SkillModelError::Checkpoint {
             path: path.display().to_string(),
             reason: e.to_string(),
-        })?;
+        };
+        let path = dir.join(format!("{}.safetensors", self.name));
+        self.vs.load(&path).map_err(|e| corrupt(&path, e))?;
+        let path = dir.join(format!("{}_adam.safetensors", self.name));
+        if path.exists() {
+            self.opt
+                .state_mut()
+                .load(&path)
+                .map_err(|e| corrupt(&path, e))?;
+        }
+        Ok(())
     }
-    Ok(())
 }
 
 #[cfg(test)]

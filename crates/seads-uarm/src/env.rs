@@ -245,20 +245,7 @@ impl Environment for UarmEnv {
     }
 
     fn step(&mut self, action: &[f32]) -> Result<StepOutcome, EnvError> {
-        if action.len() != self.spec.action_dim {
-            return Err(EnvError::ActionLength {
-                env: self.spec.name.clone(),
-                expected: self.spec.action_dim,
-                found: action.len(),
-            });
-        }
-        if let Some(index) = action.iter().position(|a| !a.is_finite()) {
-            return Err(EnvError::NonFiniteAction {
-                env: self.spec.name.clone(),
-                index,
-                value: action[index],
-            });
-        }
+        self.spec.check_action(action)?;
         if let Some(limit) = self.spec.step_limit
             && self.steps >= limit
         {
