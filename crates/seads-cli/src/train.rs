@@ -91,7 +91,11 @@ pub fn drive(run: &mut Run, quiet: bool) -> Result<()> {
             .progress_chars("=> "),
     );
     bar.set_position(run.trainer().env_steps().min(budget));
-    let mut coverage = f64::NAN;
+    // A resumed run shows its last evaluation until the next one.
+    let mut coverage = seads_rl::read_metrics(run.dir())
+        .ok()
+        .and_then(|m| m.last().map(|m| m.skill_coverage))
+        .unwrap_or(f64::NAN);
     let k = run.trainer().num_skills();
     while !run.finished() {
         let event = run.step().context("training")?;
