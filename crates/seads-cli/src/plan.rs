@@ -255,10 +255,12 @@ pub fn run_evaluation(
     })
     .map_err(|e| BadInput(e.into()))?;
     bar.finish_and_clear();
-    let name = if replan {
-        "evaluation-replan.json"
-    } else {
-        "evaluation-plan-once.json"
+    // The standard depths 1–5 are what `seads plot` draws; other studies are kept beside them.
+    let mode = if replan { "replan" } else { "plan-once" };
+    let name = match (depths.first(), depths.last()) {
+        (Some(1), Some(5)) if depths.len() == 5 => format!("evaluation-{mode}.json"),
+        (Some(a), Some(b)) => format!("evaluation-{mode}-depths-{a}-{b}.json"),
+        _ => format!("evaluation-{mode}.json"),
     };
     let path = run.join(name);
     let tmp = path.with_extension("tmp");
