@@ -21,9 +21,9 @@ pub struct RunArgs {
     /// Environment (its preset supplies every other setting).
     #[arg(long, default_value = "lightsout-cursor")]
     env: String,
-    /// Training budget in environment steps (the paper's Cursor budget is 500000; skills appear
-    /// after a few ten thousand).
-    #[arg(long, default_value_t = 50_000)]
+    /// Training budget in environment steps (the paper's Cursor budget is 500000; most skills
+    /// appear within 10⁵).
+    #[arg(long, default_value_t = 100_000)]
     env_steps: u64,
     /// Seed of the run.
     #[arg(long, default_value_t = 1)]
@@ -31,6 +31,10 @@ pub struct RunArgs {
     /// Boards per solution depth (1–5) in the evaluation.
     #[arg(long, default_value_t = 20)]
     boards: usize,
+    /// Time limit per search, seconds (a board that needs a move no skill makes is searched
+    /// until then).
+    #[arg(long, default_value_t = 10.0)]
+    timeout: f64,
 }
 
 /// `seads run`.
@@ -65,7 +69,7 @@ pub fn run(args: RunArgs) -> Result<()> {
         seeds: seeds.clone(),
         split: Split::Test,
         replan,
-        timeout: 60.0,
+        timeout: args.timeout,
     };
     let replan = run_evaluation(&mut agent, &args.out, tasks(true), false)?;
     let once = run_evaluation(&mut agent, &args.out, tasks(false), false)?;
@@ -82,7 +86,7 @@ pub fn run(args: RunArgs) -> Result<()> {
         );
     }
     let figures = args.out.join("figures");
-    let written = crate::plot::write_figures(&args.out, &figures, None, args.boards, 60.0, true)?;
+    let written = crate::plot::write_figures(&args.out, &figures, None, args.boards, args.timeout, true)?;
     println!("\nfigures ({}): {}", written.len(), figures.display());
     println!(
         "next: seads solve --run {} --board \"…\" --replan   (see seads --help)",
