@@ -5,8 +5,8 @@
 //! The arm moves instantly to commanded points; the pen cannot go below the screen (it rests on
 //! the glass). When the pen comes within 0.5 mm of the screen inside its area, the tablet
 //! registers a tap at that point (once per touch: the pen must lift by 1 mm before the next),
-//! presses the LightsOut field under it and logs a report. When a tap solves the board, the app
-//! shows a new random board (1–5 moves from the goal), as a game app starts a new level.
+//! presses the LightsOut field under it and logs a report. A solved board stays on the screen
+//! (the environment's reset shows a new one).
 
 use std::collections::VecDeque;
 use std::sync::{Arc, Mutex, MutexGuard};
@@ -253,9 +253,6 @@ impl World {
             self.board = self.game.apply(self.board, mv);
             self.seq += 1;
             self.last_move = Some(mv);
-            if self.game.is_goal(self.board) {
-                self.board = scramble(&self.game, &mut self.rng);
-            }
         } else if height_mm > 1.0 {
             self.touching = false;
         }

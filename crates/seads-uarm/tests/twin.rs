@@ -231,3 +231,14 @@ fn the_simulated_arm_records_and_replays_exactly() {
     let replayed = replay_episode(&mut env, &recorded).unwrap();
     assert_eq!(replayed, recorded);
 }
+
+#[test]
+fn a_solving_press_leaves_the_solved_board() {
+    let twin = Twin::new(9);
+    let mut env = env(&twin, ActionSpace::Absolute);
+    let game = LightsOut::new(5).unwrap();
+    env.set_board(game.apply(game.goal(), 7)).unwrap();
+    let out = env.step(&[0.5, 0.3]).unwrap();
+    assert_eq!(out.push, Push::Move(7));
+    assert!(game.is_goal(env.board()) && game.is_goal(twin.board()));
+}
