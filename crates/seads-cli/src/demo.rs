@@ -86,7 +86,8 @@ pub fn run(args: RunArgs) -> Result<()> {
         );
     }
     let figures = args.out.join("figures");
-    let written = crate::plot::write_figures(&args.out, &figures, None, args.boards, args.timeout, true)?;
+    let written =
+        crate::plot::write_figures(&args.out, &figures, None, args.boards, args.timeout, true)?;
     println!("\nfigures ({}): {}", written.len(), figures.display());
     println!(
         "next: seads solve --run {} --board \"…\" --replan   (see seads --help)",
