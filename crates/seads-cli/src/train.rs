@@ -105,7 +105,8 @@ pub fn drive(run: &mut Run, quiet: bool) -> Result<()> {
                 "epoch {:>6}  steps {:>9}  coverage {:>5.2}/{}  reward {:>6.2}  {:>6.0} steps/s",
                 m.epoch, m.env_steps, m.skill_coverage, k, m.mean_reward, m.steps_per_s
             );
-            if quiet {
+            // A hidden bar (quiet, or output not a terminal) drops `println`: print directly.
+            if bar.is_hidden() {
                 println!("{line}");
             } else {
                 bar.println(line);
@@ -123,6 +124,13 @@ pub fn drive(run: &mut Run, quiet: bool) -> Result<()> {
         ));
     }
     bar.finish_and_clear();
+    if coverage.is_nan() {
+        // Nothing was evaluated in this call (e.g. a finished run resumed): show the record.
+        coverage = seads_rl::read_metrics(run.dir())
+            .ok()
+            .and_then(|m| m.last().map(|m| m.skill_coverage))
+            .unwrap_or(f64::NAN);
+    }
     let t = run.trainer().timings();
     println!(
         "trained {} epochs, {} steps in {:.0} s: skill coverage {:.2}/{}; run directory {}",
