@@ -51,7 +51,6 @@ struct World {
     board: SymbolicState,
     seq: u64,
     last_move: Option<usize>,
-    rng: ChaCha8Rng,
     /// Every G0 target received (for tests: where the arm was sent).
     trail: Vec<[f64; 3]>,
 }
@@ -97,7 +96,6 @@ impl Twin {
             board,
             seq: 0,
             last_move: None,
-            rng,
             trail: Vec::new(),
         };
         Self {
