@@ -51,7 +51,9 @@ pub fn policy_input(obs: &[f32], skill: usize, row: &mut [f32]) {
 
 /// Runs skill `skills[i]` on `envs[i]` (already reset or positioned) until each skill ends, with
 /// one batched policy call per time step. Actions are sampled with noise from `rng`, or
-/// deterministic when `rng` is `None`. Environments are stepped on rayon's pool.
+/// deterministic when `rng` is `None`. Environments are stepped on rayon's pool, except
+/// exclusive ones (clones of one robot, [`EnvSpec::exclusive`](seads_embodiment::EnvSpec)):
+/// their episodes run one after another, each starting where the previous one left the robot.
 pub fn run_episodes(
     envs: &mut [Box<dyn Environment>],
     skills: &[usize],
@@ -62,6 +64,20 @@ pub fn run_episodes(
     let Some(first) = envs.first() else {
         return Ok(Vec::new());
     };
+    if first.spec().exclusive && envs.len() > 1 {
+        let mut episodes = Vec::with_capacity(envs.len());
+        for (env, &skill) in envs.iter_mut().zip(skills) {
+            let one = std::slice::from_mut(env);
+            episodes.extend(run_episodes(
+                one,
+                &[skill],
+                policy,
+                num_skills,
+                rng.as_deref_mut(),
+            )?);
+        }
+        return Ok(episodes);
+    }
     let spec = first.spec().clone();
     let (o, a, width) = (spec.obs_dim, spec.action_dim, spec.obs_dim + num_skills);
     let mut episodes: Vec<Episode> = envs

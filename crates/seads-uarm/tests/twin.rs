@@ -242,3 +242,42 @@ fn a_solving_press_leaves_the_solved_board() {
     assert_eq!(out.push, Push::Move(7));
     assert!(game.is_goal(env.board()) && game.is_goal(twin.board()));
 }
+
+/// Clones of the robot share one board: a trainer's episodes on them must run one after
+/// another, so that each records the board its own push started from.
+#[test]
+fn episodes_on_one_robot_run_one_after_another() {
+    use rand::SeedableRng;
+    use seads_rl::{Sac, SacConfig, run_episodes};
+    let twin = Twin::new(5);
+    let mut config_env = env(&twin, ActionSpace::Absolute);
+    config_env.reset();
+    let k = 25;
+    let input = config_env.spec().obs_dim + k;
+    let spec = config_env.spec().clone();
+    let sac = Sac::new(
+        input,
+        &spec.action_low,
+        &spec.action_high,
+        &SacConfig::default(),
+        tch::Device::Cpu,
+        2,
+    );
+    let mut envs: Vec<Box<dyn Environment>> = (0..6).map(|_| config_env.box_clone()).collect();
+    let skills = [0, 3, 7, 11, 19, 24];
+    let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(9);
+    let episodes = run_episodes(&mut envs, &skills, &sac, k, Some(&mut rng)).unwrap();
+    let game = LightsOut::new(5).unwrap();
+    let mut board = episodes[0].z0;
+    for e in &episodes {
+        assert_eq!(
+            e.z0, board,
+            "each episode starts where the previous one ended"
+        );
+        let mv = e
+            .game_move
+            .expect("an absolute push always presses a field");
+        assert_eq!(e.zt, game.apply(e.z0, mv), "one push, one move");
+        board = e.zt;
+    }
+}
