@@ -1,0 +1,32 @@
+//! One SAC update at the sizes of `lightsout-cursor` (policy input 28 + 25, 2-D action, hidden
+//! 256 × 256, batch 128) on one libtorch thread: the SAC phase of an epoch is 16 of these.
+
+use criterion::{Criterion, criterion_group, criterion_main};
+use rand::{RngExt, SeedableRng};
+use rand_chacha::ChaCha8Rng;
+use seads_rl::{Sac, SacConfig, TransitionBatch};
+use tch::Device;
+
+fn sac_update(c: &mut Criterion) {
+    tch::set_num_threads(1);
+    let (input, batch) = (53, 128);
+    let config = SacConfig::default();
+    let mut sac = Sac::new(input, &[-1.0, -1.0], &[1.0, 1.0], &config, Device::Cpu, 1);
+    let mut rng = ChaCha8Rng::seed_from_u64(2);
+    let mut random =
+        |n: usize| -> Vec<f32> { (0..n).map(|_| rng.random_range(-1.0..1.0)).collect() };
+    let transitions = TransitionBatch {
+        obs: random(batch * input),
+        actions: random(batch * 2),
+        rewards: random(batch),
+        next_obs: random(batch * input),
+        dones: vec![1.0; batch],
+    };
+    let mut rng = ChaCha8Rng::seed_from_u64(3);
+    c.bench_function("sac_update_hidden256_batch128", |b| {
+        b.iter(|| sac.update(&transitions, &mut rng))
+    });
+}
+
+criterion_group!(benches, sac_update);
+criterion_main!(benches);
