@@ -124,13 +124,6 @@ pub fn drive(run: &mut Run, quiet: bool) -> Result<()> {
         ));
     }
     bar.finish_and_clear();
-    if coverage.is_nan() {
-        // Nothing was evaluated in this call (e.g. a finished run resumed): show the record.
-        coverage = seads_rl::read_metrics(run.dir())
-            .ok()
-            .and_then(|m| m.last().map(|m| m.skill_coverage))
-            .unwrap_or(f64::NAN);
-    }
     let t = run.trainer().timings();
     println!(
         "trained {} epochs, {} steps in {:.0} s: skill coverage {:.2}/{}; run directory {}",

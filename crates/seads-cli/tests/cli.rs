@@ -9,14 +9,19 @@ fn seads(args: &[&str]) -> Output {
         .expect("run seads")
 }
 
-fn json(args: &[&str]) -> serde_json::Value {
+/// Runs seads and asserts that it succeeded.
+fn seads_ok(args: &[&str]) -> Output {
     let out = seads(args);
     assert!(
         out.status.success(),
         "seads {args:?}: {}",
         String::from_utf8_lossy(&out.stderr)
     );
-    serde_json::from_slice(&out.stdout).expect("valid JSON")
+    out
+}
+
+fn json(args: &[&str]) -> serde_json::Value {
+    serde_json::from_slice(&seads_ok(args).stdout).expect("valid JSON")
 }
 
 /// Exit code 2 and a single `error:` line on stderr.
@@ -196,7 +201,7 @@ fn render_writes_png_and_svg() {
     let dir = tempfile::tempdir().unwrap();
     for (env, file) in [("tileswap-cursor", "a.png"), ("lightsout-reacher", "b.svg")] {
         let out = dir.path().join(file);
-        let status = seads(&[
+        seads_ok(&[
             "render",
             "--env",
             env,
@@ -205,11 +210,6 @@ fn render_writes_png_and_svg() {
             "--out",
             out.to_str().unwrap(),
         ]);
-        assert!(
-            status.status.success(),
-            "{}",
-            String::from_utf8_lossy(&status.stderr)
-        );
         let bytes = std::fs::read(&out).unwrap();
         if file.ends_with(".png") {
             assert_eq!(&bytes[1..4], b"PNG");
@@ -281,7 +281,7 @@ fn train_writes_a_run_directory_and_resumes() {
     let dir = tempfile::tempdir().unwrap();
     let run = dir.path().join("run");
     let config = tiny_config(dir.path());
-    let out = seads(&[
+    let out = seads_ok(&[
         "train",
         "--config",
         config.to_str().unwrap(),
@@ -291,11 +291,6 @@ fn train_writes_a_run_directory_and_resumes() {
         "3",
         "--quiet",
     ]);
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
     let stdout = String::from_utf8_lossy(&out.stdout);
     assert!(
         stdout.contains("coverage") && stdout.contains("time per phase"),
@@ -311,12 +306,7 @@ fn train_writes_a_run_directory_and_resumes() {
     assert!(last["env_steps"].as_u64().unwrap() >= 600);
     assert!(run.join("checkpoints/latest").exists());
     // Resuming a finished run has nothing left to do but succeeds.
-    let out = seads(&["train", "--resume", run.to_str().unwrap(), "--quiet"]);
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+    seads_ok(&["train", "--resume", run.to_str().unwrap(), "--quiet"]);
     // The same directory cannot be trained into twice.
     check_bad_input(
         &[
@@ -383,7 +373,7 @@ fn tiny_run() -> &'static std::path::Path {
         let dir = tempfile::tempdir().unwrap();
         let config = tiny_config(dir.path());
         let run = dir.path().join("run");
-        let out = seads(&[
+        seads_ok(&[
             "train",
             "--config",
             config.to_str().unwrap(),
@@ -391,11 +381,6 @@ fn tiny_run() -> &'static std::path::Path {
             run.to_str().unwrap(),
             "--quiet",
         ]);
-        assert!(
-            out.status.success(),
-            "{}",
-            String::from_utf8_lossy(&out.stderr)
-        );
         dir
     })
     .path()
@@ -456,7 +441,7 @@ fn solve_evaluate_and_plot_a_trained_run() {
     let rate = v["success_rate"]["1"].as_f64().unwrap();
     assert!((0.0..=1.0).contains(&rate));
     let figures = tiny_run().join("figures");
-    let out = seads(&[
+    seads_ok(&[
         "plot",
         "--run",
         run,
@@ -467,11 +452,6 @@ fn solve_evaluate_and_plot_a_trained_run() {
         "--timeout",
         "0.5",
     ]);
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
     for name in ["coverage", "success", "trajectories", "pushes"] {
         assert_eq!(
             &std::fs::read(figures.join(format!("{name}.png"))).unwrap()[1..4],
@@ -506,7 +486,7 @@ fn record_and_replay_round_trip() {
     for env in ["tileswap-cursor", "lightsout-reacher"] {
         let rec = dir.path().join(format!("{env}.jsonl"));
         let re = dir.path().join(format!("{env}.re.jsonl"));
-        let out = seads(&[
+        seads_ok(&[
             "record",
             "--env",
             env,
@@ -519,12 +499,7 @@ fn record_and_replay_round_trip() {
             "--out",
             rec.to_str().unwrap(),
         ]);
-        assert!(
-            out.status.success(),
-            "{}",
-            String::from_utf8_lossy(&out.stderr)
-        );
-        let out = seads(&[
+        let out = seads_ok(&[
             "replay",
             "--env",
             env,
@@ -534,11 +509,6 @@ fn record_and_replay_round_trip() {
             re.to_str().unwrap(),
             "--compare",
         ]);
-        assert!(
-            out.status.success(),
-            "{}",
-            String::from_utf8_lossy(&out.stderr)
-        );
         assert!(String::from_utf8_lossy(&out.stdout).contains("0 board and 0 move mismatches"));
         assert_eq!(
             std::fs::read_to_string(&rec).unwrap(),
@@ -619,7 +589,7 @@ fn replay_reports_bad_lines_with_their_number() {
         "valid environments",
     );
     let jaco = dir.path().join("jaco.jsonl");
-    let out = seads(&[
+    seads_ok(&[
         "record",
         "--env",
         "lightsout-jaco",
@@ -630,11 +600,6 @@ fn replay_reports_bad_lines_with_their_number() {
         "--out",
         jaco.to_str().unwrap(),
     ]);
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
     check_bad_input(
         &[
             "replay",
@@ -653,7 +618,7 @@ fn replay_reports_bad_lines_with_their_number() {
 fn uarm_twin_calibrates_and_trains() {
     let dir = tempfile::tempdir().unwrap();
     let cal = dir.path().join("cal.toml");
-    let out = seads(&[
+    seads_ok(&[
         "uarm",
         "calibrate",
         "--port",
@@ -662,17 +627,12 @@ fn uarm_twin_calibrates_and_trains() {
         cal.to_str().unwrap(),
     ]);
     assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    assert!(
         std::fs::read_to_string(&cal)
             .unwrap()
             .contains("corners = [[160.0, 108.5, 5.0]")
     );
     let run = dir.path().join("run");
-    let out = seads(&[
+    let out = seads_ok(&[
         "uarm",
         "train",
         "--port",
@@ -689,11 +649,6 @@ fn uarm_twin_calibrates_and_trains() {
         run.to_str().unwrap(),
         "--quiet",
     ]);
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
     let stdout = String::from_utf8_lossy(&out.stdout);
     assert!(stdout.contains("of 5 boards with re-planning"), "{stdout}");
     assert!(
