@@ -132,8 +132,6 @@ pub struct Sac {
     /// The critics' and the targets' parameters as flat buffers of the same layout.
     critic_flat: Tensor,
     target_flat: Tensor,
-    /// The critics' parameters, frozen while the actor's loss is differentiated.
-    critic_params: Vec<Tensor>,
 }
 
 const LOG_STD_MIN: f64 = -20.0;
@@ -197,7 +195,6 @@ impl Sac {
         let critic_opt = Adam::new(&critic_vs, config.lr);
         let critic_flat = critic_opt.parameters().shallow_clone();
         let target_flat = flatten_parameters(&target_vs);
-        let critic_params = critic_vs.trainable_variables();
         Self {
             config: config.clone(),
             input_dim,
@@ -215,7 +212,6 @@ impl Sac {
             critic_opt,
             critic_flat,
             target_flat,
-            critic_params,
         }
     }
 
@@ -288,12 +284,6 @@ impl Sac {
         })
     }
 
-    fn set_critics_trainable(&self, trainable: bool) {
-        for p in &self.critic_params {
-            let _ = p.set_requires_grad(trainable);
-        }
-    }
-
     fn min_q(q: &[Mlp; 2], x: &Tensor, a: &Tensor) -> Tensor {
         let xa = Tensor::cat(&[x, a], 1);
         q[0].forward(&xa).minimum(&q[1].forward(&xa))
@@ -325,13 +315,13 @@ impl Sac {
         self.critic_opt.backward_step(&critic_loss);
 
         // The actor's loss flows through the critics to the action; their weights need no
-        // gradient (the critic step zeroes them anyway), which saves a third of that backward.
-        self.set_critics_trainable(false);
+        // gradient (the critic step zeroes them anyway), so the critics are frozen meanwhile.
+        self.critic_vs.freeze();
         let (new_action, log_prob) = self.sample(&obs, &self.gaussian(rows, rng));
         let q = Self::min_q(&self.q, &obs, &new_action);
         let actor_loss = (log_prob * alpha - &q).mean(Kind::Float);
         self.actor_opt.backward_step(&actor_loss);
-        self.set_critics_trainable(true);
+        self.critic_vs.unfreeze();
 
         let tau = self.config.tau;
         tch::no_grad(|| {
