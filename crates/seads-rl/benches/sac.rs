@@ -1,7 +1,7 @@
 //! One SAC update at the sizes of `lightsout-cursor` (policy input 28 + 25, 2-D action, hidden
 //! 256 × 256, batch 128) on one libtorch thread: the SAC phase of an epoch is 16 of these.
 
-use criterion::{Criterion, criterion_group, criterion_main};
+use criterion::{Criterion, criterion_group};
 use rand::{RngExt, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use seads_rl::{Sac, SacConfig, TransitionBatch};
@@ -29,4 +29,3 @@ fn sac_update(c: &mut Criterion) {
 }
 
 criterion_group!(benches, sac_update);
-criterion_main!(benches);
