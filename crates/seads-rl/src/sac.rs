@@ -154,40 +154,14 @@ impl Sac {
         let mean = Mlp::new(&(actor_vs.root() / "actor"), i, &config.hidden, a, &mut rng);
         let last = *config.hidden.last().expect("validated");
         let log_std = xavier_linear(&(actor_vs.root() / "actor_log_std"), last, a, &mut rng);
+        // Twin critics (their targets are initialised the same way, then overwritten by a copy).
+        let twin_critics = |vs: &nn::VarStore, rng: &mut ChaCha8Rng| {
+            ["q1", "q2"].map(|name| Mlp::new(&(vs.root() / name), i + a, &config.hidden, 1, rng))
+        };
         let critic_vs = nn::VarStore::new(device);
-        let q = [
-            Mlp::new(
-                &(critic_vs.root() / "q1"),
-                i + a,
-                &config.hidden,
-                1,
-                &mut rng,
-            ),
-            Mlp::new(
-                &(critic_vs.root() / "q2"),
-                i + a,
-                &config.hidden,
-                1,
-                &mut rng,
-            ),
-        ];
+        let q = twin_critics(&critic_vs, &mut rng);
         let mut target_vs = nn::VarStore::new(device);
-        let q_target = [
-            Mlp::new(
-                &(target_vs.root() / "q1"),
-                i + a,
-                &config.hidden,
-                1,
-                &mut rng,
-            ),
-            Mlp::new(
-                &(target_vs.root() / "q2"),
-                i + a,
-                &config.hidden,
-                1,
-                &mut rng,
-            ),
-        ];
+        let q_target = twin_critics(&target_vs, &mut rng);
         target_vs.copy(&critic_vs).expect("same layout");
         let scale: Vec<f32> = low.iter().zip(high).map(|(l, h)| (h - l) / 2.0).collect();
         let bias: Vec<f32> = low.iter().zip(high).map(|(l, h)| (h + l) / 2.0).collect();
