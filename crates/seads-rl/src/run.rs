@@ -27,6 +27,7 @@ const RESUME_ONLY: &[&str] = &[
     "forward_model_adam.safetensors",
     "discriminator_adam.safetensors",
     "episodes.safetensors",
+    crate::trainer::PREPARED_FILE,
 ];
 
 /// One line of `metrics.jsonl`.

@@ -28,7 +28,7 @@ struct Streams {
     collect: ChaCha8Rng,
     /// Buffer sampling and relabelling choices.
     sample: ChaCha8Rng,
-    /// SAC update noise and minibatches.
+    /// SAC update noise.
     sac: ChaCha8Rng,
 }
 
@@ -75,6 +75,9 @@ struct Progress {
     streams: Streams,
 }
 
+/// The checkpoint file of the prepared next updates (absent when there are none).
+pub(crate) const PREPARED_FILE: &str = "prepared.safetensors";
+
 /// A SEADS agent in training.
 pub struct Trainer {
     config: TrainConfig,
@@ -86,8 +89,17 @@ pub struct Trainer {
     model: Box<dyn SkillModel>,
     episodes: VecDeque<Episode>,
     progress: Progress,
-    /// The next epoch's relabelled skill-model batch, prepared while SAC updates.
-    prepared: Option<Vec<SkillTransition>>,
+    /// The next epoch's updates, prepared while SAC updated: the skill model has taken its
+    /// steps, and the SAC minibatches wait here.
+    prepared: Option<Prepared>,
+}
+
+/// An epoch's skill-model update done and its SAC minibatches relabelled, ready for SAC.
+#[derive(Debug, Clone, Default)]
+struct Prepared {
+    minibatches: Vec<TransitionBatch>,
+    mean_reward: f32,
+    skill_model_loss: f32,
 }
 
 impl Trainer {
@@ -216,13 +228,14 @@ impl Trainer {
 
     /// One epoch of Algorithm 3.
     ///
-    /// Order within an epoch: collect the new episodes with the parameters of the start of the
-    /// epoch (the reference collects in the background while it updates); update the skill model
-    /// on a relabelled batch (p = 1); score and relabel an independent batch (p = 0.5, only
-    /// board-changing episodes) with the updated model; take the SAC steps. The new episodes join
-    /// the buffers after the updates. The next epoch's skill-model batch depends only on those
-    /// buffers and on the updated model, so it is sampled, scored and relabelled on a second
-    /// thread while SAC updates: the same computation as doing it at the start of the next epoch.
+    /// The updates of epoch n use the buffers as they were before its new episodes arrive and
+    /// need nothing from its collection, so they are prepared ahead: while SAC takes epoch n's
+    /// steps on one thread, the calling thread appends epoch n's episodes, takes epoch n + 1's
+    /// skill-model steps (on a batch relabelled with p = 1) and scores and relabels epoch n + 1's
+    /// SAC batch (p = 0.5, only board-changing episodes) with the updated model. That is the
+    /// same computation as Algorithm 3 done in order; only the two halves run side by side.
+    /// Episodes are collected first, with the parameters of the start of the epoch (the
+    /// reference collects in the background while it updates).
     pub fn run_epoch(&mut self) -> Result<EpochStats, RlError> {
         let mut stats = EpochStats {
             epoch: self.progress.epoch,
@@ -245,89 +258,50 @@ impl Trainer {
         )?;
         self.progress.timings.collect += start.elapsed().as_secs_f64();
         stats.changed = new.iter().filter(|e| e.changed()).count() as f32 / new.len().max(1) as f32;
-
         let new_steps: u64 = new.iter().map(|e| e.len(self.spec.action_dim) as u64).sum();
-        let mut buffers = Buffers {
-            config: &self.config,
-            k: self.k,
-            episodes: &mut self.episodes,
-            rng: &mut self.progress.streams.sample,
+        let finished = self.progress.env_steps + new_steps >= self.config.env_steps;
+
+        let mut prepare = Prepare {
+            buffers: Buffers {
+                config: &self.config,
+                k: self.k,
+                episodes: &mut self.episodes,
+                rng: &mut self.progress.streams.sample,
+            },
+            model: self.model.as_mut(),
+            spec: &self.spec,
+            timings: &mut self.progress.timings,
         };
-        if buffers.ready() {
-            stats.updated = true;
-            // Step 3a: the skill model, on the batch prepared last epoch (or now, the first time).
-            let tuples = match self.prepared.take() {
-                Some(tuples) => tuples,
-                None => {
-                    let start = Instant::now();
-                    let tuples = buffers.skill_model_batch(self.model.as_ref());
-                    self.progress.timings.relabel += start.elapsed().as_secs_f64();
-                    tuples
-                }
-            };
-            let start = Instant::now();
-            let config = &self.config.skill_model;
-            let mut loss = 0.0;
-            for _ in 0..config.updates_per_epoch {
-                let minibatch: Vec<SkillTransition> = (0..config.batch_size)
-                    .map(|_| tuples[buffers.rng.random_range(0..tuples.len())])
-                    .collect();
-                loss += self.model.train_step(&minibatch);
-            }
-            stats.skill_model_loss = loss / config.updates_per_epoch.max(1) as f32;
-            self.progress.timings.skill_model += start.elapsed().as_secs_f64();
-
-            // Step 3b: SAC minibatches from an independently relabelled batch.
-            let start = Instant::now();
-            let (minibatches, mean_reward) = buffers.sac_minibatches(
-                self.model.as_ref(),
-                &self.spec,
-                &self.config,
-                &mut self.progress.streams.sac,
-            );
-            stats.mean_reward = mean_reward;
-            self.progress.timings.relabel += start.elapsed().as_secs_f64();
-
-            let (sac, model, sac_rng) = (
-                &mut self.sac,
-                &mut self.model,
-                &mut self.progress.streams.sac,
-            );
-            let ((losses, sac_s), (prepared, prepare_s)) = std::thread::scope(|scope| {
-                let updates = scope.spawn(move || {
-                    let start = Instant::now();
-                    let mut total = SacLosses::default();
-                    for minibatch in &minibatches {
-                        let l = sac.update(minibatch, sac_rng);
-                        total.critic += l.critic;
-                        total.actor += l.actor;
-                        total.q += l.q;
-                    }
-                    let n = minibatches.len().max(1) as f32;
-                    (
-                        SacLosses {
-                            critic: total.critic / n,
-                            actor: total.actor / n,
-                            q: total.q / n,
-                        },
-                        start.elapsed().as_secs_f64(),
-                    )
-                });
+        // The first epoch with a full buffer (or the first after a resume) prepares its own.
+        let prepared = match self.prepared.take() {
+            Some(prepared) => Some(prepared),
+            None => prepare.buffers.ready().then(|| prepare.updates()),
+        };
+        let Some(prepared) = prepared else {
+            prepare.buffers.push(new);
+            self.progress.env_steps += new_steps;
+            self.progress.epoch += 1;
+            stats.env_steps = self.progress.env_steps;
+            return Ok(stats);
+        };
+        stats.updated = true;
+        stats.mean_reward = prepared.mean_reward;
+        stats.skill_model_loss = prepared.skill_model_loss;
+        let (sac, sac_rng) = (&mut self.sac, &mut self.progress.streams.sac);
+        let ((losses, sac_s), next) = std::thread::scope(|scope| {
+            let updates = scope.spawn(move || {
                 let start = Instant::now();
-                buffers.push(new);
-                let prepared = buffers
-                    .ready()
-                    .then(|| buffers.skill_model_batch(model.as_ref()));
-                let prepare_s = start.elapsed().as_secs_f64();
-                (updates.join().expect("SAC thread"), (prepared, prepare_s))
+                let losses = sac_updates(sac, &prepared.minibatches, sac_rng);
+                (losses, start.elapsed().as_secs_f64())
             });
-            stats.sac = losses;
-            self.prepared = prepared;
-            self.progress.timings.sac += sac_s;
-            self.progress.timings.relabel += prepare_s;
-        } else {
-            buffers.push(new);
-        }
+            prepare.buffers.push(new);
+            // No next epoch once the budget is spent: the final skill model is epoch n's.
+            let next = (!finished && prepare.buffers.ready()).then(|| prepare.updates());
+            (updates.join().expect("SAC thread"), next)
+        });
+        stats.sac = losses;
+        self.prepared = next;
+        self.progress.timings.sac += sac_s;
         self.progress.env_steps += new_steps;
         self.progress.epoch += 1;
         stats.env_steps = self.progress.env_steps;
@@ -352,6 +326,9 @@ impl Trainer {
         self.sac.save(dir)?;
         self.model.save(dir)?;
         self.save_buffer(&dir.join("episodes.safetensors"))?;
+        if let Some(prepared) = &self.prepared {
+            prepared.save(&dir.join(PREPARED_FILE))?;
+        }
         let path = dir.join("progress.json");
         std::fs::write(
             &path,
@@ -372,7 +349,13 @@ impl Trainer {
         self.sac.load(dir, false)?;
         self.model.load(dir)?;
         self.load_buffer(&dir.join("episodes.safetensors"))?;
-        self.prepared = None;
+        let path = dir.join(PREPARED_FILE);
+        self.prepared = if path.exists() {
+            let width = self.spec.obs_dim + self.k;
+            Some(Prepared::load(&path, width, self.spec.action_dim)?)
+        } else {
+            None
+        };
         let path = dir.join("progress.json");
         let text = std::fs::read_to_string(&path).map_err(|e| RlError::io(&path, e))?;
         self.progress = serde_json::from_str(&text).map_err(|e| RlError::Checkpoint {
@@ -471,6 +454,147 @@ impl Trainer {
             return Err(corrupt("trailing episode data".into()));
         }
         Ok(())
+    }
+}
+
+impl Prepared {
+    /// Writes the minibatches (stacked) and the two statistics.
+    fn save(&self, path: &Path) -> Result<(), RlError> {
+        let stack = |part: fn(&TransitionBatch) -> &[f32]| {
+            Tensor::from_slice(
+                &self
+                    .minibatches
+                    .iter()
+                    .flat_map(|b| part(b).iter().copied())
+                    .collect::<Vec<f32>>(),
+            )
+        };
+        let rows: Vec<i64> = self
+            .minibatches
+            .iter()
+            .map(|b| b.rewards.len() as i64)
+            .collect();
+        let tensors = [
+            ("obs", stack(|b| &b.obs)),
+            ("actions", stack(|b| &b.actions)),
+            ("rewards", stack(|b| &b.rewards)),
+            ("next_obs", stack(|b| &b.next_obs)),
+            ("dones", stack(|b| &b.dones)),
+            ("rows", Tensor::from_slice(&rows)),
+            (
+                "stats",
+                Tensor::from_slice(&[self.mean_reward, self.skill_model_loss]),
+            ),
+        ];
+        Tensor::write_safetensors(&tensors, path).map_err(|e| RlError::io(path, e))
+    }
+
+    /// Reads what [`Prepared::save`] wrote, for policy inputs of `width` and actions of
+    /// `action_dim` values.
+    fn load(path: &Path, width: usize, action_dim: usize) -> Result<Self, RlError> {
+        let corrupt = |reason: String| RlError::Checkpoint {
+            path: path.display().to_string(),
+            reason,
+        };
+        let tensors = Tensor::read_safetensors(path).map_err(|e| corrupt(e.to_string()))?;
+        let floats = |name: &str| -> Result<Vec<f32>, RlError> {
+            let tensor = tensors
+                .iter()
+                .find(|(n, _)| n == name)
+                .map(|(_, t)| t.to_kind(Kind::Float).view([-1]))
+                .ok_or_else(|| corrupt(format!("no tensor {name:?}")))?;
+            Vec::<f32>::try_from(tensor).map_err(|e| corrupt(e.to_string()))
+        };
+        let rows: Vec<usize> = floats("rows")?.iter().map(|&r| r as usize).collect();
+        let total: usize = rows.iter().sum();
+        let (obs, actions, rewards) = (floats("obs")?, floats("actions")?, floats("rewards")?);
+        let (next_obs, dones, stats) = (floats("next_obs")?, floats("dones")?, floats("stats")?);
+        if obs.len() != total * width
+            || next_obs.len() != total * width
+            || actions.len() != total * action_dim
+            || rewards.len() != total
+            || dones.len() != total
+            || stats.len() != 2
+        {
+            return Err(corrupt(
+                "prepared minibatches do not match the environment".into(),
+            ));
+        }
+        let mut minibatches = Vec::with_capacity(rows.len());
+        let mut first = 0;
+        for n in rows {
+            let part =
+                |values: &[f32], cols: usize| values[first * cols..(first + n) * cols].to_vec();
+            minibatches.push(TransitionBatch {
+                obs: part(&obs, width),
+                actions: part(&actions, action_dim),
+                rewards: part(&rewards, 1),
+                next_obs: part(&next_obs, width),
+                dones: part(&dones, 1),
+            });
+            first += n;
+        }
+        Ok(Self {
+            minibatches,
+            mean_reward: stats[0],
+            skill_model_loss: stats[1],
+        })
+    }
+}
+
+/// SAC steps on the given minibatches; returns their mean losses.
+fn sac_updates(sac: &mut Sac, minibatches: &[TransitionBatch], rng: &mut ChaCha8Rng) -> SacLosses {
+    let mut total = SacLosses::default();
+    for minibatch in minibatches {
+        let l = sac.update(minibatch, rng);
+        total.critic += l.critic;
+        total.actor += l.actor;
+        total.q += l.q;
+    }
+    let n = minibatches.len().max(1) as f32;
+    SacLosses {
+        critic: total.critic / n,
+        actor: total.actor / n,
+        q: total.q / n,
+    }
+}
+
+/// What preparing an epoch's updates works on: everything but SAC, which updates meanwhile.
+struct Prepare<'a> {
+    buffers: Buffers<'a>,
+    model: &'a mut dyn SkillModel,
+    spec: &'a EnvSpec,
+    timings: &'a mut Timings,
+}
+
+impl Prepare<'_> {
+    /// Steps 3a and 3b of an epoch up to SAC: the skill-model update on a batch relabelled with
+    /// p = 1, then an independent batch scored and relabelled with the updated model and cut
+    /// into SAC minibatches.
+    fn updates(&mut self) -> Prepared {
+        let start = Instant::now();
+        let tuples = self.buffers.skill_model_batch(&*self.model);
+        self.timings.relabel += start.elapsed().as_secs_f64();
+
+        let start = Instant::now();
+        let config = &self.buffers.config.skill_model;
+        let mut loss = 0.0;
+        for _ in 0..config.updates_per_epoch {
+            let minibatch: Vec<SkillTransition> = (0..config.batch_size)
+                .map(|_| tuples[self.buffers.rng.random_range(0..tuples.len())])
+                .collect();
+            loss += self.model.train_step(&minibatch);
+        }
+        self.timings.skill_model += start.elapsed().as_secs_f64();
+
+        let start = Instant::now();
+        let (minibatches, mean_reward) = self.buffers.sac_minibatches(&*self.model, self.spec);
+        self.timings.relabel += start.elapsed().as_secs_f64();
+        Prepared {
+            minibatches,
+            mean_reward,
+            skill_model_loss: loss / config.updates_per_epoch.max(1) as f32,
+        }
     }
 }
 
@@ -601,9 +725,8 @@ impl Buffers<'_> {
         &mut self,
         model: &dyn SkillModel,
         spec: &EnvSpec,
-        config: &TrainConfig,
-        rng: &mut ChaCha8Rng,
     ) -> (Vec<TransitionBatch>, f32) {
+        let config = self.config;
         let batch = self.update_batch();
         // Only board-changing episodes need scores: the others get the minimum reward and are
         // never relabelled.
@@ -626,7 +749,7 @@ impl Buffers<'_> {
         let minibatches = (0..config.sac.updates_per_epoch)
             .map(|_| {
                 let picks: Vec<(usize, usize)> = (0..config.sac.batch_size)
-                    .map(|_| transitions[rng.random_range(0..transitions.len())])
+                    .map(|_| transitions[self.rng.random_range(0..transitions.len())])
                     .collect();
                 self.transition_batch(spec, &batch, &labels, &finals, &picks)
             })

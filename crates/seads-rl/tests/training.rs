@@ -157,6 +157,34 @@ fn resume_continues_from_the_last_checkpoint() {
     assert!(all.last().unwrap().1.join("episodes.safetensors").exists());
 }
 
+/// A checkpoint holds the updates already prepared for the next epoch (the skill model steps
+/// ahead of SAC): a trainer restored from it takes the same SAC steps on the same relabelled
+/// batch as the one that saved it.
+#[test]
+fn a_checkpoint_keeps_the_prepared_updates() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut trainer = Trainer::new(small(5, 100_000)).unwrap();
+    for _ in 0..4 {
+        trainer.run_epoch().unwrap();
+    }
+    trainer.save(dir.path()).unwrap();
+    assert!(dir.path().join("prepared.safetensors").exists());
+    let mut restored = Trainer::new(small(5, 100_000)).unwrap();
+    restored.load(dir.path()).unwrap();
+    let (a, b) = (trainer.run_epoch().unwrap(), restored.run_epoch().unwrap());
+    assert!(a.updated && b.updated);
+    assert_eq!(a.mean_reward.to_bits(), b.mean_reward.to_bits());
+    assert_eq!(a.skill_model_loss.to_bits(), b.skill_model_loss.to_bits());
+    assert_eq!(a.sac.critic.to_bits(), b.sac.critic.to_bits());
+    assert_eq!(a.sac.actor.to_bits(), b.sac.actor.to_bits());
+
+    std::fs::write(dir.path().join("prepared.safetensors"), b"garbage").unwrap();
+    let err = restored
+        .load(dir.path())
+        .expect_err("corrupt prepared updates");
+    assert!(err.to_string().contains("prepared.safetensors"), "{err}");
+}
+
 #[test]
 fn corrupt_checkpoints_are_errors_not_panics() {
     let dir = tempfile::tempdir().unwrap();
