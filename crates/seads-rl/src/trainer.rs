@@ -32,16 +32,18 @@ struct Streams {
     sac: ChaCha8Rng,
 }
 
-/// Seconds spent per phase since the start of the run (the epoch profile).
+/// Seconds spent per phase since the start of the run (the epoch profile). Relabelling and the
+/// skill-model steps run beside SAC (see [`Trainer::run_epoch`]), so the phases add up to more
+/// than the wall time.
 #[derive(Debug, Clone, Copy, Default, Serialize, Deserialize)]
 pub struct Timings {
     /// Episode collection (environment steps and policy calls).
     pub collect: f64,
-    /// Skill-model scores, rewards and assignments, for both batches.
+    /// Skill-model scores, rewards and assignments for both batches, and SAC minibatch assembly.
     pub relabel: f64,
     /// Skill-model gradient steps.
     pub skill_model: f64,
-    /// SAC gradient steps (including minibatch assembly).
+    /// SAC gradient steps.
     pub sac: f64,
     /// Skill-coverage evaluations.
     pub evaluate: f64,
@@ -272,36 +274,34 @@ impl Trainer {
             spec: &self.spec,
             timings: &mut self.progress.timings,
         };
-        // The first epoch with a full buffer (or the first after a resume) prepares its own.
+        // The first epoch with a full buffer prepares its own updates (as does the first after
+        // resuming from a checkpoint written before checkpoints kept them).
         let prepared = match self.prepared.take() {
             Some(prepared) => Some(prepared),
             None => prepare.buffers.ready().then(|| prepare.updates()),
         };
-        let Some(prepared) = prepared else {
-            prepare.buffers.push(new);
-            self.progress.env_steps += new_steps;
-            self.progress.epoch += 1;
-            stats.env_steps = self.progress.env_steps;
-            return Ok(stats);
-        };
-        stats.updated = true;
-        stats.mean_reward = prepared.mean_reward;
-        stats.skill_model_loss = prepared.skill_model_loss;
-        let (sac, sac_rng) = (&mut self.sac, &mut self.progress.streams.sac);
-        let ((losses, sac_s), next) = std::thread::scope(|scope| {
-            let updates = scope.spawn(move || {
-                let start = Instant::now();
-                let losses = sac_updates(sac, &prepared.minibatches, sac_rng);
-                (losses, start.elapsed().as_secs_f64())
+        if let Some(prepared) = prepared {
+            stats.updated = true;
+            stats.mean_reward = prepared.mean_reward;
+            stats.skill_model_loss = prepared.skill_model_loss;
+            let (sac, sac_rng) = (&mut self.sac, &mut self.progress.streams.sac);
+            let ((losses, sac_s), next) = std::thread::scope(|scope| {
+                let updates = scope.spawn(move || {
+                    let start = Instant::now();
+                    let losses = sac_updates(sac, &prepared.minibatches, sac_rng);
+                    (losses, start.elapsed().as_secs_f64())
+                });
+                prepare.buffers.push(new);
+                // No next epoch once the budget is spent: the final skill model is epoch n's.
+                let next = (!finished && prepare.buffers.ready()).then(|| prepare.updates());
+                (updates.join().expect("SAC thread"), next)
             });
+            stats.sac = losses;
+            self.prepared = next;
+            self.progress.timings.sac += sac_s;
+        } else {
             prepare.buffers.push(new);
-            // No next epoch once the budget is spent: the final skill model is epoch n's.
-            let next = (!finished && prepare.buffers.ready()).then(|| prepare.updates());
-            (updates.join().expect("SAC thread"), next)
-        });
-        stats.sac = losses;
-        self.prepared = next;
-        self.progress.timings.sac += sac_s;
+        }
         self.progress.env_steps += new_steps;
         self.progress.epoch += 1;
         stats.env_steps = self.progress.env_steps;
