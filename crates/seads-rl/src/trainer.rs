@@ -97,7 +97,7 @@ pub struct Trainer {
 }
 
 /// An epoch's skill-model update done and its SAC minibatches relabelled, ready for SAC.
-#[derive(Debug, Clone, Default)]
+#[derive(Debug)]
 struct Prepared {
     minibatches: Vec<TransitionBatch>,
     mean_reward: f32,
@@ -405,24 +405,10 @@ impl Trainer {
     }
 
     fn load_buffer(&mut self, path: &Path) -> Result<(), RlError> {
-        let corrupt = |reason: String| RlError::Checkpoint {
-            path: path.display().to_string(),
-            reason,
-        };
-        let tensors = Tensor::read_safetensors(path).map_err(|e| corrupt(e.to_string()))?;
-        let get = |name: &str| {
-            tensors
-                .iter()
-                .find(|(n, _)| n == name)
-                .map(|(_, t)| t.shallow_clone())
-                .ok_or_else(|| corrupt(format!("no tensor {name:?}")))
-        };
-        let obs = Vec::<f32>::try_from(get("obs")?.to_kind(Kind::Float))
-            .map_err(|e| corrupt(e.to_string()))?;
-        let actions = Vec::<f32>::try_from(get("actions")?.to_kind(Kind::Float))
-            .map_err(|e| corrupt(e.to_string()))?;
-        let meta =
-            Vec::<i64>::try_from(get("meta")?.view([-1])).map_err(|e| corrupt(e.to_string()))?;
+        let file = TensorFile::read(path)?;
+        let corrupt = |reason: String| file.corrupt(reason);
+        let (obs, actions) = (file.floats("obs")?, file.floats("actions")?);
+        let meta = file.ints("meta")?;
         let (o, a) = (self.spec.obs_dim, self.spec.action_dim);
         let (mut po, mut pa) = (0, 0);
         self.episodes.clear();
@@ -454,6 +440,49 @@ impl Trainer {
             return Err(corrupt("trailing episode data".into()));
         }
         Ok(())
+    }
+}
+
+/// The tensors of a checkpoint file, by name; every error names the file.
+struct TensorFile<'a> {
+    path: &'a Path,
+    tensors: Vec<(String, Tensor)>,
+}
+
+impl<'a> TensorFile<'a> {
+    fn read(path: &'a Path) -> Result<Self, RlError> {
+        let tensors = Tensor::read_safetensors(path).map_err(|e| RlError::Checkpoint {
+            path: path.display().to_string(),
+            reason: e.to_string(),
+        })?;
+        Ok(Self { path, tensors })
+    }
+
+    fn corrupt(&self, reason: String) -> RlError {
+        RlError::Checkpoint {
+            path: self.path.display().to_string(),
+            reason,
+        }
+    }
+
+    fn get(&self, name: &str) -> Result<&Tensor, RlError> {
+        self.tensors
+            .iter()
+            .find(|(n, _)| n == name)
+            .map(|(_, t)| t)
+            .ok_or_else(|| self.corrupt(format!("no tensor {name:?}")))
+    }
+
+    /// The named tensor's values as f32, flattened.
+    fn floats(&self, name: &str) -> Result<Vec<f32>, RlError> {
+        Vec::<f32>::try_from(self.get(name)?.to_kind(Kind::Float).view([-1]))
+            .map_err(|e| self.corrupt(e.to_string()))
+    }
+
+    /// The named tensor's values as i64, flattened.
+    fn ints(&self, name: &str) -> Result<Vec<i64>, RlError> {
+        Vec::<i64>::try_from(self.get(name)?.to_kind(Kind::Int64).view([-1]))
+            .map_err(|e| self.corrupt(e.to_string()))
     }
 }
 
@@ -492,33 +521,29 @@ impl Prepared {
     /// Reads what [`Prepared::save`] wrote, for policy inputs of `width` and actions of
     /// `action_dim` values.
     fn load(path: &Path, width: usize, action_dim: usize) -> Result<Self, RlError> {
-        let corrupt = |reason: String| RlError::Checkpoint {
-            path: path.display().to_string(),
-            reason,
-        };
-        let tensors = Tensor::read_safetensors(path).map_err(|e| corrupt(e.to_string()))?;
-        let floats = |name: &str| -> Result<Vec<f32>, RlError> {
-            let tensor = tensors
-                .iter()
-                .find(|(n, _)| n == name)
-                .map(|(_, t)| t.to_kind(Kind::Float).view([-1]))
-                .ok_or_else(|| corrupt(format!("no tensor {name:?}")))?;
-            Vec::<f32>::try_from(tensor).map_err(|e| corrupt(e.to_string()))
-        };
-        let rows: Vec<usize> = floats("rows")?.iter().map(|&r| r as usize).collect();
-        let total: usize = rows.iter().sum();
+        let file = TensorFile::read(path)?;
+        let rows: Vec<usize> = file
+            .ints("rows")?
+            .into_iter()
+            .map(usize::try_from)
+            .collect::<Result<_, _>>()
+            .map_err(|_| file.corrupt("negative minibatch size".into()))?;
+        let total = rows
+            .iter()
+            .try_fold(0usize, |sum, &n| sum.checked_add(n))
+            .ok_or_else(|| file.corrupt("minibatch sizes overflow".into()))?;
+        let floats = |name| file.floats(name);
         let (obs, actions, rewards) = (floats("obs")?, floats("actions")?, floats("rewards")?);
         let (next_obs, dones, stats) = (floats("next_obs")?, floats("dones")?, floats("stats")?);
-        if obs.len() != total * width
+        // Rewards first: their length bounds `total`, so the products below cannot overflow.
+        if rewards.len() != total
+            || dones.len() != total
+            || obs.len() != total * width
             || next_obs.len() != total * width
             || actions.len() != total * action_dim
-            || rewards.len() != total
-            || dones.len() != total
             || stats.len() != 2
         {
-            return Err(corrupt(
-                "prepared minibatches do not match the environment".into(),
-            ));
+            return Err(file.corrupt("prepared minibatches do not match the environment".into()));
         }
         let mut minibatches = Vec::with_capacity(rows.len());
         let mut first = 0;
