@@ -270,7 +270,9 @@ fn tiny_config(dir: &std::path::Path) -> std::path::PathBuf {
     .replace("recent_episodes = 256", "recent_episodes = 16")
     .replace("eval_every = 100", "eval_every = 5")
     .replace("checkpoint_every = 100", "checkpoint_every = 5")
-    .replace("eval_seeds = 20", "eval_seeds = 1");
+    .replace("eval_seeds = 20", "eval_seeds = 1")
+    // Tests run side by side: SAC taking a second thread would oversubscribe the cores.
+    .replace("sac_threads_alone = 2", "sac_threads_alone = 0");
     let path = dir.join("tiny.toml");
     std::fs::write(&path, text).unwrap();
     path

@@ -1,5 +1,6 @@
-//! One SAC update at the sizes of `lightsout-cursor` (policy input 28 + 25, 2-D action, hidden
-//! 256 × 256, batch 128) on one libtorch thread: the SAC phase of an epoch is 16 of these.
+//! One SAC update at the sizes of `lightsout-cursor` (policy input 28 + 25) and `tileswap-cursor`
+//! (policy input 96), 2-D action, hidden 256 × 256, batch 128, on one libtorch thread: the SAC
+//! phase of an epoch is 16 of these.
 
 use criterion::{Criterion, criterion_group};
 use rand::{RngExt, SeedableRng};
@@ -9,7 +10,13 @@ use tch::Device;
 
 fn sac_update(c: &mut Criterion) {
     tch::set_num_threads(1);
-    let (input, batch) = (53, 128);
+    for (env, input) in [("lightsout_cursor", 53), ("tileswap_cursor", 96)] {
+        bench_update(c, env, input);
+    }
+}
+
+fn bench_update(c: &mut Criterion, env: &str, input: usize) {
+    let batch = 128;
     let config = SacConfig::default();
     let mut sac = Sac::new(input, &[-1.0, -1.0], &[1.0, 1.0], &config, Device::Cpu, 1);
     let mut rng = ChaCha8Rng::seed_from_u64(2);
@@ -23,7 +30,7 @@ fn sac_update(c: &mut Criterion) {
         dones: vec![1.0; batch],
     };
     let mut rng = ChaCha8Rng::seed_from_u64(3);
-    c.bench_function("sac_update_hidden256_batch128", |b| {
+    c.bench_function(&format!("sac_update_{env}_hidden256_batch128"), |b| {
         b.iter(|| sac.update(&transitions, &mut rng))
     });
 }

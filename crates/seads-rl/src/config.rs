@@ -67,6 +67,11 @@ pub struct TrainConfig {
     /// libtorch intra-op threads per training thread (0: libtorch's default; the presets use 1,
     /// since SAC updates and skill-model scoring already run on two threads).
     pub threads: usize,
+    /// libtorch threads of the SAC thread once the other training thread has finished preparing
+    /// the next epoch's updates and waits (0: keep `threads`). The presets use 2, for a run that
+    /// has two cores to itself; set 0 when several runs share the cores, since libtorch's threads
+    /// busy-wait and slow down badly when the cores are oversubscribed.
+    pub sac_threads_alone: usize,
 }
 
 impl Default for TrainConfig {
@@ -89,6 +94,7 @@ impl Default for TrainConfig {
             eval_seeds: 20,
             checkpoint_every: 100,
             threads: 0,
+            sac_threads_alone: 0,
         }
     }
 }

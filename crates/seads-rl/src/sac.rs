@@ -288,21 +288,16 @@ impl Sac {
                 .mean(Kind::Float);
         self.critic_opt.backward_step(&critic_loss);
 
-        // The actor's loss flows through the critics to the action; their weights need no
-        // gradient (the critic step zeroes them anyway), so the critics are frozen meanwhile.
-        self.critic_vs.freeze();
+        // The actor's loss flows through the critics to the action; only the actor's parameters
+        // receive gradients (`backward_step` differentiates with respect to its own parameters).
         let (new_action, log_prob) = self.sample(&obs, &self.gaussian(rows, rng));
         let q = Self::min_q(&self.q, &obs, &new_action);
         let actor_loss = (log_prob * alpha - &q).mean(Kind::Float);
         self.actor_opt.backward_step(&actor_loss);
-        self.critic_vs.unfreeze();
 
-        let tau = self.config.tau;
+        // θ' ← (1 − τ)·θ' + τ·θ.
         tch::no_grad(|| {
-            let _ = self
-                .target_flat
-                .g_mul_scalar_(1.0 - tau)
-                .g_add_(&(&self.critic_flat * tau));
+            let _ = self.target_flat.lerp_(&self.critic_flat, self.config.tau);
         });
         SacLosses {
             critic: mean_f32(&critic_loss),

@@ -3,6 +3,7 @@
 
 use std::collections::VecDeque;
 use std::path::Path;
+use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::Instant;
 
 use rand::RngExt;
@@ -236,6 +237,7 @@ impl Trainer {
     /// skill-model steps (on a batch relabelled with p = 1) and scores and relabels epoch n + 1's
     /// SAC batch (p = 0.5, only board-changing episodes) with the updated model. That is the
     /// same computation as Algorithm 3 done in order; only the two halves run side by side.
+    /// Once the calling thread has finished preparing, SAC takes over its libtorch threads too.
     /// Episodes are collected first, with the parameters of the start of the epoch (the
     /// reference collects in the background while it updates).
     pub fn run_epoch(&mut self) -> Result<EpochStats, RlError> {
@@ -285,15 +287,22 @@ impl Trainer {
             stats.mean_reward = prepared.mean_reward;
             stats.skill_model_loss = prepared.skill_model_loss;
             let (sac, sac_rng) = (&mut self.sac, &mut self.progress.streams.sac);
+            let threads = SacThreads {
+                threads: self.config.threads,
+                alone: self.config.sac_threads_alone,
+                prepared: AtomicBool::new(false),
+            };
             let ((losses, sac_s), next) = std::thread::scope(|scope| {
+                let threads = &threads;
                 let updates = scope.spawn(move || {
                     let start = Instant::now();
-                    let losses = sac_updates(sac, &prepared.minibatches, sac_rng);
+                    let losses = sac_updates(sac, &prepared.minibatches, sac_rng, threads);
                     (losses, start.elapsed().as_secs_f64())
                 });
                 prepare.buffers.push(new);
                 // No next epoch once the budget is spent: the final skill model is epoch n's.
                 let next = (!finished && prepare.buffers.ready()).then(|| prepare.updates());
+                threads.prepared.store(true, Ordering::Release);
                 (updates.join().expect("SAC thread"), next)
             });
             stats.sac = losses;
@@ -567,10 +576,37 @@ impl Prepared {
     }
 }
 
-/// SAC steps on the given minibatches; returns their mean losses.
-fn sac_updates(sac: &mut Sac, minibatches: &[TransitionBatch], rng: &mut ChaCha8Rng) -> SacLosses {
+/// How many libtorch threads the SAC thread of an epoch uses.
+struct SacThreads {
+    /// While the calling thread prepares (`TrainConfig::threads`; 0: libtorch's default).
+    threads: usize,
+    /// Once it has finished (`TrainConfig::sac_threads_alone`; 0: no change).
+    alone: usize,
+    /// Set by the calling thread once it has finished preparing the next epoch's updates.
+    prepared: AtomicBool,
+}
+
+/// SAC steps on the given minibatches; returns their mean losses. The thread count changes only
+/// how fast they run: libtorch's results are the same with one or two threads (checked by a
+/// test), so the moment SAC takes more threads does not change the run.
+fn sac_updates(
+    sac: &mut Sac,
+    minibatches: &[TransitionBatch],
+    rng: &mut ChaCha8Rng,
+    threads: &SacThreads,
+) -> SacLosses {
+    // libtorch's thread count is per thread, and a fresh thread starts with the value any thread
+    // set last: set it.
+    if threads.threads > 0 {
+        tch::set_num_threads(threads.threads as i32);
+    }
+    let mut alone = threads.alone == 0;
     let mut total = SacLosses::default();
     for minibatch in minibatches {
+        if !alone && threads.prepared.load(Ordering::Acquire) {
+            tch::set_num_threads(threads.alone as i32);
+            alone = true;
+        }
         let l = sac.update(minibatch, rng);
         total.critic += l.critic;
         total.actor += l.actor;

@@ -159,42 +159,24 @@ impl Adam {
         }
     }
 
-    /// Clears the gradients of the parameters.
-    pub fn zero_grad(&mut self) {
-        for p in &mut self.params {
-            p.zero_grad();
-        }
-    }
-
-    /// One update from the gradients accumulated by `loss.backward()`.
-    pub fn step(&mut self) {
+    /// One update from the gradient `g` of the flat parameters, in place, as PyTorch's
+    /// single-tensor Adam computes it; `g` is used as scratch space.
+    fn step(&mut self, mut g: Tensor) {
         tch::no_grad(|| {
-            let grads: Vec<Tensor> = self
-                .params
-                .iter()
-                .map(|p| {
-                    let g = p.grad();
-                    if g.defined() {
-                        g.view([-1])
-                    } else {
-                        p.zeros_like().view([-1])
-                    }
-                })
-                .collect();
-            let g = Tensor::cat(&grads, 0);
             let _ = self.step.g_add_scalar_(1.0);
             let t = f64::try_from(&self.step).expect("scalar step count");
             let (c1, c2) = (1.0 - Self::BETA1.powf(t), 1.0 - Self::BETA2.powf(t));
-            let _ = self
-                .m
-                .g_mul_scalar_(Self::BETA1)
-                .g_add_(&(&g * (1.0 - Self::BETA1)));
-            let _ = self
-                .v
-                .g_mul_scalar_(Self::BETA2)
-                .g_add_(&(g.square() * (1.0 - Self::BETA2)));
-            let denom = (&self.v / c2).sqrt() + Self::EPS;
-            let _ = self.flat.g_sub_(&(&self.m / denom * (self.lr / c1)));
+            // m ← β₁·m + (1 − β₁)·g and v ← β₂·v + (1 − β₂)·g², as interpolations.
+            let _ = self.m.lerp_(&g, 1.0 - Self::BETA1);
+            let _ = self.v.lerp_(&g.square_(), 1.0 - Self::BETA2);
+            // θ ← θ − (lr / c₁)·m / (√v / √c₂ + ε), with the step size folded into the divisor.
+            let step_size = self.lr / c1;
+            let mut denom = self.v.sqrt();
+            let _ = denom
+                .g_div_scalar_(c2.sqrt())
+                .g_add_scalar_(Self::EPS)
+                .g_mul_scalar_(-1.0 / step_size);
+            let _ = self.flat.addcdiv_(&self.m, &denom);
         });
     }
 
@@ -203,11 +185,25 @@ impl Adam {
         &self.flat
     }
 
-    /// Zero the gradients, back-propagate `loss`, update.
+    /// Back-propagates `loss` to the optimised parameters only (other variables of the graph get
+    /// no gradient) and updates them.
     pub fn backward_step(&mut self, loss: &Tensor) {
-        self.zero_grad();
-        loss.backward();
-        self.step();
+        let grads = Tensor::run_backward(&[loss], &self.params, false, false);
+        let g = tch::no_grad(|| {
+            let flat: Vec<Tensor> = grads
+                .iter()
+                .zip(&self.params)
+                .map(|(g, p)| {
+                    if g.defined() {
+                        g.view([-1])
+                    } else {
+                        p.zeros_like().view([-1])
+                    }
+                })
+                .collect();
+            Tensor::cat(&flat, 0)
+        });
+        self.step(g);
     }
 
     /// The optimiser state (moments and step count), for checkpoints.
