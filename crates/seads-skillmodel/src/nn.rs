@@ -194,8 +194,10 @@ impl Adam {
                 .iter()
                 .zip(&self.params)
                 .map(|(g, p)| {
+                    // Gradients straight from autograd may be strided differently from their
+                    // parameters: reshape copies only where it must.
                     if g.defined() {
-                        g.view([-1])
+                        g.reshape([-1])
                     } else {
                         p.zeros_like().view([-1])
                     }
