@@ -2,6 +2,8 @@
 
 use criterion::criterion_main;
 
+#[path = "../tests/common/mod.rs"]
+mod common;
 mod sac;
 
 criterion_main!(sac::benches);

@@ -3,10 +3,12 @@
 //! phase of an epoch is 16 of these.
 
 use criterion::{Criterion, criterion_group};
-use rand::{RngExt, SeedableRng};
+use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
-use seads_rl::{Sac, SacConfig, TransitionBatch};
+use seads_rl::{Sac, SacConfig};
 use tch::Device;
+
+use crate::common;
 
 fn sac_update(c: &mut Criterion) {
     tch::set_num_threads(1);
@@ -16,19 +18,9 @@ fn sac_update(c: &mut Criterion) {
 }
 
 fn bench_update(c: &mut Criterion, env: &str, input: usize) {
-    let batch = 128;
     let config = SacConfig::default();
     let mut sac = Sac::new(input, &[-1.0, -1.0], &[1.0, 1.0], &config, Device::Cpu, 1);
-    let mut rng = ChaCha8Rng::seed_from_u64(2);
-    let mut random =
-        |n: usize| -> Vec<f32> { (0..n).map(|_| rng.random_range(-1.0..1.0)).collect() };
-    let transitions = TransitionBatch {
-        obs: random(batch * input),
-        actions: random(batch * 2),
-        rewards: random(batch),
-        next_obs: random(batch * input),
-        dones: vec![1.0; batch],
-    };
+    let transitions = common::random_transitions(128, input, 2);
     let mut rng = ChaCha8Rng::seed_from_u64(3);
     c.bench_function(&format!("sac_update_{env}_hidden256_batch128"), |b| {
         b.iter(|| sac.update(&transitions, &mut rng))

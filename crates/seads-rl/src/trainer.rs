@@ -237,7 +237,8 @@ impl Trainer {
     /// skill-model steps (on a batch relabelled with p = 1) and scores and relabels epoch n + 1's
     /// SAC batch (p = 0.5, only board-changing episodes) with the updated model. That is the
     /// same computation as Algorithm 3 done in order; only the two halves run side by side.
-    /// Once the calling thread has finished preparing, SAC takes over its libtorch threads too.
+    /// Once the calling thread has finished preparing, SAC may take more libtorch threads
+    /// (`TrainConfig::sac_threads_alone`).
     /// Episodes are collected first, with the parameters of the start of the epoch (the
     /// reference collects in the background while it updates).
     pub fn run_epoch(&mut self) -> Result<EpochStats, RlError> {
@@ -421,18 +422,21 @@ impl Trainer {
         let (o, a) = (self.spec.obs_dim, self.spec.action_dim);
         let (mut po, mut pa) = (0, 0);
         self.episodes.clear();
+        let mismatch = || corrupt("episode table does not match the environment".into());
         for m in meta.chunks(9) {
-            let len = m[0] as usize;
-            let (obs_end, act_end) = (po + (len + 1) * o, pa + len * a);
+            // The length is checked against the data before it is used: no negative or
+            // overflowing lengths.
             if m.len() != 9
-                || obs_end > obs.len()
-                || act_end > actions.len()
+                || !(0..=obs.len() as i64).contains(&m[0])
                 || m[1] < 0
                 || m[1] as usize >= self.k
             {
-                return Err(corrupt(
-                    "episode table does not match the environment".into(),
-                ));
+                return Err(mismatch());
+            }
+            let len = m[0] as usize;
+            let (obs_end, act_end) = (po + (len + 1) * o, pa + len * a);
+            if obs_end > obs.len() || act_end > actions.len() {
+                return Err(mismatch());
             }
             let word = |i: usize| m[i] as u64;
             self.episodes.push_back(Episode {

@@ -9,6 +9,8 @@ use seads_rl::{
 };
 use tch::Device;
 
+mod common;
+
 /// A one-step task: observe s ∈ [−1, 1], act a ∈ [−1, 1], reward −(a − s)², then the episode
 /// ends. SAC must learn a ≈ s.
 #[test]
@@ -50,17 +52,8 @@ fn sac_learns_to_track_a_target() {
 /// that depends on timing, so this keeps runs reproducible).
 #[test]
 fn sac_updates_do_not_depend_on_the_thread_count() {
-    let (input, batch) = (96, 128);
-    let mut rng = ChaCha8Rng::seed_from_u64(2);
-    let mut random =
-        |n: usize| -> Vec<f32> { (0..n).map(|_| rng.random_range(-1.0..1.0)).collect() };
-    let transitions = TransitionBatch {
-        obs: random(batch * input),
-        actions: random(batch * 2),
-        rewards: random(batch),
-        next_obs: random(batch * input),
-        dones: vec![0.0; batch],
-    };
+    let input = 96;
+    let transitions = common::random_transitions(128, input, 2);
     let run = |threads: i32| {
         let transitions = &transitions;
         // libtorch's thread count is per thread: each run has a thread of its own.
@@ -254,11 +247,23 @@ fn corrupt_checkpoints_are_errors_not_panics() {
     }
     drop(run);
     let latest = latest_checkpoint(&path).unwrap().unwrap();
-    std::fs::write(latest.join("episodes.safetensors"), b"garbage").unwrap();
+    let episodes = latest.join("episodes.safetensors");
+    let intact = std::fs::read(&episodes).unwrap();
+    std::fs::write(&episodes, b"garbage").unwrap();
     let err = Run::resume(&path)
         .err()
         .expect("a corrupt checkpoint is an error");
     assert!(err.to_string().contains("episodes.safetensors"), "{err}");
+    // Well-formed tensors whose episode table gives the second episode a negative length.
+    std::fs::write(&episodes, intact).unwrap();
+    let mut tensors = tch::Tensor::read_safetensors(&episodes).unwrap();
+    let meta = &mut tensors.iter_mut().find(|(n, _)| n == "meta").unwrap().1;
+    let _ = meta.get(1).get(0).fill_(-1);
+    tch::Tensor::write_safetensors(&tensors, &episodes).unwrap();
+    let err = Run::resume(&path)
+        .err()
+        .expect("a negative episode length is an error");
+    assert!(err.to_string().contains("episode table"), "{err}");
     std::fs::remove_dir_all(&latest).unwrap();
     assert!(Run::resume(&path).is_err());
 }

@@ -159,8 +159,8 @@ impl Adam {
         }
     }
 
-    /// One update from the gradient `g` of the flat parameters, in place, as PyTorch's
-    /// single-tensor Adam computes it; `g` is used as scratch space.
+    /// One update from the gradient `g` of the flat parameters, in place, by PyTorch's Adam
+    /// formula (the rounding may differ in the last bits); `g` is used as scratch space.
     fn step(&mut self, mut g: Tensor) {
         tch::no_grad(|| {
             let _ = self.step.g_add_scalar_(1.0);
