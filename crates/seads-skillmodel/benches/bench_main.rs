@@ -3,5 +3,6 @@
 use criterion::criterion_main;
 
 mod planner;
+mod relabel;
 
-criterion_main!(planner::benches);
+criterion_main!(planner::benches, relabel::benches);

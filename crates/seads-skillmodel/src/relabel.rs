@@ -14,27 +14,114 @@ pub enum RelabelKind {
     Max,
 }
 
-/// New labels by assignment: slot i carries label `labels[i]`, column j is episode j, the cost of
-/// giving episode j label `labels[i]` is −C_j[labels[i]]; the minimum-cost assignment (SciPy's
-/// algorithm, as the reference) says which episode receives which label. `clipped` holds the K
-/// clipped log-posteriors of each episode, row-major. The multiset of labels is preserved.
+/// New labels by assignment (SPEC §3.6): slot i carries label `labels[i]`, column j is episode j,
+/// the cost of giving episode j label `labels[i]` is −C_j[labels[i]]; a minimum-cost assignment
+/// says which episode receives which label. `clipped` holds the K clipped log-posteriors of each
+/// episode, row-major. The multiset of labels is preserved.
+///
+/// The reference solves this as a square n × n problem (SciPy's `linear_sum_assignment`), cubic
+/// in the number of episodes. Slots with the same label are interchangeable, so it is a
+/// transportation problem: the distinct labels are sources whose capacities are their counts.
+/// It is solved by successive shortest paths (below), with the same optimal total; where several
+/// assignments are optimal, ties may break differently from SciPy's.
 pub fn relabel_assignment(clipped: &[f32], k: usize, labels: &[usize]) -> Vec<usize> {
-    let n = labels.len();
-    if n == 0 {
-        return Vec::new();
-    }
-    let mut cost = vec![0.0f64; n * n];
-    for (i, &label) in labels.iter().enumerate() {
-        for j in 0..n {
-            cost[i * n + j] = -(clipped[j * k + label] as f64);
+    // The distinct labels, ascending, and how many slots carry each.
+    let mut groups: Vec<usize> = labels.to_vec();
+    groups.sort_unstable();
+    groups.dedup();
+    let capacity: Vec<usize> = groups
+        .iter()
+        .map(|g| labels.iter().filter(|l| *l == g).count())
+        .collect();
+    let cost: Vec<Vec<f64>> = (0..labels.len())
+        .map(|e| {
+            groups
+                .iter()
+                .map(|&g| -f64::from(clipped[e * k + g]))
+                .collect()
+        })
+        .collect();
+    capacitated_assignment(&cost, &capacity)
+        .into_iter()
+        .map(|g| groups[g])
+        .collect()
+}
+
+/// A minimum-cost assignment of episodes to groups that takes exactly `capacity[g]` episodes
+/// into group g (the capacities add up to the number of episodes). `cost[e][g]` is the cost of
+/// putting episode e into group g. Returns each episode's group.
+///
+/// Episodes are added one at a time, each along a shortest augmenting path, which keeps the
+/// partial assignment optimal (the successive-shortest-path method for min-cost flow). A path
+/// enters a group and, if that group is full, moves one of its episodes on to another group: with
+/// G groups the paths live on a G-node graph whose edge g → h costs the cheapest such move. The
+/// partial assignment is optimal, so that graph has no negative cycle and Bellman–Ford finds the
+/// paths. One episode costs O(n·G + G³), all of them O(n²·G + n·G³): for n = 512 episodes and
+/// G ≤ 30 labels, milliseconds instead of the square problem's O(n³).
+fn capacitated_assignment(cost: &[Vec<f64>], capacity: &[usize]) -> Vec<usize> {
+    const NONE: usize = usize::MAX;
+    let g_count = capacity.len();
+    let mut group_of = vec![NONE; cost.len()];
+    let mut filled = vec![0usize; g_count];
+    // Cheapest move out of each group into each other group, and the episode that makes it.
+    let mut edge = vec![(f64::INFINITY, NONE); g_count * g_count];
+    let mut dist = vec![0.0f64; g_count];
+    let mut pred = vec![NONE; g_count];
+    for new in 0..cost.len() {
+        edge.fill((f64::INFINITY, NONE));
+        for (e, &g) in group_of.iter().enumerate() {
+            if g == NONE {
+                continue;
+            }
+            for h in 0..g_count {
+                let step = cost[e][h] - cost[e][g];
+                if h != g && step < edge[g * g_count + h].0 {
+                    edge[g * g_count + h] = (step, e);
+                }
+            }
         }
+        // Shortest paths from the new episode (it enters group h at cost[new][h]).
+        dist.copy_from_slice(&cost[new]);
+        pred.fill(NONE);
+        for _ in 0..g_count {
+            let mut changed = false;
+            for g in 0..g_count {
+                // Only a full group passes an episode on; a group with room ends the path.
+                if filled[g] < capacity[g] {
+                    continue;
+                }
+                for h in 0..g_count {
+                    let (step, _) = edge[g * g_count + h];
+                    if dist[g] + step < dist[h] {
+                        dist[h] = dist[g] + step;
+                        pred[h] = g;
+                        changed = true;
+                    }
+                }
+            }
+            if !changed {
+                break;
+            }
+        }
+        // The cheapest group with room (the first on ties).
+        let mut target = NONE;
+        for g in 0..g_count {
+            if filled[g] < capacity[g] && (target == NONE || dist[g] < dist[target]) {
+                target = g;
+            }
+        }
+        // Walk the path back: each group on it hands one episode to the next.
+        filled[target] += 1;
+        let mut h = target;
+        while pred[h] != NONE {
+            let g = pred[h];
+            let moved = edge[g * g_count + h].1;
+            group_of[moved] = h;
+            h = g;
+        }
+        group_of[new] = h;
     }
-    let (rows, cols) = lsap::solve(n, n, &cost, false).expect("finite costs have an assignment");
-    let mut new_labels = vec![0; n];
-    for (&slot, &episode) in rows.iter().zip(&cols) {
-        new_labels[episode] = labels[slot];
-    }
-    new_labels
+    group_of
 }
 
 /// New labels by independent maximisation: argmax_k C_e[k] (first maximum on ties).
