@@ -3,7 +3,7 @@
 
 use std::path::PathBuf;
 
-use anyhow::{Context, Result};
+use anyhow::Result;
 use clap::Args;
 use seads_games::Split;
 use seads_planner::summarise;
@@ -41,7 +41,7 @@ pub struct RunArgs {
 pub fn run(args: RunArgs) -> Result<()> {
     let mut run = if args.out.join("config.toml").exists() {
         println!("resuming the run in {}", args.out.display());
-        Run::resume(&args.out).with_context(|| format!("resuming {}", args.out.display()))?
+        crate::train::resume(&args.out, Run::resume(&args.out))?
     } else {
         let mut config = TrainConfig::preset(&args.env).map_err(|e| BadInput(e.into()))?;
         config.env_steps = args.env_steps;

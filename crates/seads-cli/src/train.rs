@@ -5,7 +5,7 @@ use std::path::PathBuf;
 use anyhow::{Context, Result};
 use clap::Args;
 use indicatif::{ProgressBar, ProgressStyle};
-use seads_rl::{Run, TrainConfig};
+use seads_rl::{Hook, Moment, Run, TrainConfig};
 
 use crate::BadInput;
 
@@ -22,13 +22,15 @@ pub struct TrainArgs {
     #[arg(long)]
     seed: Option<u64>,
     /// Budget in environment steps (default: the preset's, 5·10⁵ Cursor, 10⁷ Reacher and Jaco).
+    /// With --resume, raises the run's budget (finished or not) and records it in its config.
     #[arg(long)]
     env_steps: Option<u64>,
     /// A full configuration file (TOML) instead of the preset; see `configs/`.
     #[arg(long)]
     config: Option<PathBuf>,
-    /// Continue the run in this directory from its last checkpoint.
-    #[arg(long, conflicts_with_all = ["env", "out", "seed", "env_steps", "config"])]
+    /// Continue the run in this directory from its last checkpoint. What a crash left (a torn
+    /// metrics line, an unreadable checkpoint, temporary files) is repaired and reported.
+    #[arg(long, conflicts_with_all = ["env", "out", "seed", "config"])]
     resume: Option<PathBuf>,
     /// No progress bar; one line per evaluation instead.
     #[arg(long)]
@@ -64,7 +66,15 @@ fn config(args: &TrainArgs) -> Result<TrainConfig> {
 /// Runs `seads train`.
 pub fn train(args: TrainArgs) -> Result<()> {
     let mut run = match &args.resume {
-        Some(dir) => Run::resume(dir).with_context(|| format!("resuming {}", dir.display()))?,
+        Some(dir) => {
+            if let Some(steps) = args.env_steps {
+                seads_rl::raise_budget(dir, steps).map_err(|e| match e {
+                    seads_rl::RlError::Config(_) => BadInput(e.into()).into(),
+                    other => anyhow::Error::from(other),
+                })?;
+            }
+            resume(dir, Run::resume(dir))?
+        }
         None => {
             let config = config(&args)?;
             let out = args.out.as_ref().expect("clap requires --out");
@@ -77,8 +87,52 @@ pub fn train(args: TrainArgs) -> Result<()> {
     drive(&mut run, args.quiet)
 }
 
+/// The resumed run, after telling on stderr what resuming repaired.
+pub fn resume(dir: &std::path::Path, run: Result<Run, seads_rl::RlError>) -> Result<Run> {
+    let run = run.with_context(|| format!("resuming {}", dir.display()))?;
+    for repair in run.repairs() {
+        eprintln!("seads: {}: {repair}", dir.display());
+    }
+    Ok(run)
+}
+
+/// The variable of the crash-point tests (`crates/seads-cli/tests/crash.rs`): `list` names every
+/// [`Moment`] of the run on stderr as it passes; a number N stops the process at the N-th moment
+/// (counted from 1 in this process), says so on stderr and waits there to be killed.
+pub const CRASH_POINT_VAR: &str = "SEADS_CRASH_POINT";
+
+/// The hook [`CRASH_POINT_VAR`] asks for, if it is set.
+fn crash_hook() -> Result<Option<Hook>> {
+    let Ok(value) = std::env::var(CRASH_POINT_VAR) else {
+        return Ok(None);
+    };
+    if value == "list" {
+        return Ok(Some(Box::new(|moment: Moment| {
+            eprintln!("seads: moment {}", moment.name());
+        })));
+    }
+    let stop: u64 = value.parse().map_err(|_| {
+        BadInput(anyhow::anyhow!(
+            "{CRASH_POINT_VAR} must be `list` or a moment number, got {value:?}"
+        ))
+    })?;
+    let mut count = 0;
+    Ok(Some(Box::new(move |moment: Moment| {
+        count += 1;
+        if count == stop {
+            eprintln!("seads: stopped at moment {count} ({})", moment.name());
+            loop {
+                std::thread::park();
+            }
+        }
+    })))
+}
+
 /// Trains `run` to its budget, showing progress, and prints a summary.
 pub fn drive(run: &mut Run, quiet: bool) -> Result<()> {
+    if let Some(hook) = crash_hook()? {
+        run.set_hook(hook);
+    }
     let budget = run.trainer().config().env_steps;
     let bar = if quiet {
         ProgressBar::hidden()

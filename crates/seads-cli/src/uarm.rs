@@ -220,8 +220,7 @@ pub fn train(args: UarmTrainArgs) -> Result<()> {
     let trainer =
         |config: TrainConfig| Trainer::with_environments(config, env.box_clone(), env.box_clone());
     let mut run = if args.resume {
-        Run::resume_with(&args.out, trainer)
-            .with_context(|| format!("resuming {}", args.out.display()))?
+        crate::train::resume(&args.out, Run::resume_with(&args.out, trainer))?
     } else {
         Run::with_trainer(&args.out, trainer(robot_config(&env, &args)?)?)
             .map_err(|e| BadInput(e.into()))?

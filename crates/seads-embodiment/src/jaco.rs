@@ -669,6 +669,9 @@ impl Manipulator for Jaco {
     }
 
     fn reset(&mut self, rng: &mut ChaCha8Rng) {
+        // A fresh world: rapier keeps contacts and solver warm starts from the previous step,
+        // and a reset must depend on nothing but the seed (a resumed run has a fresh world).
+        *self = Jaco::new(self.board, self.substeps);
         self.randomize(rng);
         self.set_controls(&[0.0; 9]);
     }

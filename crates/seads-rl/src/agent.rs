@@ -99,7 +99,7 @@ impl Agent {
             SkillModelKind::Forward => {
                 let mut model =
                     ForwardModel::new(spec.symbolic_len, k, &config.skill_model, Device::Cpu, 0);
-                model.load(checkpoint)?;
+                model.load(checkpoint, false)?;
                 Some(model)
             }
             SkillModelKind::Vic => None,
@@ -107,9 +107,11 @@ impl Agent {
         let epoch = checkpoint
             .file_name()
             .and_then(|n| n.to_str())
-            .and_then(|n| n.strip_prefix("epoch-"))
-            .and_then(|n| n.parse().ok())
-            .unwrap_or(0);
+            .and_then(crate::store::checkpoint_epoch)
+            .ok_or_else(|| RlError::Checkpoint {
+                path: checkpoint.display().to_string(),
+                reason: "a checkpoint folder is named epoch-N".into(),
+            })?;
         Ok(Self {
             config,
             spec,

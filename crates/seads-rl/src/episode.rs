@@ -1,6 +1,5 @@
 //! Episodes (one skill execution each) and how they are collected with a policy.
 
-use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 use rayon::prelude::*;
 use seads_embodiment::{EnvError, Environment};
@@ -173,11 +172,4 @@ pub fn skill_coverage(
             moves.len()
         })
         .collect())
-}
-
-/// A fresh RNG stream derived from a seed and a purpose, so that streams never overlap.
-pub fn stream(seed: u64, purpose: u64) -> ChaCha8Rng {
-    let mut rng = ChaCha8Rng::seed_from_u64(seed);
-    rng.set_stream(purpose);
-    rng
 }

@@ -13,6 +13,8 @@ mod config;
 mod episode;
 mod run;
 mod sac;
+mod seeds;
+mod store;
 mod trainer;
 
 use std::path::Path;
@@ -20,14 +22,19 @@ use std::path::Path;
 pub use agent::{Agent, AgentPolicy};
 pub use config::{RelabelConfig, TrainConfig};
 pub use episode::{Episode, policy_input, run_episodes, skill_coverage};
-pub use run::{Metrics, Run, RunEvent, checkpoints, latest_checkpoint, load_config, read_metrics};
+pub use run::{Hook, Metrics, Moment, Run, RunEvent, load_config, raise_budget};
 pub use sac::{Sac, SacConfig, SacLosses, TransitionBatch};
+pub use seeds::{Purpose, derived_seed, stream, train_env_seed};
+pub use store::{checkpoints, latest_checkpoint, read_metrics, write_atomic};
 pub use trainer::{COVERAGE_SEED, EpochStats, Timings, Trainer};
 
 /// Sets the number of libtorch intra-op threads of the process.
 pub fn set_threads(n: usize) {
     tch::set_num_threads(n as i32);
 }
+
+/// A boxed error kept as the source of another.
+pub type BoxError = Box<dyn std::error::Error + Send + Sync>;
 
 /// Errors of training and checkpoints.
 #[derive(Debug, thiserror::Error)]
@@ -42,14 +49,15 @@ pub enum RlError {
     #[error(transparent)]
     SkillModel(#[from] seads_skillmodel::SkillModelError),
     /// Reading or writing a file failed.
-    #[error("{path}: {reason}")]
+    #[error("{path}")]
     Io {
         /// The file.
         path: String,
         /// What went wrong.
-        reason: String,
+        #[source]
+        source: BoxError,
     },
-    /// A checkpoint is missing, corrupt or from another configuration.
+    /// A checkpoint file is missing, corrupt or from another configuration.
     #[error("cannot load checkpoint {path}: {reason}")]
     Checkpoint {
         /// The file.
@@ -57,13 +65,40 @@ pub enum RlError {
         /// What went wrong.
         reason: String,
     },
+    /// A checkpoint file could not be read or parsed.
+    #[error("cannot load checkpoint {path}")]
+    Unreadable {
+        /// The file.
+        path: String,
+        /// What went wrong.
+        #[source]
+        source: BoxError,
+    },
+    /// A run that has written checkpoints has none that can be loaded.
+    #[error("{dir}: none of its {tried} checkpoint(s) can be loaded; the newest")]
+    NoCheckpoint {
+        /// The checkpoints folder.
+        dir: String,
+        /// How many checkpoints were tried.
+        tried: usize,
+        /// Why the newest could not be loaded.
+        #[source]
+        source: Box<RlError>,
+    },
 }
 
 impl RlError {
-    fn io(path: &Path, e: impl std::fmt::Display) -> Self {
+    fn io(path: &Path, e: impl Into<BoxError>) -> Self {
         RlError::Io {
             path: path.display().to_string(),
-            reason: e.to_string(),
+            source: e.into(),
+        }
+    }
+
+    fn unreadable(path: &Path, e: impl Into<BoxError>) -> Self {
+        RlError::Unreadable {
+            path: path.display().to_string(),
+            source: e.into(),
         }
     }
 }

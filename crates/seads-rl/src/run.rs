@@ -10,15 +10,20 @@
 //! ```
 
 use std::fs;
-use std::io::Write as _;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 use serde::{Deserialize, Serialize};
 
+use crate::store::{
+    CHECKPOINTS, CONFIG, LATEST, METRICS, append_metrics, checkpoint_name, checkpoints,
+    clean_leftovers, commit_dir, hidden_sibling, latest_pointer, read_metrics_text, write_atomic,
+    write_metrics,
+};
 use crate::{EpochStats, RlError, Timings, TrainConfig, Trainer};
 
-/// Files of a checkpoint that only resuming needs; dropped from older checkpoints.
+/// Files of a checkpoint that only resuming needs; dropped from checkpoints older than the two
+/// newest.
 const RESUME_ONLY: &[&str] = &[
     "sac_critic.safetensors",
     "sac_target.safetensors",
@@ -27,8 +32,47 @@ const RESUME_ONLY: &[&str] = &[
     "forward_model_adam.safetensors",
     "discriminator_adam.safetensors",
     "episodes.safetensors",
+    "progress.json",
     crate::trainer::PREPARED_FILE,
 ];
+
+/// Moments of a run at which a crash leaves a different state on disk. A hook set with
+/// [`Run::set_hook`] is called at each (the crash-point tests stop the process there).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Moment {
+    /// An epoch's episodes are collected; its updates have not started.
+    Collected,
+    /// The next epoch's updates are prepared while this epoch's SAC steps may still run.
+    Prepared,
+    /// An epoch is complete in memory; nothing of it is on disk yet.
+    EpochDone,
+    /// An evaluation line was appended to `metrics.jsonl`.
+    MetricsAppended,
+    /// A checkpoint's files are written in its temporary folder, not yet renamed.
+    CheckpointWritten,
+    /// A checkpoint folder is in place; `latest` still names the previous one.
+    CheckpointRenamed,
+    /// `latest` names the new checkpoint; older ones still hold their resume files.
+    LatestWritten,
+}
+
+impl Moment {
+    /// A short name (`collected`, `metrics-appended`, …).
+    pub fn name(self) -> &'static str {
+        match self {
+            Moment::Collected => "collected",
+            Moment::Prepared => "prepared",
+            Moment::EpochDone => "epoch-done",
+            Moment::MetricsAppended => "metrics-appended",
+            Moment::CheckpointWritten => "checkpoint-written",
+            Moment::CheckpointRenamed => "checkpoint-renamed",
+            Moment::LatestWritten => "latest-written",
+        }
+    }
+}
+
+/// A hook called at every [`Moment`].
+pub type Hook = Box<dyn FnMut(Moment) + Send>;
 
 /// One line of `metrics.jsonl`.
 #[derive(Debug, Clone, Serialize, Deserialize)]
@@ -74,12 +118,8 @@ pub struct Run {
     trainer: Trainer,
     started: Instant,
     wall_before: f64,
-}
-
-fn atomic_write(path: &Path, text: &str) -> Result<(), RlError> {
-    let tmp = path.with_extension("tmp");
-    fs::write(&tmp, text).map_err(|e| RlError::io(&tmp, e))?;
-    fs::rename(&tmp, path).map_err(|e| RlError::io(path, e))
+    hook: Hook,
+    repairs: Vec<String>,
 }
 
 impl Run {
@@ -90,7 +130,7 @@ impl Run {
     }
 
     fn check_free(dir: &Path) -> Result<(), RlError> {
-        if dir.join("config.toml").exists() {
+        if dir.join(CONFIG).exists() {
             return Err(RlError::Config(format!(
                 "{} already holds a run; resume it with --resume or choose another directory",
                 dir.display()
@@ -102,15 +142,22 @@ impl Run {
     /// Starts a run in `dir` with a trainer built elsewhere (e.g. on the robot's environment).
     pub fn with_trainer(dir: &Path, trainer: Trainer) -> Result<Self, RlError> {
         Self::check_free(dir)?;
-        fs::create_dir_all(dir.join("checkpoints")).map_err(|e| RlError::io(dir, e))?;
-        atomic_write(&dir.join("config.toml"), &trainer.config().to_toml())?;
-        fs::write(dir.join("metrics.jsonl"), "").map_err(|e| RlError::io(dir, e))?;
-        Ok(Self {
+        fs::create_dir_all(dir.join(CHECKPOINTS)).map_err(|e| RlError::io(dir, e))?;
+        write_metrics(dir, &[])?;
+        // The config last: a folder with a config is a run.
+        write_atomic(&dir.join(CONFIG), trainer.config().to_toml().as_bytes())?;
+        Ok(Self::new(dir, trainer, 0.0, Vec::new()))
+    }
+
+    fn new(dir: &Path, trainer: Trainer, wall_before: f64, repairs: Vec<String>) -> Self {
+        Self {
             dir: dir.to_path_buf(),
             trainer,
             started: Instant::now(),
-            wall_before: 0.0,
-        })
+            wall_before,
+            hook: Box::new(|_| {}),
+            repairs,
+        }
     }
 
     /// Continues the run in `dir` from its latest checkpoint (from scratch if it has none).
@@ -119,35 +166,98 @@ impl Run {
     }
 
     /// Continues the run in `dir`, building its trainer with `build` from the saved config.
+    ///
+    /// Repairs what a crash can leave: leftover temporary files and folders are removed; a
+    /// checkpoint that cannot be loaded (the latest included) is passed over for the newest one
+    /// that can; evaluation lines after that checkpoint, and a torn last line, are dropped.
+    /// Each repair is described in [`Run::repairs`]. It is an error only when no checkpoint can
+    /// be loaded although the run has written one.
     pub fn resume_with(
         dir: &Path,
-        build: impl FnOnce(TrainConfig) -> Result<Trainer, RlError>,
+        mut build: impl FnMut(TrainConfig) -> Result<Trainer, RlError>,
     ) -> Result<Self, RlError> {
         let config = load_config(dir)?;
-        let mut trainer = build(config)?;
-        let mut wall_before = 0.0;
-        let mut kept = Vec::new();
-        if let Some(checkpoint) = latest_checkpoint(dir)? {
-            trainer.load(&checkpoint)?;
-            // Drop evaluations logged after the checkpoint: they will be redone.
-            let metrics = read_metrics(dir)?;
-            kept = metrics
-                .into_iter()
-                .filter(|m| m.epoch <= trainer.epoch())
-                .collect();
-            wall_before = kept.last().map_or(0.0, |m| m.wall_s);
-        }
-        let text: String = kept
-            .iter()
-            .map(|m| serde_json::to_string(m).expect("metrics serialise") + "\n")
+        let mut repairs: Vec<String> = clean_leftovers(&dir.join(CHECKPOINTS))?
+            .into_iter()
+            .map(|name| format!("removed {name}, left by an interrupted write"))
             .collect();
-        atomic_write(&dir.join("metrics.jsonl"), &text)?;
-        Ok(Self {
-            dir: dir.to_path_buf(),
-            trainer,
-            started: Instant::now(),
-            wall_before,
-        })
+        let mut trainer = build(config.clone())?;
+        let mut candidates: Vec<PathBuf> = Vec::new();
+        let pointer = latest_pointer(dir)?;
+        let had_pointer = pointer.is_some();
+        candidates.extend(pointer);
+        let written = if dir.join(CHECKPOINTS).is_dir() {
+            checkpoints(dir)?
+        } else {
+            Vec::new()
+        };
+        for (_, path) in written.iter().rev() {
+            if !candidates.contains(path) {
+                candidates.push(path.clone());
+            }
+        }
+        let mut failures: Vec<RlError> = Vec::new();
+        let mut resumed = None;
+        for candidate in candidates {
+            match trainer.load(&candidate) {
+                Ok(()) => {
+                    resumed = Some(candidate);
+                    break;
+                }
+                Err(e) => {
+                    repairs.push(format!(
+                        "passed over checkpoint {}: {e}",
+                        candidate.display()
+                    ));
+                    failures.push(e);
+                    // A failed load may have changed part of the state: start from a fresh one.
+                    trainer = build(config.clone())?;
+                }
+            }
+        }
+        let (mut metrics, torn) = read_metrics_text(dir)?;
+        if torn {
+            repairs.push(format!("dropped a torn last line of {METRICS}"));
+        }
+        if resumed.is_none() && (had_pointer || !written.is_empty()) {
+            let tried = failures.len();
+            return Err(match failures.into_iter().next() {
+                Some(newest) => RlError::NoCheckpoint {
+                    dir: dir.join(CHECKPOINTS).display().to_string(),
+                    tried,
+                    source: Box::new(newest),
+                },
+                None => RlError::Checkpoint {
+                    path: dir.join(CHECKPOINTS).display().to_string(),
+                    reason: "the latest checkpoint is missing and no other exists".into(),
+                },
+            });
+        }
+        // Evaluations after the checkpoint are redone; a run with no checkpoint starts afresh.
+        let epoch = trainer.epoch();
+        let before = metrics.len();
+        metrics.retain(|m| resumed.is_some() && m.epoch <= epoch);
+        if metrics.len() < before {
+            repairs.push(format!(
+                "dropped {} evaluation line(s) after epoch {epoch}, to be redone",
+                before - metrics.len()
+            ));
+        }
+        if metrics.len() < before || torn {
+            write_metrics(dir, &metrics)?;
+        }
+        let wall_before = metrics.last().map_or(0.0, |m| m.wall_s);
+        Ok(Self::new(dir, trainer, wall_before, repairs))
+    }
+
+    /// What resuming repaired, one sentence each (empty for a new run or a clean resume).
+    pub fn repairs(&self) -> &[String] {
+        &self.repairs
+    }
+
+    /// Calls `hook` at every [`Moment`] from now on.
+    pub fn set_hook(&mut self, hook: Hook) {
+        self.hook = hook;
     }
 
     /// The trainer.
@@ -187,37 +297,40 @@ impl Run {
             steps_per_s: self.trainer.env_steps() as f64 / wall_s.max(1e-9),
             timings: self.trainer.timings(),
         };
-        let path = self.dir.join("metrics.jsonl");
-        let mut file = fs::OpenOptions::new()
-            .append(true)
-            .open(&path)
-            .map_err(|e| RlError::io(&path, e))?;
-        writeln!(
-            file,
-            "{}",
-            serde_json::to_string(&metrics).expect("metrics serialise")
-        )
-        .map_err(|e| RlError::io(&path, e))?;
+        append_metrics(&self.dir, &metrics)?;
+        (self.hook)(Moment::MetricsAppended);
         Ok(metrics)
     }
 
-    /// Writes a complete checkpoint atomically (a temporary folder renamed into place, then the
-    /// `latest` pointer), then strips the resume-only files from the previous one.
-    pub fn checkpoint(&self) -> Result<PathBuf, RlError> {
-        let root = self.dir.join("checkpoints");
-        let name = format!("epoch-{:06}", self.trainer.epoch());
-        let tmp = root.join(format!(".{name}.tmp"));
+    /// Writes a complete checkpoint durably (a temporary folder renamed into place, then the
+    /// `latest` pointer), then strips the resume-only files from all but the two newest.
+    pub fn checkpoint(&mut self) -> Result<PathBuf, RlError> {
+        let root = self.dir.join(CHECKPOINTS);
+        let name = checkpoint_name(self.trainer.epoch());
+        let dest = root.join(&name);
+        let tmp = hidden_sibling(&dest, "tmp");
         let _ = fs::remove_dir_all(&tmp);
         fs::create_dir_all(&tmp).map_err(|e| RlError::io(&tmp, e))?;
         self.trainer.save(&tmp)?;
-        let dest = root.join(&name);
-        let _ = fs::remove_dir_all(&dest);
-        fs::rename(&tmp, &dest).map_err(|e| RlError::io(&dest, e))?;
-        let previous = fs::read_to_string(root.join("latest")).ok();
-        atomic_write(&root.join("latest"), &name)?;
-        if let Some(previous) = previous.map(|p| p.trim().to_owned()).filter(|p| *p != name) {
+        (self.hook)(Moment::CheckpointWritten);
+        commit_dir(&tmp, &dest)?;
+        (self.hook)(Moment::CheckpointRenamed);
+        write_atomic(&root.join(LATEST), name.as_bytes())?;
+        (self.hook)(Moment::LatestWritten);
+        let epoch = self.trainer.epoch();
+        let older: Vec<PathBuf> = checkpoints(&self.dir)?
+            .into_iter()
+            .filter(|(e, _)| *e <= epoch)
+            .map(|(_, p)| p)
+            .collect();
+        for old in older.iter().rev().skip(2) {
             for file in RESUME_ONLY {
-                let _ = fs::remove_file(root.join(&previous).join(file));
+                match fs::remove_file(old.join(file)) {
+                    Err(e) if e.kind() != std::io::ErrorKind::NotFound => {
+                        return Err(RlError::io(&old.join(file), e));
+                    }
+                    _ => {}
+                }
             }
         }
         Ok(dest)
@@ -227,7 +340,8 @@ impl Run {
     /// the first epoch's updates, i.e. at epoch 1, and when the budget is spent).
     pub fn step(&mut self) -> Result<RunEvent, RlError> {
         let first = self.trainer.epoch() == 0;
-        let stats = self.trainer.run_epoch()?;
+        let stats = self.trainer.run_epoch_observed(&mut self.hook)?;
+        (self.hook)(Moment::EpochDone);
         let epoch = self.trainer.epoch();
         let done = self.trainer.finished();
         let config = self.trainer.config();
@@ -251,65 +365,27 @@ impl Run {
     }
 }
 
+/// Raises the budget of the run in `dir` to `env_steps` environment steps and records it in its
+/// config; the run continues with `seads train --resume`. A budget below the current one is a
+/// configuration error.
+pub fn raise_budget(dir: &Path, env_steps: u64) -> Result<(), RlError> {
+    let mut config = load_config(dir)?;
+    if env_steps < config.env_steps {
+        return Err(RlError::Config(format!(
+            "--env-steps {env_steps} is below the run's budget of {}; a budget can only be raised",
+            config.env_steps
+        )));
+    }
+    if env_steps > config.env_steps {
+        config.env_steps = env_steps;
+        write_atomic(&dir.join(CONFIG), config.to_toml().as_bytes())?;
+    }
+    Ok(())
+}
+
 /// Reads and validates `dir/config.toml`.
 pub fn load_config(dir: &Path) -> Result<TrainConfig, RlError> {
-    let path = dir.join("config.toml");
+    let path = dir.join(CONFIG);
     let text = fs::read_to_string(&path).map_err(|e| RlError::io(&path, e))?;
     TrainConfig::from_toml(&text).map_err(|e| RlError::Config(format!("{}: {e}", path.display())))
-}
-
-/// The latest complete checkpoint of the run in `dir`, if any.
-pub fn latest_checkpoint(dir: &Path) -> Result<Option<PathBuf>, RlError> {
-    let pointer = dir.join("checkpoints").join("latest");
-    match fs::read_to_string(&pointer) {
-        Ok(name) => {
-            let path = dir.join("checkpoints").join(name.trim());
-            if path.is_dir() {
-                Ok(Some(path))
-            } else {
-                Err(RlError::Checkpoint {
-                    path: path.display().to_string(),
-                    reason: "the latest checkpoint is missing".into(),
-                })
-            }
-        }
-        Err(e) if e.kind() == std::io::ErrorKind::NotFound => Ok(None),
-        Err(e) => Err(RlError::io(&pointer, e)),
-    }
-}
-
-/// Every checkpoint of the run in `dir`, oldest first, as (epoch, path).
-pub fn checkpoints(dir: &Path) -> Result<Vec<(u64, PathBuf)>, RlError> {
-    let root = dir.join("checkpoints");
-    let mut out: Vec<(u64, PathBuf)> = fs::read_dir(&root)
-        .map_err(|e| RlError::io(&root, e))?
-        .filter_map(|entry| {
-            let entry = entry.ok()?;
-            let epoch = entry
-                .file_name()
-                .to_str()?
-                .strip_prefix("epoch-")?
-                .parse()
-                .ok()?;
-            Some((epoch, entry.path()))
-        })
-        .collect();
-    out.sort();
-    Ok(out)
-}
-
-/// The lines of `dir/metrics.jsonl`.
-pub fn read_metrics(dir: &Path) -> Result<Vec<Metrics>, RlError> {
-    let path = dir.join("metrics.jsonl");
-    let text = fs::read_to_string(&path).map_err(|e| RlError::io(&path, e))?;
-    text.lines()
-        .filter(|l| !l.trim().is_empty())
-        .enumerate()
-        .map(|(i, l)| {
-            serde_json::from_str(l).map_err(|e| RlError::Checkpoint {
-                path: format!("{}:{}", path.display(), i + 1),
-                reason: e.to_string(),
-            })
-        })
-        .collect()
 }

@@ -336,10 +336,7 @@ impl Sac {
         };
         for (name, vs) in stores {
             let path = dir.join(format!("{name}.safetensors"));
-            vs.load(&path).map_err(|e| RlError::Checkpoint {
-                path: path.display().to_string(),
-                reason: e.to_string(),
-            })?;
+            vs.load(&path).map_err(|e| RlError::unreadable(&path, e))?;
         }
         Ok(())
     }

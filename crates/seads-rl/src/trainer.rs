@@ -14,8 +14,9 @@ use seads_skillmodel::{SkillModel, SkillTransition, episode_rewards, minimum_rew
 use serde::{Deserialize, Serialize};
 use tch::{Device, Kind, Tensor};
 
-use crate::episode::{policy_input, run_episodes, skill_coverage, stream};
-use crate::{Episode, RlError, Sac, SacLosses, TrainConfig, TransitionBatch};
+use crate::episode::{policy_input, run_episodes, skill_coverage};
+use crate::seeds::{Purpose, derived_seed, stream, train_env_seed};
+use crate::{Episode, Moment, RlError, Sac, SacLosses, TrainConfig, TransitionBatch};
 
 /// First seed of the skill-coverage evaluation (the paper's 444555 … 444574).
 pub const COVERAGE_SEED: u64 = 444_555;
@@ -137,13 +138,9 @@ impl Trainer {
         }
         let spec = template.spec().clone();
         let k = config.num_skills.unwrap_or(spec.num_skills);
+        // Seeded before every epoch (`train_env_seed`).
         let envs = (0..config.episodes_per_epoch)
-            .map(|i| {
-                let mut env = template.box_clone();
-                // Training workers are seeded 6242 + seed + i (the reference's base seed).
-                env.seed(6242 + config.seed + i as u64);
-                env
-            })
+            .map(|_| template.box_clone())
             .collect();
         let device = Device::Cpu;
         let sac = Sac::new(
@@ -152,17 +149,19 @@ impl Trainer {
             &spec.action_high,
             &config.sac,
             device,
-            config.seed,
+            derived_seed(config.seed, Purpose::SacInit, 0),
         );
-        let model =
-            config
-                .skill_model
-                .build(spec.symbolic_len, k, device, config.seed.wrapping_add(1));
+        let model = config.skill_model.build(
+            spec.symbolic_len,
+            k,
+            device,
+            derived_seed(config.seed, Purpose::SkillModelInit, 0),
+        );
         let streams = Streams {
-            labels: stream(config.seed, 1),
-            collect: stream(config.seed, 2),
-            sample: stream(config.seed, 3),
-            sac: stream(config.seed, 4),
+            labels: stream(config.seed, Purpose::Labels),
+            collect: stream(config.seed, Purpose::Collect),
+            sample: stream(config.seed, Purpose::Sample),
+            sac: stream(config.seed, Purpose::Sac),
         };
         let progress = Progress {
             epoch: 0,
@@ -242,6 +241,15 @@ impl Trainer {
     /// Episodes are collected first, with the parameters of the start of the epoch (the
     /// reference collects in the background while it updates).
     pub fn run_epoch(&mut self) -> Result<EpochStats, RlError> {
+        self.run_epoch_observed(&mut |_| {})
+    }
+
+    /// [`Trainer::run_epoch`], calling `hook` once the episodes are collected and once the next
+    /// epoch's updates are prepared (from the calling thread, while SAC may still update).
+    pub fn run_epoch_observed(
+        &mut self,
+        hook: &mut dyn FnMut(Moment),
+    ) -> Result<EpochStats, RlError> {
         let mut stats = EpochStats {
             epoch: self.progress.epoch,
             ..EpochStats::default()
@@ -251,7 +259,14 @@ impl Trainer {
         let skills: Vec<usize> = (0..self.envs.len())
             .map(|_| self.progress.streams.labels.random_range(0..self.k))
             .collect();
-        for env in &mut self.envs {
+        let slots = self.envs.len();
+        for (slot, env) in self.envs.iter_mut().enumerate() {
+            env.seed(train_env_seed(
+                self.config.seed,
+                self.progress.epoch,
+                slots,
+                slot,
+            ));
             env.reset();
         }
         let new = run_episodes(
@@ -262,6 +277,7 @@ impl Trainer {
             Some(&mut self.progress.streams.collect),
         )?;
         self.progress.timings.collect += start.elapsed().as_secs_f64();
+        hook(Moment::Collected);
         stats.changed = new.iter().filter(|e| e.changed()).count() as f32 / new.len().max(1) as f32;
         let new_steps: u64 = new.iter().map(|e| e.len(self.spec.action_dim) as u64).sum();
         let finished = self.progress.env_steps + new_steps >= self.config.env_steps;
@@ -304,6 +320,7 @@ impl Trainer {
                 // No next epoch once the budget is spent: the final skill model is epoch n's.
                 let next = (!finished && prepare.buffers.ready()).then(|| prepare.updates());
                 threads.prepared.store(true, Ordering::Release);
+                hook(Moment::Prepared);
                 (updates.join().expect("SAC thread"), next)
             });
             stats.sac = losses;
@@ -357,7 +374,7 @@ impl Trainer {
     /// Restores the complete training state written by [`Trainer::save`].
     pub fn load(&mut self, dir: &Path) -> Result<(), RlError> {
         self.sac.load(dir, false)?;
-        self.model.load(dir)?;
+        self.model.load(dir, true)?;
         self.load_buffer(&dir.join("episodes.safetensors"))?;
         let path = dir.join(PREPARED_FILE);
         self.prepared = if path.exists() {
@@ -368,15 +385,7 @@ impl Trainer {
         };
         let path = dir.join("progress.json");
         let text = std::fs::read_to_string(&path).map_err(|e| RlError::io(&path, e))?;
-        self.progress = serde_json::from_str(&text).map_err(|e| RlError::Checkpoint {
-            path: path.display().to_string(),
-            reason: e.to_string(),
-        })?;
-        // Environments are re-seeded per resumed epoch, as the reference does (its worker seeds
-        // are base + 100 · first epoch): a resumed run does not repeat the boards of its start.
-        for (i, env) in self.envs.iter_mut().enumerate() {
-            env.seed(6242 + self.config.seed + i as u64 + 100 * self.progress.epoch);
-        }
+        self.progress = serde_json::from_str(&text).map_err(|e| RlError::unreadable(&path, e))?;
         Ok(())
     }
 
@@ -464,10 +473,7 @@ struct TensorFile<'a> {
 
 impl<'a> TensorFile<'a> {
     fn read(path: &'a Path) -> Result<Self, RlError> {
-        let tensors = Tensor::read_safetensors(path).map_err(|e| RlError::Checkpoint {
-            path: path.display().to_string(),
-            reason: e.to_string(),
-        })?;
+        let tensors = Tensor::read_safetensors(path).map_err(|e| RlError::unreadable(path, e))?;
         Ok(Self { path, tensors })
     }
 

@@ -237,25 +237,56 @@ fn a_checkpoint_keeps_the_prepared_updates() {
     assert!(err.to_string().contains("prepared.safetensors"), "{err}");
 }
 
+/// An error and its sources, as the CLI prints them.
+fn chain(err: &dyn std::error::Error) -> String {
+    let mut text = err.to_string();
+    let mut source = err.source();
+    while let Some(e) = source {
+        text += &format!(": {e}");
+        source = e.source();
+    }
+    text
+}
+
+/// A corrupt latest checkpoint is passed over for the one before it (resuming says so); when no
+/// checkpoint can be loaded, resuming is an error that names the file, never a panic.
 #[test]
 fn corrupt_checkpoints_are_errors_not_panics() {
     let dir = tempfile::tempdir().unwrap();
     let path = dir.path().join("run");
-    let mut run = Run::create(&path, small(2, 600)).unwrap();
+    let mut run = Run::create(&path, small(2, 4000)).unwrap();
     while !run.finished() {
         run.step().unwrap();
     }
     drop(run);
-    let latest = latest_checkpoint(&path).unwrap().unwrap();
+    let all = checkpoints(&path).unwrap();
+    let (latest, before) = (&all[all.len() - 1].1, &all[all.len() - 2].1);
     let episodes = latest.join("episodes.safetensors");
     let intact = std::fs::read(&episodes).unwrap();
     std::fs::write(&episodes, b"garbage").unwrap();
+    let resumed = Run::resume(&path).unwrap();
+    assert!(
+        resumed.repairs()[0].contains("episodes.safetensors"),
+        "{:?}",
+        resumed.repairs()
+    );
+    assert_eq!(
+        resumed.trainer().epoch(),
+        all[all.len() - 2].0,
+        "resumed from the checkpoint before"
+    );
+    drop(resumed);
+    std::fs::write(before.join("episodes.safetensors"), b"garbage").unwrap();
     let err = Run::resume(&path)
         .err()
-        .expect("a corrupt checkpoint is an error");
-    assert!(err.to_string().contains("episodes.safetensors"), "{err}");
+        .expect("no loadable checkpoint is an error");
+    assert!(
+        chain(&err).contains("episodes.safetensors"),
+        "{}",
+        chain(&err)
+    );
     // Well-formed tensors whose episode table gives the second episode a negative length.
-    std::fs::write(&episodes, intact).unwrap();
+    std::fs::write(&episodes, &intact).unwrap();
     let mut tensors = tch::Tensor::read_safetensors(&episodes).unwrap();
     let meta = &mut tensors.iter_mut().find(|(n, _)| n == "meta").unwrap().1;
     let _ = meta.get(1).get(0).fill_(-1);
@@ -263,9 +294,66 @@ fn corrupt_checkpoints_are_errors_not_panics() {
     let err = Run::resume(&path)
         .err()
         .expect("a negative episode length is an error");
-    assert!(err.to_string().contains("episode table"), "{err}");
-    std::fs::remove_dir_all(&latest).unwrap();
-    assert!(Run::resume(&path).is_err());
+    assert!(chain(&err).contains("episode table"), "{}", chain(&err));
+    // A missing optimiser state is an error on resume (a fresh optimiser would change the run).
+    std::fs::write(&episodes, &intact).unwrap();
+    std::fs::remove_file(latest.join("sac_critic_adam.safetensors")).unwrap();
+    std::fs::remove_dir_all(before).unwrap();
+    let err = Run::resume(&path).err().expect("a missing optimiser state");
+    assert!(chain(&err).contains("sac_critic_adam"), "{}", chain(&err));
+    std::fs::remove_dir_all(latest).unwrap();
+    assert!(
+        Run::resume(&path).is_err(),
+        "checkpoints were written, none is left"
+    );
+}
+
+/// The same run killed after a checkpoint and resumed equals the run that was never killed, in
+/// every evaluation (the case: seed 5, an evaluation and a checkpoint every 20 epochs,
+/// scaled down). Before environments were seeded per epoch, the resumed run collected other
+/// episodes.
+#[test]
+fn a_resumed_run_equals_the_uninterrupted_run() {
+    let dir = tempfile::tempdir().unwrap();
+    let config = TrainConfig {
+        eval_every: 5,
+        checkpoint_every: 5,
+        ..small(5, 2500)
+    };
+    let strip = |path: &std::path::Path| -> Vec<(u64, u64, u64, u32, u32, u32)> {
+        read_metrics(path)
+            .unwrap()
+            .iter()
+            .map(|m| {
+                (
+                    m.epoch,
+                    m.env_steps,
+                    m.skill_coverage.to_bits(),
+                    m.mean_reward.to_bits(),
+                    m.skill_model_loss.to_bits(),
+                    m.critic_loss.to_bits(),
+                )
+            })
+            .collect()
+    };
+    let whole = dir.path().join("whole");
+    let mut run = Run::create(&whole, config.clone()).unwrap();
+    while !run.finished() {
+        run.step().unwrap();
+    }
+    let killed = dir.path().join("killed");
+    let mut run = Run::create(&killed, config).unwrap();
+    for _ in 0..13 {
+        run.step().unwrap();
+    }
+    drop(run); // killed at epoch 13, after its epoch-10 checkpoint
+    let mut run = Run::resume(&killed).unwrap();
+    assert_eq!(run.trainer().epoch(), 10);
+    while !run.finished() {
+        run.step().unwrap();
+    }
+    assert!(strip(&whole).len() > 5);
+    assert_eq!(strip(&killed), strip(&whole));
 }
 
 #[test]

@@ -40,8 +40,10 @@ pub trait SkillModel: Send {
     fn train_step(&mut self, batch: &[SkillTransition]) -> f32;
     /// Writes the parameters and the optimiser state.
     fn save(&self, dir: &Path) -> Result<(), SkillModelError>;
-    /// Reads what [`SkillModel::save`] wrote.
-    fn load(&mut self, dir: &Path) -> Result<(), SkillModelError>;
+    /// Reads what [`SkillModel::save`] wrote. With `optimiser`, the optimiser state must be there
+    /// too (resuming training: a fresh optimiser would change the run); without, it is not read
+    /// (evaluation).
+    fn load(&mut self, dir: &Path, optimiser: bool) -> Result<(), SkillModelError>;
 }
 
 /// Which skill model, and its network and optimiser. `Default` = the paper's forward model.
@@ -258,8 +260,8 @@ impl SkillModel for ForwardModel {
         self.network.save(dir)
     }
 
-    fn load(&mut self, dir: &Path) -> Result<(), SkillModelError> {
-        self.network.load(dir)
+    fn load(&mut self, dir: &Path, optimiser: bool) -> Result<(), SkillModelError> {
+        self.network.load(dir, optimiser)
     }
 }
 
@@ -332,13 +334,13 @@ impl SkillModel for SkillDiscriminator {
         self.network.save(dir)
     }
 
-    fn load(&mut self, dir: &Path) -> Result<(), SkillModelError> {
-        self.network.load(dir)
+    fn load(&mut self, dir: &Path, optimiser: bool) -> Result<(), SkillModelError> {
+        self.network.load(dir, optimiser)
     }
 }
 
 /// A named network with its own var store and optimiser, saved as `<name>.safetensors` and
-/// `<name>_adam.safetensors` (the optimiser file is optional when loading, for evaluation).
+/// `<name>_adam.safetensors` (the optimiser file is read only when resuming training).
 #[derive(Debug)]
 struct Trainable {
     name: &'static str,
@@ -380,15 +382,15 @@ impl Trainable {
             .map_err(io)
     }
 
-    fn load(&mut self, dir: &Path) -> Result<(), SkillModelError> {
+    fn load(&mut self, dir: &Path, optimiser: bool) -> Result<(), SkillModelError> {
         let corrupt = |path: &Path, e: tch::TchError| SkillModelError::Checkpoint {
             path: path.display().to_string(),
             reason: e.to_string(),
         };
         let path = dir.join(format!("{}.safetensors", self.name));
         self.vs.load(&path).map_err(|e| corrupt(&path, e))?;
-        let path = dir.join(format!("{}_adam.safetensors", self.name));
-        if path.exists() {
+        if optimiser {
+            let path = dir.join(format!("{}_adam.safetensors", self.name));
             self.opt
                 .state_mut()
                 .load(&path)

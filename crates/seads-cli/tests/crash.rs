@@ -1,0 +1,285 @@
+//! Crash-point tests: `seads train` is killed with SIGKILL at many moments of its life, resumed,
+//! and must end with exactly the metrics of the run that was never killed.
+//!
+//! The moments are deterministic: with `SEADS_CRASH_POINT=N` the binary stops at the N-th moment
+//! of the run (after collecting an epoch, while SAC updates, after an epoch, after a metrics
+//! append, between the steps of a checkpoint write) and waits there to be killed. CI kills at 32
+//! moments spread over the run plus the first of each kind; `SEADS_CRASH_TEST_ALL=1` kills at
+//! every moment (the long variant, hundreds of kills).
+
+use std::io::{BufRead, BufReader};
+use std::path::{Path, PathBuf};
+use std::process::{Command, Stdio};
+use std::sync::OnceLock;
+
+use serde_json::Value;
+
+const SEADS: &str = env!("CARGO_BIN_EXE_seads");
+
+/// A small run: ~150 epochs of 8 short episodes, updates from epoch 4, an evaluation every 4
+/// epochs and a checkpoint every 5 (so checkpoints fall between evaluations too); ~900 moments.
+fn config(dir: &Path) -> PathBuf {
+    let text = std::fs::read_to_string(concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../../configs/lightsout-cursor.toml"
+    ))
+    .unwrap()
+    .replace("seed = 1", "seed = 5")
+    .replace("env_steps = 500000", "env_steps = 1600")
+    .replace("episodes_per_epoch = 32", "episodes_per_epoch = 8")
+    .replace("hidden = [256, 256]", "hidden = [32, 32]")
+    .replace("sampled_episodes = 256", "sampled_episodes = 32")
+    .replace("recent_episodes = 256", "recent_episodes = 16")
+    .replace("eval_every = 100", "eval_every = 4")
+    .replace("checkpoint_every = 100", "checkpoint_every = 5")
+    .replace("eval_seeds = 20", "eval_seeds = 1")
+    .replace("sac_threads_alone = 2", "sac_threads_alone = 0");
+    let path = dir.join("crash.toml");
+    std::fs::write(&path, text).unwrap();
+    path
+}
+
+fn train(config: &Path, out: &Path) -> Command {
+    let mut cmd = Command::new(SEADS);
+    cmd.args(["train", "--quiet", "--config"])
+        .arg(config)
+        .arg("--out")
+        .arg(out);
+    cmd
+}
+
+fn resume(out: &Path) -> std::process::Output {
+    let output = Command::new(SEADS)
+        .args(["train", "--quiet", "--resume"])
+        .arg(out)
+        .output()
+        .unwrap();
+    assert!(
+        output.status.success(),
+        "resuming {}: {}",
+        out.display(),
+        String::from_utf8_lossy(&output.stderr)
+    );
+    output
+}
+
+/// The metrics lines without what depends on the clock.
+fn metrics(run: &Path) -> Vec<Value> {
+    std::fs::read_to_string(run.join("metrics.jsonl"))
+        .unwrap()
+        .lines()
+        .map(|line| {
+            let mut v: Value = serde_json::from_str(line).unwrap();
+            let map = v.as_object_mut().unwrap();
+            for key in ["wall_s", "steps_per_s", "timings"] {
+                map.remove(key).unwrap();
+            }
+            v
+        })
+        .collect()
+}
+
+struct Baseline {
+    _dir: tempfile::TempDir,
+    config: PathBuf,
+    metrics: Vec<Value>,
+    /// The name of every moment of the run, in order.
+    moments: Vec<String>,
+}
+
+/// The run that is never killed, and the list of its moments.
+fn baseline() -> &'static Baseline {
+    static BASELINE: OnceLock<Baseline> = OnceLock::new();
+    BASELINE.get_or_init(|| {
+        let dir = tempfile::tempdir().unwrap();
+        let config = config(dir.path());
+        let out = dir.path().join("base");
+        let output = train(&config, &out)
+            .env("SEADS_CRASH_POINT", "list")
+            .output()
+            .unwrap();
+        assert!(output.status.success());
+        let moments: Vec<String> = String::from_utf8_lossy(&output.stderr)
+            .lines()
+            .filter_map(|l| l.strip_prefix("seads: moment "))
+            .map(str::to_owned)
+            .collect();
+        let metrics = metrics(&out);
+        assert!(metrics.len() >= 10, "{} evaluations", metrics.len());
+        Baseline {
+            _dir: dir,
+            config,
+            metrics,
+            moments,
+        }
+    })
+}
+
+/// Starts a fresh run, kills it with SIGKILL where it stopped at moment `point`, then resumes it
+/// to the end; returns the resumed run's stderr.
+fn kill_and_resume(point: usize, tear: bool) -> String {
+    let base = baseline();
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("run");
+    let mut child = train(&base.config, &out)
+        .env("SEADS_CRASH_POINT", point.to_string())
+        .stdout(Stdio::null())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    let stderr = BufReader::new(child.stderr.take().unwrap());
+    let mut stopped = false;
+    for line in stderr.lines() {
+        if line.unwrap().starts_with("seads: stopped at moment") {
+            stopped = true;
+            break;
+        }
+    }
+    assert!(stopped, "the run never reached moment {point}");
+    child.kill().unwrap(); // SIGKILL
+    child.wait().unwrap();
+    if tear {
+        // A crash during the append: the last line lost its second half and its newline.
+        let path = out.join("metrics.jsonl");
+        let text = std::fs::read_to_string(&path).unwrap();
+        let body = text.trim_end_matches('\n');
+        let start = body.rfind('\n').map_or(0, |i| i + 1);
+        let cut = start + (body.len() - start) / 2;
+        std::fs::write(&path, &body[..cut]).unwrap();
+    }
+    let output = resume(&out);
+    assert_eq!(
+        metrics(&out),
+        base.metrics,
+        "killed at moment {point} ({}), the resumed run differs",
+        base.moments[point - 1]
+    );
+    String::from_utf8_lossy(&output.stderr).into_owned()
+}
+
+/// The moments to kill at: 32 spread over the run and the first of each kind; every moment with
+/// `SEADS_CRASH_TEST_ALL=1`.
+fn points() -> Vec<usize> {
+    let moments = &baseline().moments;
+    let n = moments.len();
+    assert!(n >= 60, "{n} moments");
+    if std::env::var_os("SEADS_CRASH_TEST_ALL").is_some() {
+        return (1..=n).collect();
+    }
+    let mut points: Vec<usize> = (0..32).map(|i| 1 + i * (n - 1) / 31).collect();
+    for kind in [
+        "collected",
+        "prepared",
+        "epoch-done",
+        "metrics-appended",
+        "checkpoint-written",
+        "checkpoint-renamed",
+        "latest-written",
+    ] {
+        let first = moments.iter().position(|m| m == kind);
+        points.push(1 + first.unwrap_or_else(|| panic!("no moment {kind}")));
+    }
+    points.sort_unstable();
+    points.dedup();
+    points
+}
+
+fn kill_at_every_other_point(parity: usize) {
+    let moments = &baseline().moments;
+    for (i, point) in points().into_iter().enumerate() {
+        if i % 2 == parity {
+            let tear = moments[point - 1] == "metrics-appended";
+            kill_and_resume(point, tear);
+        }
+    }
+}
+
+/// Half of the kill points (the two halves run side by side).
+#[test]
+fn killed_runs_resume_to_the_same_metrics_a() {
+    kill_at_every_other_point(0);
+}
+
+/// The other half.
+#[test]
+fn killed_runs_resume_to_the_same_metrics_b() {
+    kill_at_every_other_point(1);
+}
+
+/// A run killed right after an append whose line was torn, and whose latest checkpoint is
+/// unreadable: resuming drops the torn line, falls back to the checkpoint before, says both on
+/// stderr, and still ends exactly as the run that was never killed.
+#[test]
+fn a_torn_line_and_a_corrupt_latest_checkpoint_are_repaired() {
+    let base = baseline();
+    // The second checkpoint's pointer update: an older complete checkpoint exists.
+    let point = 1 + base
+        .moments
+        .iter()
+        .enumerate()
+        .filter(|(_, m)| *m == "latest-written")
+        .nth(3)
+        .unwrap()
+        .0;
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("run");
+    let mut child = train(&base.config, &out)
+        .env("SEADS_CRASH_POINT", point.to_string())
+        .stdout(Stdio::null())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    for line in BufReader::new(child.stderr.take().unwrap()).lines() {
+        if line.unwrap().starts_with("seads: stopped") {
+            break;
+        }
+    }
+    child.kill().unwrap();
+    child.wait().unwrap();
+    let latest = std::fs::read_to_string(out.join("checkpoints/latest")).unwrap();
+    std::fs::write(
+        out.join("checkpoints")
+            .join(latest.trim())
+            .join("progress.json"),
+        "{",
+    )
+    .unwrap();
+    std::fs::create_dir(out.join("checkpoints/.epoch-000099.tmp")).unwrap();
+    let mut text = std::fs::read_to_string(out.join("metrics.jsonl")).unwrap();
+    text.push_str("{\"epoch\": 1");
+    std::fs::write(out.join("metrics.jsonl"), text).unwrap();
+    let stderr = String::from_utf8_lossy(&resume(&out).stderr).into_owned();
+    assert!(stderr.contains("passed over checkpoint"), "{stderr}");
+    assert!(stderr.contains("torn last line"), "{stderr}");
+    assert!(stderr.contains(".epoch-000099.tmp"), "{stderr}");
+    assert_eq!(metrics(&out), base.metrics);
+}
+
+/// `--env-steps` with `--resume` raises a finished run's budget and records it; lowering it is
+/// bad input.
+#[test]
+fn a_finished_run_can_be_extended() {
+    let base = baseline();
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("run");
+    assert!(train(&base.config, &out).output().unwrap().status.success());
+    let run = out.to_str().unwrap();
+    let output = Command::new(SEADS)
+        .args(["train", "--quiet", "--resume", run, "--env-steps", "2000"])
+        .output()
+        .unwrap();
+    assert!(output.status.success());
+    let config = std::fs::read_to_string(out.join("config.toml")).unwrap();
+    assert!(config.contains("env_steps = 2000"), "{config}");
+    let metrics = metrics(&out);
+    assert!(metrics.last().unwrap()["env_steps"].as_u64().unwrap() >= 2000);
+    // The rows up to the old end are the old run's.
+    assert_eq!(metrics[..base.metrics.len()], base.metrics[..]);
+    let output = Command::new(SEADS)
+        .args(["train", "--quiet", "--resume", run, "--env-steps", "100"])
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&output.stderr);
+    assert_eq!(output.status.code(), Some(2), "{stderr}");
+    assert!(stderr.contains("can only be raised"), "{stderr}");
+}

@@ -1,0 +1,259 @@
+//! The files of a run directory and how they are written, so that a crash at any point leaves a
+//! directory that resumes to exactly the run it would have been.
+//!
+//! The contract (docs/ARCHITECTURE.md, "Crash consistency"):
+//! - every file is written to a temporary name, fsynced, renamed into place and its folder
+//!   fsynced ([`write_atomic`]); a checkpoint is a folder written the same way ([`commit_dir`]);
+//! - `metrics.jsonl` only grows by whole lines, each fsynced before the checkpoint that follows
+//!   it; a line cut by a crash has no newline and is dropped when read ([`read_metrics`]);
+//! - the two newest checkpoints keep what resuming needs, so one that cannot be read has a
+//!   complete predecessor to fall back to.
+
+use std::fs;
+use std::io::Write as _;
+use std::path::{Path, PathBuf};
+
+use crate::{Metrics, RlError};
+
+/// The folder of checkpoints in a run directory.
+pub const CHECKPOINTS: &str = "checkpoints";
+/// The file in [`CHECKPOINTS`] that names the latest complete checkpoint.
+pub const LATEST: &str = "latest";
+/// The evaluation log of a run directory.
+pub const METRICS: &str = "metrics.jsonl";
+/// The configuration of a run directory.
+pub const CONFIG: &str = "config.toml";
+
+/// Writes `bytes` to `path` atomically and durably: a temporary file in the same folder,
+/// fsynced, renamed over `path`, and the folder fsynced.
+pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<(), RlError> {
+    let mut file =
+        atomic_write_file::AtomicWriteFile::open(path).map_err(|e| RlError::io(path, e))?;
+    file.write_all(bytes).map_err(|e| RlError::io(path, e))?;
+    file.commit().map_err(|e| RlError::io(path, e))
+}
+
+/// fsyncs a folder, so that the names created or renamed in it survive a power loss.
+pub fn sync_dir(dir: &Path) -> Result<(), RlError> {
+    fs::File::open(dir)
+        .and_then(|d| d.sync_all())
+        .map_err(|e| RlError::io(dir, e))
+}
+
+/// Makes the folder `tmp`, filled by the caller, the folder `dest`: fsyncs its files and itself,
+/// moves an existing `dest` aside, renames, fsyncs the parent, then removes what was aside.
+/// A crash leaves either the old `dest` or the new one (and at most a hidden leftover that
+/// [`clean_leftovers`] removes).
+pub fn commit_dir(tmp: &Path, dest: &Path) -> Result<(), RlError> {
+    for entry in fs::read_dir(tmp).map_err(|e| RlError::io(tmp, e))? {
+        let path = entry.map_err(|e| RlError::io(tmp, e))?.path();
+        fs::File::open(&path)
+            .and_then(|f| f.sync_all())
+            .map_err(|e| RlError::io(&path, e))?;
+    }
+    sync_dir(tmp)?;
+    let parent = dest.parent().unwrap_or(Path::new("."));
+    let aside = hidden_sibling(dest, "old");
+    if dest.exists() {
+        let _ = fs::remove_dir_all(&aside);
+        fs::rename(dest, &aside).map_err(|e| RlError::io(dest, e))?;
+    }
+    fs::rename(tmp, dest).map_err(|e| RlError::io(dest, e))?;
+    sync_dir(parent)?;
+    if aside.exists() {
+        fs::remove_dir_all(&aside).map_err(|e| RlError::io(&aside, e))?;
+    }
+    Ok(())
+}
+
+/// `.NAME.SUFFIX` beside `path`: where a checkpoint folder is written or set aside.
+pub fn hidden_sibling(path: &Path, suffix: &str) -> PathBuf {
+    let name = path
+        .file_name()
+        .map_or_else(Default::default, |n| n.to_string_lossy());
+    path.with_file_name(format!(".{name}.{suffix}"))
+}
+
+/// Removes the hidden leftovers of interrupted writes in `dir` (temporary checkpoint folders,
+/// folders set aside, temporary files). Returns their names.
+pub fn clean_leftovers(dir: &Path) -> Result<Vec<String>, RlError> {
+    let mut removed = Vec::new();
+    let entries = match fs::read_dir(dir) {
+        Ok(entries) => entries,
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok(removed),
+        Err(e) => return Err(RlError::io(dir, e)),
+    };
+    for entry in entries {
+        let entry = entry.map_err(|e| RlError::io(dir, e))?;
+        let name = entry.file_name().to_string_lossy().into_owned();
+        if !name.starts_with('.') {
+            continue;
+        }
+        let path = entry.path();
+        let result = if path.is_dir() {
+            fs::remove_dir_all(&path)
+        } else {
+            fs::remove_file(&path)
+        };
+        result.map_err(|e| RlError::io(&path, e))?;
+        removed.push(name);
+    }
+    Ok(removed)
+}
+
+/// The name of the checkpoint of epoch `epoch`.
+pub fn checkpoint_name(epoch: u64) -> String {
+    format!("epoch-{epoch:06}")
+}
+
+/// The epoch of a checkpoint folder name (`epoch-` and digits only), or `None`.
+pub fn checkpoint_epoch(name: &str) -> Option<u64> {
+    let digits = name.strip_prefix("epoch-")?;
+    if digits.is_empty() || !digits.bytes().all(|b| b.is_ascii_digit()) {
+        return None;
+    }
+    digits.parse().ok()
+}
+
+/// Every checkpoint folder of the run in `dir`, oldest first, as (epoch, path). Other entries
+/// (leftovers, the pointer) are not checkpoints.
+pub fn checkpoints(dir: &Path) -> Result<Vec<(u64, PathBuf)>, RlError> {
+    let root = dir.join(CHECKPOINTS);
+    let mut out = Vec::new();
+    for entry in fs::read_dir(&root).map_err(|e| RlError::io(&root, e))? {
+        let entry = entry.map_err(|e| RlError::io(&root, e))?;
+        let name = entry.file_name();
+        if let Some(epoch) = name.to_str().and_then(checkpoint_epoch)
+            && entry.path().is_dir()
+        {
+            out.push((epoch, entry.path()));
+        }
+    }
+    out.sort();
+    Ok(out)
+}
+
+/// The checkpoint `checkpoints/latest` names, if the pointer exists; the folder may be missing.
+pub fn latest_pointer(dir: &Path) -> Result<Option<PathBuf>, RlError> {
+    let pointer = dir.join(CHECKPOINTS).join(LATEST);
+    match fs::read_to_string(&pointer) {
+        Ok(name) => Ok(Some(dir.join(CHECKPOINTS).join(name.trim()))),
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => Ok(None),
+        Err(e) => Err(RlError::io(&pointer, e)),
+    }
+}
+
+/// The latest checkpoint of the run in `dir`, if any: the one `latest` names, or, if that is
+/// missing, the newest checkpoint folder.
+pub fn latest_checkpoint(dir: &Path) -> Result<Option<PathBuf>, RlError> {
+    if let Some(path) = latest_pointer(dir)?
+        && path.is_dir()
+    {
+        return Ok(Some(path));
+    }
+    Ok(checkpoints(dir)?.pop().map(|(_, path)| path))
+}
+
+/// The lines of `dir/metrics.jsonl`. A last line without its newline is the trace of a crash
+/// during the append and is left out; any other line that does not parse is an error.
+pub fn read_metrics(dir: &Path) -> Result<Vec<Metrics>, RlError> {
+    Ok(read_metrics_text(dir)?.0)
+}
+
+/// The whole lines of `dir/metrics.jsonl`, and whether a torn last line was left out.
+pub(crate) fn read_metrics_text(dir: &Path) -> Result<(Vec<Metrics>, bool), RlError> {
+    let path = dir.join(METRICS);
+    let text = fs::read_to_string(&path).map_err(|e| RlError::io(&path, e))?;
+    let (whole, torn) = match text.rfind('\n') {
+        Some(end) => (&text[..=end], !text[end + 1..].trim().is_empty()),
+        None => ("", !text.trim().is_empty()),
+    };
+    let metrics = whole
+        .lines()
+        .enumerate()
+        .filter(|(_, l)| !l.trim().is_empty())
+        .map(|(i, l)| {
+            serde_json::from_str(l).map_err(|e| RlError::Unreadable {
+                path: format!("{}:{}", path.display(), i + 1),
+                source: e.into(),
+            })
+        })
+        .collect::<Result<_, _>>()?;
+    Ok((metrics, torn))
+}
+
+/// Appends one line to `dir/metrics.jsonl` and fsyncs it.
+pub fn append_metrics(dir: &Path, metrics: &Metrics) -> Result<(), RlError> {
+    let path = dir.join(METRICS);
+    let mut line = serde_json::to_string(metrics).map_err(|e| RlError::io(&path, e))?;
+    line.push('\n');
+    let mut file = fs::OpenOptions::new()
+        .append(true)
+        .open(&path)
+        .map_err(|e| RlError::io(&path, e))?;
+    file.write_all(line.as_bytes())
+        .and_then(|()| file.sync_data())
+        .map_err(|e| RlError::io(&path, e))
+}
+
+/// Rewrites `dir/metrics.jsonl` with exactly `metrics`.
+pub fn write_metrics(dir: &Path, metrics: &[Metrics]) -> Result<(), RlError> {
+    let path = dir.join(METRICS);
+    let mut text = String::new();
+    for m in metrics {
+        text += &serde_json::to_string(m).map_err(|e| RlError::io(&path, e))?;
+        text.push('\n');
+    }
+    write_atomic(&path, text.as_bytes())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn checkpoint_names_round_trip_and_others_are_not_checkpoints() {
+        assert_eq!(checkpoint_name(20), "epoch-000020");
+        assert_eq!(checkpoint_epoch("epoch-000020"), Some(20));
+        assert_eq!(checkpoint_epoch("epoch-1234567"), Some(1_234_567));
+        for name in [
+            "epoch-",
+            "epoch-12a",
+            "epoch--1",
+            ".epoch-000020.tmp",
+            "latest",
+            "epoch-+3",
+        ] {
+            assert_eq!(checkpoint_epoch(name), None, "{name}");
+        }
+    }
+
+    #[test]
+    fn write_atomic_replaces_and_leaves_no_temporary_file() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("a.txt");
+        write_atomic(&path, b"one").unwrap();
+        write_atomic(&path, b"two").unwrap();
+        assert_eq!(fs::read_to_string(&path).unwrap(), "two");
+        assert_eq!(fs::read_dir(dir.path()).unwrap().count(), 1);
+    }
+
+    #[test]
+    fn commit_dir_replaces_a_folder_and_cleaning_removes_leftovers() {
+        let dir = tempfile::tempdir().unwrap();
+        let dest = dir.path().join("epoch-000010");
+        for content in ["old", "new"] {
+            let tmp = hidden_sibling(&dest, "tmp");
+            fs::create_dir_all(&tmp).unwrap();
+            fs::write(tmp.join("f"), content).unwrap();
+            commit_dir(&tmp, &dest).unwrap();
+        }
+        assert_eq!(fs::read_to_string(dest.join("f")).unwrap(), "new");
+        fs::create_dir(hidden_sibling(&dest, "tmp")).unwrap();
+        fs::write(dir.path().join(".latest.x1y2"), "").unwrap();
+        let mut removed = clean_leftovers(dir.path()).unwrap();
+        removed.sort();
+        assert_eq!(removed, [".epoch-000010.tmp", ".latest.x1y2"]);
+        assert!(dest.is_dir());
+    }
+}
