@@ -33,7 +33,7 @@ pub struct RunArgs {
     boards: usize,
     /// Time limit per search, seconds (a board that needs a move no skill makes is searched
     /// until then).
-    #[arg(long, default_value_t = 10.0)]
+    #[arg(long, default_value_t = 10.0, value_parser = crate::positive_finite)]
     timeout: f64,
 }
 
@@ -41,11 +41,16 @@ pub struct RunArgs {
 pub fn run(args: RunArgs) -> Result<()> {
     let mut run = if args.out.join("config.toml").exists() {
         println!("resuming the run in {}", args.out.display());
+        let config = seads_rl::load_config(&args.out)?;
+        crate::kernels::use_kernels(config.portable_numerics)?;
         crate::train::resume(&args.out, Run::resume(&args.out))?
     } else {
         let mut config = TrainConfig::preset(&args.env).map_err(|e| BadInput(e.into()))?;
         config.env_steps = args.env_steps;
         config.seed = args.seed;
+        // The demo gives the same numbers on every machine.
+        config.portable_numerics = true;
+        crate::kernels::use_kernels(true)?;
         println!(
             "training SEADS on {} for {} environment steps into {}",
             config.env,

@@ -51,7 +51,7 @@ pub struct RenderArgs {
     #[arg(long)]
     board_size: Option<usize>,
     /// Relative spacing between fields (spaced LightsOut boards), in [0, 1].
-    #[arg(long)]
+    #[arg(long, value_parser = crate::positive_finite)]
     spacing: Option<f64>,
 }
 
@@ -64,7 +64,7 @@ pub fn render(args: RenderArgs) -> Result<()> {
     };
     let mut env = build_env(&args.env, &config)?;
     env.seed(args.seed);
-    env.reset();
+    env.reset()?;
     let title = format!("{} (seed {})", args.env, args.seed);
     crate::draw::render_scene(&env.scene(), &title, &args.out)?;
     println!("wrote {}", args.out.display());
@@ -115,10 +115,10 @@ pub fn env_bench(args: BenchArgs) -> Result<()> {
         .map(|i| {
             let mut env = template.clone();
             env.seed(i as u64 + 1);
-            env.reset();
-            env
+            env.reset()?;
+            Ok(env)
         })
-        .collect();
+        .collect::<Result<_>>()?;
     let start = Instant::now();
     std::thread::scope(|scope| {
         let handles: Vec<_> = envs

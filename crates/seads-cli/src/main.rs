@@ -6,6 +6,7 @@ mod draw;
 mod envs;
 mod episodes;
 mod games;
+mod kernels;
 mod plan;
 mod plot;
 mod train;
@@ -64,6 +65,19 @@ enum Command {
 #[derive(Debug, thiserror::Error)]
 #[error(transparent)]
 pub struct BadInput(#[from] pub anyhow::Error);
+
+/// A command-line number that must be finite and positive (seconds, millimetres, spacings):
+/// negative, zero, NaN and infinite values are usage errors (exit code 2), never a panic.
+fn positive_finite(text: &str) -> Result<f64, String> {
+    let value: f64 = text
+        .parse()
+        .map_err(|_| format!("{text:?} is not a number"))?;
+    if value.is_finite() && value > 0.0 {
+        Ok(value)
+    } else {
+        Err(format!("{text} must be a finite number above 0"))
+    }
+}
 
 /// Keeps freed memory in the process: libtorch allocates and frees multi-megabyte temporaries
 /// on every training step, and glibc's defaults return them to the OS (mmap / trim), so each

@@ -22,6 +22,9 @@ use crate::envs::build_env;
 
 /// Loads the agent of a run, turning a missing or foreign directory into a clear error.
 pub fn load_agent(run: &Path, checkpoint: Option<u64>) -> Result<Agent> {
+    let config = seads_rl::load_config(run)
+        .with_context(|| format!("loading the agent of run {}", run.display()))?;
+    crate::kernels::use_kernels(config.portable_numerics)?;
     Agent::load(run, checkpoint)
         .with_context(|| format!("loading the agent of run {}", run.display()))
 }
@@ -45,7 +48,7 @@ pub struct SolveArgs {
     #[arg(long, default_value_t = 0)]
     seed: u64,
     /// Time limit per search, seconds.
-    #[arg(long, default_value_t = 300.0)]
+    #[arg(long, default_value_t = 300.0, value_parser = crate::positive_finite)]
     timeout: f64,
     /// Draw the board and the executed skills' paths into this image (.png or .svg).
     #[arg(long)]
@@ -62,7 +65,7 @@ pub fn solve_board(args: SolveArgs) -> Result<()> {
     let game = env.spec().game.build(env.spec().board_size)?;
     let board = game.parse(&args.board).map_err(|e| BadInput(e.into()))?;
     env.seed(args.seed);
-    env.reset();
+    env.reset()?;
     env.set_board(board).map_err(|e| BadInput(e.into()))?;
     let before = env.scene();
     let config = SolveConfig {
@@ -179,7 +182,7 @@ pub struct EvaluateArgs {
     #[arg(long)]
     checkpoint: Option<u64>,
     /// Time limit per search, seconds (the authors' evaluation used 60).
-    #[arg(long, default_value_t = 60.0)]
+    #[arg(long, default_value_t = 60.0, value_parser = crate::positive_finite)]
     timeout: f64,
     /// Print JSON.
     #[arg(long)]

@@ -33,7 +33,7 @@ pub struct PlotArgs {
     #[arg(long, default_value_t = 20)]
     boards: usize,
     /// Time limit per search in such an evaluation, seconds.
-    #[arg(long, default_value_t = 60.0)]
+    #[arg(long, default_value_t = 60.0, value_parser = crate::positive_finite)]
     timeout: f64,
 }
 
@@ -89,7 +89,7 @@ pub fn write_figures(
             },
         )?;
         env.seed(COVERAGE_SEED);
-        env.reset();
+        env.reset()?;
         env.scene()
     };
     both("trajectories", &|p| {
@@ -153,7 +153,7 @@ fn skill_runs(agent: &Agent) -> Result<Vec<Vec<SkillRun>>> {
             (0..20)
                 .map(|i| {
                     env.seed(COVERAGE_SEED + i);
-                    env.reset();
+                    env.reset()?;
                     Ok(execute_skill(env.as_mut(), &agent.policy, skill)?)
                 })
                 .collect()

@@ -73,10 +73,14 @@ pub fn train(args: TrainArgs) -> Result<()> {
                     other => anyhow::Error::from(other),
                 })?;
             }
+            let config = seads_rl::load_config(dir)
+                .with_context(|| format!("resuming {}", dir.display()))?;
+            crate::kernels::use_kernels(config.portable_numerics)?;
             resume(dir, Run::resume(dir))?
         }
         None => {
             let config = config(&args)?;
+            crate::kernels::use_kernels(config.portable_numerics)?;
             let out = args.out.as_ref().expect("clap requires --out");
             Run::create(out, config).map_err(|e| match e {
                 seads_rl::RlError::Config(_) => BadInput(e.into()).into(),

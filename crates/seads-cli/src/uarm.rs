@@ -39,13 +39,21 @@ pub struct Connection {
 }
 
 impl Connection {
-    fn twin(&self) -> Option<Twin> {
-        let rest = self.port.strip_prefix("sim")?;
-        let seed = rest
-            .strip_prefix(':')
-            .and_then(|s| s.parse().ok())
-            .unwrap_or(0);
-        Some(Twin::new(seed))
+    /// The twin that `--port sim` or `sim:SEED` asks for; any other port is a serial port.
+    fn twin(&self) -> Result<Option<Twin>> {
+        if self.port == "sim" {
+            return Ok(Some(Twin::new(0)));
+        }
+        let Some(seed) = self.port.strip_prefix("sim:") else {
+            return Ok(None);
+        };
+        let seed = seed.parse().map_err(|_| {
+            BadInput(anyhow::anyhow!(
+                "--port {}: the twin's seed must be a whole number (sim:SEED)",
+                self.port
+            ))
+        })?;
+        Ok(Some(Twin::new(seed)))
     }
 
     fn arm(&self, twin: Option<&Twin>) -> Result<Swift> {
@@ -73,7 +81,7 @@ pub struct CalibrateArgs {
     #[arg(long, default_value = "uarm-calibration.toml")]
     out: PathBuf,
     /// Distance from the screen for z = 1, mm.
-    #[arg(long, default_value_t = 100.0)]
+    #[arg(long, default_value_t = 100.0, value_parser = crate::positive_finite)]
     d_max_mm: f64,
 }
 
@@ -109,7 +117,7 @@ fn record_corners(arm: &mut Swift, twin: Option<&Twin>) -> Result<[[f64; 3]; 4]>
 
 /// `seads uarm calibrate`.
 pub fn calibrate(args: CalibrateArgs) -> Result<()> {
-    let twin = args.connection.twin();
+    let twin = args.connection.twin()?;
     let mut arm = args.connection.arm(twin.as_ref())?;
     let corners = record_corners(&mut arm, twin.as_ref())?;
     let calibration = Calibration::fit(CalibrationFile {
@@ -150,7 +158,7 @@ pub struct UarmTrainArgs {
     #[arg(long, default_value_t = 20)]
     boards: usize,
     /// Time limit per search in the final evaluation, seconds.
-    #[arg(long, default_value_t = 60.0)]
+    #[arg(long, default_value_t = 60.0, value_parser = crate::positive_finite)]
     timeout: f64,
     /// Continue the run in --out from its last checkpoint.
     #[arg(long)]
@@ -215,7 +223,14 @@ fn robot_config(env: &UarmEnv, args: &UarmTrainArgs) -> Result<TrainConfig> {
 
 /// `seads uarm train`.
 pub fn train(args: UarmTrainArgs) -> Result<()> {
-    let twin = args.connection.twin();
+    // Before the twin or the arm starts a thread: the kernels of the run (the preset's when new).
+    let portable = if args.resume {
+        load_config(&args.out)?.portable_numerics
+    } else {
+        TrainConfig::preset("lightsout-cursor")?.portable_numerics
+    };
+    crate::kernels::use_kernels(portable)?;
+    let twin = args.connection.twin()?;
     let env = build_env(&args, twin.as_ref())?;
     let trainer =
         |config: TrainConfig| Trainer::with_environments(config, env.box_clone(), env.box_clone());

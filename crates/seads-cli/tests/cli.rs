@@ -272,7 +272,8 @@ fn tiny_config(dir: &std::path::Path) -> std::path::PathBuf {
     .replace("checkpoint_every = 100", "checkpoint_every = 5")
     .replace("eval_seeds = 20", "eval_seeds = 1")
     // Tests run side by side: SAC taking a second thread would oversubscribe the cores.
-    .replace("sac_threads_alone = 2", "sac_threads_alone = 0");
+    .replace("sac_threads_alone = 2", "sac_threads_alone = 0")
+    .replace("portable_numerics = false", "portable_numerics = true");
     let path = dir.join("tiny.toml");
     std::fs::write(&path, text).unwrap();
     path
@@ -679,6 +680,30 @@ fn uarm_rejects_bad_input() {
         ],
         "line",
     );
+    // Issue 13: `sim:abc` became seed 0, and every port starting with `sim` the twin.
+    check_bad_input(
+        &[
+            "uarm",
+            "train",
+            "--port",
+            "sim:abc",
+            "--out",
+            run.to_str().unwrap(),
+        ],
+        "sim:SEED",
+    );
+    // A real arm: it needs a calibration, which the twin does not.
+    check_bad_input(
+        &[
+            "uarm",
+            "train",
+            "--port",
+            "simulated-arm",
+            "--out",
+            run.to_str().unwrap(),
+        ],
+        "needs --calibration",
+    );
     let out = seads(&[
         "uarm",
         "train",
@@ -711,4 +736,108 @@ fn uarm_rejects_bad_input() {
         ],
         "needs --calibration",
     );
+}
+
+/// The run's `portable_numerics` decides libtorch's kernels, not the environment the binary
+/// inherits: a portable run gives the same numbers whatever MKL_CBWR says, and a fast run is
+/// another run.
+#[test]
+fn the_run_decides_the_kernels() {
+    let dir = tempfile::tempdir().unwrap();
+    let portable = tiny_config(dir.path());
+    let fast = dir.path().join("fast.toml");
+    std::fs::write(
+        &fast,
+        std::fs::read_to_string(&portable)
+            .unwrap()
+            .replace("portable_numerics = true", "portable_numerics = false"),
+    )
+    .unwrap();
+    let losses = |config: &std::path::Path, mkl: &str, name: &str| -> Vec<String> {
+        let out = dir.path().join(name);
+        let status = std::process::Command::new(env!("CARGO_BIN_EXE_seads"))
+            .args(["train", "--quiet", "--config"])
+            .arg(config)
+            .arg("--out")
+            .arg(&out)
+            .env("MKL_CBWR", mkl)
+            .output()
+            .unwrap()
+            .status;
+        assert!(status.success());
+        std::fs::read_to_string(out.join("metrics.jsonl"))
+            .unwrap()
+            .lines()
+            .map(|l| {
+                let v: serde_json::Value = serde_json::from_str(l).unwrap();
+                format!("{} {}", v["critic_loss"], v["skill_model_loss"])
+            })
+            .collect()
+    };
+    let a = losses(&portable, "AUTO", "a");
+    assert_eq!(a, losses(&portable, "COMPATIBLE", "b"));
+    assert_ne!(a, losses(&fast, "COMPATIBLE", "c"));
+}
+
+/// Every numeric option rejects negative, NaN and infinite values with exit code 2 and an error,
+/// never a panic (issue 13: `--timeout=-1` and `--timeout nan` panicked).
+#[test]
+fn numeric_options_reject_negative_nan_and_infinite_values() {
+    let options: &[(&[&str], &str)] = &[
+        (&["run"], "--env-steps"),
+        (&["run"], "--seed"),
+        (&["run"], "--boards"),
+        (&["run"], "--timeout"),
+        (&["render"], "--seed"),
+        (&["render"], "--board-size"),
+        (&["render"], "--spacing"),
+        (&["env-bench"], "--steps"),
+        (&["env-bench"], "--threads"),
+        (&["env-bench"], "--physics-substeps"),
+        (&["record"], "--episodes"),
+        (&["record"], "--steps"),
+        (&["record"], "--seed"),
+        (&["games", "split"], "--max-depth"),
+        (&["games", "depths"], "--size"),
+        (&["solve"], "--checkpoint"),
+        (&["solve"], "--seed"),
+        (&["solve"], "--timeout"),
+        (&["evaluate"], "--boards"),
+        (&["evaluate"], "--seed"),
+        (&["evaluate"], "--checkpoint"),
+        (&["evaluate"], "--timeout"),
+        (&["plan-bench"], "--boards"),
+        (&["plan-bench"], "--threads"),
+        (&["plot"], "--checkpoint"),
+        (&["plot"], "--boards"),
+        (&["plot"], "--timeout"),
+        (&["train"], "--seed"),
+        (&["train"], "--env-steps"),
+        (&["uarm", "calibrate"], "--d-max-mm"),
+        (&["uarm", "train"], "--env-steps"),
+        (&["uarm", "train"], "--seed"),
+        (&["uarm", "train"], "--boards"),
+        (&["uarm", "train"], "--timeout"),
+    ];
+    // Four processes at a time: each start loads libtorch.
+    std::thread::scope(|scope| {
+        for part in options.chunks(options.len().div_ceil(4)) {
+            scope.spawn(move || {
+                for (command, option) in part {
+                    for value in ["-1", "nan", "inf", "-inf"] {
+                        let mut args = command.to_vec();
+                        let arg = format!("{option}={value}");
+                        args.push(&arg);
+                        let out = seads(&args);
+                        let stderr = String::from_utf8_lossy(&out.stderr);
+                        assert_eq!(out.status.code(), Some(2), "seads {args:?}: {stderr}");
+                        assert!(
+                            stderr.contains("error") && !stderr.contains("panicked"),
+                            "seads {args:?}: {stderr}"
+                        );
+                    }
+                }
+            });
+        }
+    });
 }

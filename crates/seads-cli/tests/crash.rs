@@ -33,7 +33,8 @@ fn config(dir: &Path) -> PathBuf {
     .replace("eval_every = 100", "eval_every = 4")
     .replace("checkpoint_every = 100", "checkpoint_every = 5")
     .replace("eval_seeds = 20", "eval_seeds = 1")
-    .replace("sac_threads_alone = 2", "sac_threads_alone = 0");
+    .replace("sac_threads_alone = 2", "sac_threads_alone = 0")
+    .replace("portable_numerics = false", "portable_numerics = true");
     let path = dir.join("crash.toml");
     std::fs::write(&path, text).unwrap();
     path

@@ -17,8 +17,9 @@ pub trait Environment: Send + Sync {
     fn spec(&self) -> &EnvSpec;
     /// Re-seeds the board's and the manipulator's random streams (both from `seed`).
     fn seed(&mut self, seed: u64);
-    /// Draws a new board and manipulator state and resets the step counter.
-    fn reset(&mut self);
+    /// Draws a new board and manipulator state and resets the step counter. Simulations cannot
+    /// fail here; hardware can (the robot reports a failed move or tablet).
+    fn reset(&mut self) -> Result<(), EnvError>;
     /// Applies one action. Errors on an action of the wrong length or with a non-finite entry,
     /// on a step past the step limit, and when the simulation diverges.
     fn step(&mut self, action: &[f32]) -> Result<StepOutcome, EnvError>;
@@ -78,7 +79,8 @@ pub trait Manipulator: Clone + Send + Sync + 'static {
     fn action_bounds(&self) -> (Vec<f32>, Vec<f32>);
     /// Default steps per skill T_max.
     fn default_step_limit(&self) -> usize;
-    /// Draws a random initial state.
+    /// Draws a random initial state. It depends on nothing but `rng`: no state of earlier
+    /// episodes survives a reset (a resumed run must collect what the killed run would have).
     fn reset(&mut self, rng: &mut ChaCha8Rng);
     /// Advances one environment step under a finite, correctly sized `action`. Each touch of the
     /// board is reported to `touch`, which answers what it did; once it answered a move, later
@@ -148,8 +150,15 @@ impl<M: Manipulator> Embodied<M> {
             steps: 0,
         };
         env.seed(0);
-        env.reset();
+        env.draw_initial_state();
         env
+    }
+
+    /// A new board and manipulator state from the random streams, and a fresh step counter.
+    fn draw_initial_state(&mut self) {
+        self.board.reset();
+        self.manipulator.reset(&mut self.rng);
+        self.steps = 0;
     }
 
     /// The manipulator.
@@ -168,10 +177,9 @@ impl<M: Manipulator> Environment for Embodied<M> {
         self.rng = ChaCha8Rng::seed_from_u64(seed);
     }
 
-    fn reset(&mut self) {
-        self.board.reset();
-        self.manipulator.reset(&mut self.rng);
-        self.steps = 0;
+    fn reset(&mut self) -> Result<(), EnvError> {
+        self.draw_initial_state();
+        Ok(())
     }
 
     fn step(&mut self, action: &[f32]) -> Result<StepOutcome, EnvError> {

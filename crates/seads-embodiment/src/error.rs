@@ -3,7 +3,7 @@
 use seads_games::GameError;
 
 /// What can go wrong when building or stepping an environment.
-#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[derive(Debug, thiserror::Error)]
 pub enum EnvError {
     /// No environment of this name is registered.
     #[error("unknown environment {name:?}; valid environments: {valid}")]
@@ -71,12 +71,13 @@ pub enum EnvError {
         what: String,
     },
     /// The robot hardware failed (the arm was left at hover height where possible).
-    #[error("{env}: hardware failure: {reason}")]
+    #[error("{env}: hardware failure")]
     Hardware {
         /// Environment name.
         env: String,
         /// What failed.
-        reason: String,
+        #[source]
+        source: Box<dyn std::error::Error + Send + Sync>,
     },
     /// A board that the game does not accept.
     #[error(transparent)]

@@ -49,7 +49,7 @@ pub fn record_episode(
     mut act: impl FnMut(&[f32], &mut [f32]),
 ) -> Result<EpisodeRecord, EnvError> {
     env.set_step_limit(None);
-    env.reset();
+    env.reset()?;
     let m = env.spec().manipulator_dim;
     let initial = env.observation();
     match env.restore_manipulator(&initial[..m]) {
@@ -86,7 +86,7 @@ fn move_of(push: Push) -> Option<MoveId> {
 }
 
 /// Why a record cannot be replayed.
-#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[derive(Debug, thiserror::Error)]
 pub enum ReplayError {
     /// The record is inconsistent with the environment.
     #[error("{0}")]

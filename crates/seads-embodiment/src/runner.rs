@@ -19,10 +19,10 @@ impl VecEnv {
             .map(|i| {
                 let mut env = template.clone();
                 env.seed(base_seed + i as u64 + 1);
-                env.reset();
-                env
+                env.reset()?;
+                Ok(env)
             })
-            .collect();
+            .collect::<Result<_, EnvError>>()?;
         Ok(Self {
             envs,
             parallel: false,
@@ -145,7 +145,7 @@ pub fn random_rollout(
         env.observe(&mut obs);
         moves += outcome.moved() as usize;
         if outcome.done() {
-            env.reset();
+            env.reset()?;
         }
     }
     Ok(moves)

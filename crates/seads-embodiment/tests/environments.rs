@@ -135,7 +135,7 @@ fn same_seed_same_episode() {
             let dim = env.spec().action_dim;
             let mut trace = Vec::new();
             for _ in 0..3 {
-                env.reset();
+                env.reset().unwrap();
                 for t in 0..10 {
                     let mut a = vec![0.15 * (t as f32).sin(); dim];
                     a[1] = -0.1;
@@ -164,7 +164,7 @@ fn step_limit_truncates_and_then_refuses() {
         },
     )
     .unwrap();
-    env.reset();
+    env.reset().unwrap();
     let obs = env.observation();
     assert_eq!(obs[27], 1.0, "remaining time starts at 1");
     let mut last = StepOutcome::default();
@@ -196,7 +196,7 @@ fn reset_boards_follow_the_split_and_depth() {
         env.seed(11);
         let mut depths = [0usize; 6];
         for _ in 0..300 {
-            env.reset();
+            env.reset().unwrap();
             let board = env.board();
             assert_eq!(split_of(&game.values(board)), split);
             depths[solver.depth(board).unwrap()] += 1;
@@ -215,7 +215,7 @@ fn reset_boards_follow_the_split_and_depth() {
 #[test]
 fn moves_end_the_skill_and_change_phi() {
     let mut env = make_env("lightsout-cursor", &EnvConfig::default()).unwrap();
-    env.reset();
+    env.reset().unwrap();
     let before = env.board();
     let out = env.step(&[0.0, 0.0, 1.0]).unwrap();
     assert!(out.moved() && out.done());
@@ -238,7 +238,7 @@ fn spaced_boards_of_every_size_build() {
         let mut env = make_env("lightsout-cursor", &config).unwrap();
         assert_eq!(env.spec().num_skills, n * n);
         assert_eq!(env.spec().obs_dim, 2 + n * n + 1);
-        env.reset();
+        env.reset().unwrap();
         assert!(!env.board().is_zero());
     }
 }
@@ -253,7 +253,7 @@ fn vec_env_steps_like_single_environments() {
         .map(|i| {
             let mut e = make_env("lightsout-reacher", &config).unwrap();
             e.seed(101 + i);
-            e.reset();
+            e.reset().unwrap();
             e
         })
         .collect();
@@ -286,7 +286,7 @@ fn vec_env_steps_like_single_environments() {
 fn jaco_clones_continue_identically_and_cannot_be_restored() {
     let mut env = make_env("tileswap-jaco", &EnvConfig::default()).unwrap();
     env.seed(4);
-    env.reset();
+    env.reset().unwrap();
     let action = [0.3, -0.2, 0.1, 0.5, -0.5, 0.2, 1.0, 1.0, 1.0];
     env.step(&action).unwrap();
     let mut copy = env.clone();

@@ -68,7 +68,7 @@ fn controller(target: Vector, obs: &[f32]) -> Vec<f32> {
 /// Aims at board point `target` (world x, y): above it first, then down. Returns the move made.
 fn press(env: &mut dyn Environment, seed: u64, target: [f32; 2], top: f32) -> Option<MoveId> {
     env.seed(seed);
-    env.reset();
+    env.reset().unwrap();
     let limit = env.spec().step_limit.unwrap();
     let mut descending = false;
     for _ in 0..limit {
@@ -98,7 +98,7 @@ fn forward_kinematics_matches_the_observed_pinch_site() {
     let mut env = make_env("lightsout-jaco", &EnvConfig::default()).unwrap();
     for seed in 0..3 {
         env.seed(seed);
-        env.reset();
+        env.reset().unwrap();
         let obs = env.observation();
         let (tcp, z) = forward(&angles(&obs));
         // Reset puts the tool in the box above the board, pointing down.

@@ -43,7 +43,7 @@ fn record_then_replay_is_identical_for_every_replayable_environment() {
             );
             let mut env = make_env(name, &config).unwrap();
             env.seed(seed + 100); // a different state before the replay must not matter
-            env.reset();
+            env.reset().unwrap();
             let replayed = replay_episode(env.as_mut(), &recorded).unwrap();
             assert_eq!(replayed, recorded, "{name}, seed {seed}");
             let c = compare(&recorded, &replayed, env.spec().manipulator_dim);

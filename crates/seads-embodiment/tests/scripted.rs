@@ -42,7 +42,7 @@ fn run_skill(
     mut controller: impl FnMut(&[f32]) -> [f32; 3],
 ) -> Option<MoveId> {
     env.seed(seed);
-    env.reset();
+    env.reset().unwrap();
     let limit = env.spec().step_limit.unwrap();
     for _ in 0..limit {
         let obs = env.observation();
@@ -153,7 +153,7 @@ fn reacher_produces_every_move() {
 fn a_push_off_every_pivot_is_a_miss_and_the_skill_continues() {
     let mut env = make_env("tileswap-cursor", &EnvConfig::default()).unwrap();
     env.seed(9);
-    env.reset();
+    env.reset().unwrap();
     let before = env.board();
     // Move to the top-left corner (a dead zone) and push there.
     let mut outcome = env.step(&[-0.2, -0.2, -1.0]).unwrap();

@@ -16,7 +16,8 @@ pub struct PlannerConfig {
     pub max_layers: usize,
     /// Memory bound of the search structures, MiB.
     pub memory_limit_mib: usize,
-    /// Wall-clock limit per search, seconds (`None`: unlimited).
+    /// Wall-clock limit per search, seconds (`None`, or a value too large for the clock:
+    /// unlimited; NaN or negative: none, the search stops at once).
     pub timeout_s: Option<f64>,
     /// States expanded per call of the successor function.
     pub batch_size: usize,
@@ -130,7 +131,12 @@ fn search<K: Key>(
     config: &PlannerConfig,
 ) -> Result<Plan, PlanError> {
     let began = Instant::now();
-    let deadline = config.timeout_s.map(|s| began + Duration::from_secs_f64(s));
+    // Any number is a limit: NaN and negative ones leave no time, and one too large for the
+    // clock (infinity included) none at all.
+    let deadline = config.timeout_s.and_then(|s| {
+        let limit = Duration::try_from_secs_f64(s.max(0.0)).ok()?;
+        began.checked_add(limit)
+    });
     let k = successor.num_skills();
     let limit_bytes = config.memory_limit_mib.saturating_mul(1 << 20);
     let mut nodes = vec![Node {

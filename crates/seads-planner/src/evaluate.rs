@@ -85,7 +85,7 @@ pub fn evaluate(
         };
         for &seed in &evaluation.seeds {
             env.seed(seed);
-            env.reset();
+            env.reset()?;
             let outcome = solve(env.as_mut(), policy, successor, goal, &evaluation.solve)?;
             result.tasks += 1;
             result.plan_found += outcome.plan_found as usize;

@@ -189,7 +189,7 @@ fn test_env(depth: usize, seed: u64) -> Box<dyn Environment> {
     };
     let mut env = make_env("lightsout-cursor", &config).unwrap();
     env.seed(seed);
-    env.reset();
+    env.reset().unwrap();
     env
 }
 

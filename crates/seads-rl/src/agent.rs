@@ -85,6 +85,7 @@ impl Agent {
         spec: EnvSpec,
         checkpoint: &Path,
     ) -> Result<Self, RlError> {
+        crate::numerics::check(config.portable_numerics)?;
         let k = config.num_skills.unwrap_or(spec.num_skills);
         let mut sac = Sac::new(
             spec.obs_dim + k,

@@ -72,6 +72,10 @@ pub struct TrainConfig {
     /// has two cores to itself; set 0 when several runs share the cores, since libtorch's threads
     /// busy-wait and slow down badly when the cores are oversubscribed.
     pub sac_threads_alone: usize,
+    /// Run libtorch with kernels that give the same numbers on every x86-64 machine (MKL's
+    /// `COMPATIBLE` branch), so that the seed alone fixes the run. About 1.8× slower per SAC
+    /// update; off in the presets, on for the demo and the tests (see `seads_rl::numerics`).
+    pub portable_numerics: bool,
 }
 
 impl Default for TrainConfig {
@@ -95,6 +99,7 @@ impl Default for TrainConfig {
             checkpoint_every: 100,
             threads: 0,
             sac_threads_alone: 0,
+            portable_numerics: false,
         }
     }
 }

@@ -156,7 +156,7 @@ pub fn skill_coverage(
     for &seed in seeds {
         let mut env = template.box_clone();
         env.seed(seed);
-        env.reset();
+        env.reset()?;
         for k in 0..num_skills {
             envs.push(env.box_clone());
             skills.push(k);

@@ -11,6 +11,7 @@
 mod agent;
 mod config;
 mod episode;
+mod numerics;
 mod run;
 mod sac;
 mod seeds;
@@ -22,6 +23,7 @@ use std::path::Path;
 pub use agent::{Agent, AgentPolicy};
 pub use config::{RelabelConfig, TrainConfig};
 pub use episode::{Episode, policy_input, run_episodes, skill_coverage};
+pub use numerics::{FAST_KERNELS, PORTABLE_KERNELS, kernel_environment, portable_kernels_active};
 pub use run::{Hook, Metrics, Moment, Run, RunEvent, load_config, raise_budget};
 pub use sac::{Sac, SacConfig, SacLosses, TransitionBatch};
 pub use seeds::{Purpose, derived_seed, stream, train_env_seed};

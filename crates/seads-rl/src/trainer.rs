@@ -133,6 +133,7 @@ impl Trainer {
         eval_env: Box<dyn Environment>,
     ) -> Result<Self, RlError> {
         config.validate_values()?;
+        crate::numerics::check(config.portable_numerics)?;
         if config.threads > 0 {
             tch::set_num_threads(config.threads as i32);
         }
@@ -267,7 +268,7 @@ impl Trainer {
                 slots,
                 slot,
             ));
-            env.reset();
+            env.reset()?;
         }
         let new = run_episodes(
             &mut self.envs,

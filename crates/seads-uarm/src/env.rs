@@ -90,9 +90,13 @@ impl UarmEnv {
         calibration: Calibration,
         config: UarmConfig,
     ) -> Result<Self, UarmError> {
-        if config.step_limit == 0 || config.tap_timeout_s.is_nan() || config.tap_timeout_s < 0.0 {
+        if config.step_limit == 0
+            || !config.tap_timeout_s.is_finite()
+            || config.tap_timeout_s < 0.0
+            || config.tap_timeout_s > 3600.0
+        {
             return Err(UarmError::Config(
-                "step_limit must be at least 1 and tap_timeout_s non-negative".into(),
+                "step_limit must be at least 1 and tap_timeout_s in [0, 3600] seconds".into(),
             ));
         }
         let game = LightsOut::new(5).expect("5×5");
@@ -155,7 +159,7 @@ impl UarmEnv {
     fn hardware_error(&self, e: UarmError) -> EnvError {
         EnvError::Hardware {
             env: self.spec.name.clone(),
-            reason: e.to_string(),
+            source: Box::new(e),
         }
     }
 
@@ -220,10 +224,10 @@ impl Environment for UarmEnv {
         self.lock().rng = ChaCha8Rng::seed_from_u64(seed);
     }
 
-    fn reset(&mut self) {
+    fn reset(&mut self) -> Result<(), EnvError> {
         self.steps = 0;
         if !self.config.reset_board {
-            return;
+            return Ok(());
         }
         let mut hw = self.lock();
         let depth = hw.rng.random_range(1..=5);
@@ -232,16 +236,17 @@ impl Environment for UarmEnv {
             .sample(depth, Split::Train, &mut hw.rng)
             .expect("LightsOut has boards of depth 1..5");
         let cursor = [hw.rng.random::<f64>(), hw.rng.random::<f64>()];
-        if hw.tablet.set_board(board).is_ok() {
+        let result = (|| {
+            hw.tablet.set_board(board)?;
             hw.board = board;
-            if let Ok(r) = hw.tablet.latest(Duration::ZERO) {
-                hw.seq = r.seq;
-            }
-        }
-        let target = hw.calibration.to_arm(cursor[0], cursor[1], self.hover());
-        if hw.arm.move_to(target).is_ok() {
+            hw.seq = hw.tablet.latest(Duration::ZERO)?.seq;
+            let target = hw.calibration.to_arm(cursor[0], cursor[1], self.hover());
+            hw.arm.move_to(target)?;
             hw.cursor = cursor;
-        }
+            Ok(())
+        })();
+        drop(hw);
+        result.map_err(|e| self.hardware_error(e))
     }
 
     fn step(&mut self, action: &[f32]) -> Result<StepOutcome, EnvError> {
@@ -320,10 +325,7 @@ impl Environment for UarmEnv {
         let target = hw
             .calibration
             .to_arm(state[0] as f64, state[1] as f64, self.hover());
-        hw.arm.move_to(target).map_err(|e| EnvError::Hardware {
-            env: self.spec.name.clone(),
-            reason: e.to_string(),
-        })?;
+        hw.arm.move_to(target).map_err(|e| self.hardware_error(e))?;
         hw.cursor = [state[0] as f64, state[1] as f64];
         Ok(())
     }

@@ -53,10 +53,13 @@ pub fn parse_reply(line: &str) -> Reply {
         return garbled();
     };
     let status = status.trim();
-    if status.len() >= 2 && status[..2].eq_ignore_ascii_case("ok") {
+    // By bytes, not characters: a garbled line holds multi-byte U+FFFD.
+    if let Some((head, payload)) = status.split_at_checked(2)
+        && head.eq_ignore_ascii_case("ok")
+    {
         return Reply::Ok {
             id,
-            payload: status[2..].trim().to_owned(),
+            payload: payload.trim().to_owned(),
         };
     }
     match status
@@ -127,11 +130,36 @@ mod tests {
             "$5 maybe",
             "#5 G0",
             "\u{fffd}$5 ok",
+            // Issue 13: a garbled status byte became U+FFFD and slicing two bytes panicked.
+            "$12 \u{fffd}k",
+            "$12 o\u{fffd}",
         ] {
             assert!(
                 matches!(parse_reply(garbled), Reply::Garbled(_)),
                 "{garbled:?}"
             );
+        }
+    }
+
+    proptest::proptest! {
+        /// Any bytes off the wire, decoded as the driver decodes them, parse without a panic;
+        /// replies that do not start with `$`, `@` are garbled.
+        #[test]
+        fn any_bytes_parse_without_a_panic(bytes in proptest::collection::vec(proptest::num::u8::ANY, 0..40)) {
+            let line = String::from_utf8_lossy(&bytes);
+            let reply = parse_reply(&line);
+            let trimmed = line.trim();
+            if !trimmed.starts_with('$') && !trimmed.starts_with('@') {
+                proptest::prop_assert!(matches!(reply, Reply::Garbled(_)));
+            }
+            let _ = parse_position(&line);
+        }
+
+        /// A dollar line with a garbled status never panics either (the case above rarely draws).
+        #[test]
+        fn dollar_lines_with_any_status_parse(id in 0u16..10000, bytes in proptest::collection::vec(proptest::num::u8::ANY, 0..12)) {
+            let line = format!("${id} {}", String::from_utf8_lossy(&bytes));
+            let _ = parse_reply(&line);
         }
     }
 

@@ -127,7 +127,7 @@ fn absolute_pushes_press_the_field_under_the_pen() {
     let game = LightsOut::new(5).unwrap();
     env.seed(5);
     for field in 0..25 {
-        env.reset();
+        env.reset().unwrap();
         let before = env.board();
         let (x, y) = (
             (field % 5) as f32 * 0.2 + 0.1,
@@ -150,7 +150,7 @@ fn displacements_move_and_press_like_the_cursor() {
     let twin = Twin::new(6);
     let mut env = env(&twin, ActionSpace::Displacement);
     env.seed(1);
-    env.reset();
+    env.reset().unwrap();
     env.restore_manipulator(&[0.5, 0.5]).unwrap();
     let before = env.board();
     let out = env.step(&[0.2, 0.0, -1.0]).unwrap();
@@ -162,12 +162,38 @@ fn displacements_move_and_press_like_the_cursor() {
     assert_eq!(env.board(), LightsOut::new(5).unwrap().apply(before, 13));
 }
 
+/// An error and its sources, as the CLI prints them.
+fn chain(err: &dyn std::error::Error) -> String {
+    let mut text = err.to_string();
+    let mut source = err.source();
+    while let Some(e) = source {
+        text += &format!(": {e}");
+        source = e.source();
+    }
+    text
+}
+
+/// A reset that cannot move the arm is an error (issue 13: resets swallowed hardware errors).
+#[test]
+fn a_failed_reset_is_an_error() {
+    let twin = Twin::new(7);
+    let mut env = env(&twin, ActionSpace::Absolute);
+    env.seed(2);
+    twin.inject(Faults {
+        disconnect_at: Some(1),
+        ..Faults::default()
+    });
+    let err = env.reset().unwrap_err();
+    assert!(matches!(err, EnvError::Hardware { .. }), "{err}");
+    assert!(chain(&err).contains("disconnected"), "{}", chain(&err));
+}
+
 #[test]
 fn faults_mid_move_end_in_an_error_with_the_pen_lifted() {
     let twin = Twin::new(7);
     let mut env = env(&twin, ActionSpace::Absolute);
     env.seed(2);
-    env.reset();
+    env.reset().unwrap();
     // The press is commanded but its acknowledgement never comes.
     twin.inject(Faults {
         silent_at: Some(3),
@@ -175,7 +201,7 @@ fn faults_mid_move_end_in_an_error_with_the_pen_lifted() {
     });
     let err = env.step(&[0.5, 0.5]).unwrap_err();
     assert!(matches!(err, EnvError::Hardware { .. }), "{err}");
-    assert!(err.to_string().contains("did not answer"), "{err}");
+    assert!(chain(&err).contains("did not answer"), "{}", chain(&err));
     assert!(
         (twin.pen_height_mm() - 20.0).abs() < 0.01,
         "the pen is lifted to hover height"
@@ -197,7 +223,7 @@ fn faults_mid_move_end_in_an_error_with_the_pen_lifted() {
         ..Faults::default()
     });
     let err = env.step(&[0.3, 0.3]).unwrap_err();
-    assert!(err.to_string().contains("disconnected"), "{err}");
+    assert!(chain(&err).contains("disconnected"), "{}", chain(&err));
     twin.reconnect();
     env.reset_step_counter();
     assert!(env.step(&[0.9, 0.9]).is_ok());
@@ -227,7 +253,7 @@ fn the_simulated_arm_records_and_replays_exactly() {
     })
     .unwrap();
     assert!(recorded.steps.iter().any(|s| s.game_move.is_some()));
-    env.reset();
+    env.reset().unwrap();
     let replayed = replay_episode(&mut env, &recorded).unwrap();
     assert_eq!(replayed, recorded);
 }
@@ -251,7 +277,7 @@ fn episodes_on_one_robot_run_one_after_another() {
     use seads_rl::{Sac, SacConfig, run_episodes};
     let twin = Twin::new(5);
     let mut config_env = env(&twin, ActionSpace::Absolute);
-    config_env.reset();
+    config_env.reset().unwrap();
     let k = 25;
     let input = config_env.spec().obs_dim + k;
     let spec = config_env.spec().clone();
