@@ -39,3 +39,184 @@ fn readme_starts_with_the_two_commands_and_ci_runs_the_second() {
         ".ci/run must run `cargo xtask ci`"
     );
 }
+
+/// `cargo metadata` of the workspace, with the resolved dependency graph.
+fn metadata() -> serde_json::Value {
+    let cargo = std::env::var("CARGO").unwrap_or_else(|_| "cargo".into());
+    let out = std::process::Command::new(cargo)
+        .args(["metadata", "--format-version", "1", "--offline"])
+        .current_dir(root())
+        .output()
+        .expect("run cargo metadata");
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    serde_json::from_slice(&out.stdout).unwrap()
+}
+
+/// Every package's name and its normal (not dev or build) dependencies, by package id.
+fn normal_graph(meta: &serde_json::Value) -> Vec<(String, String, Vec<String>)> {
+    let name_of = |id: &str| -> String {
+        meta["packages"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .find(|p| p["id"] == id)
+            .map(|p| p["name"].as_str().unwrap().to_owned())
+            .unwrap()
+    };
+    meta["resolve"]["nodes"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|node| {
+            let id = node["id"].as_str().unwrap().to_owned();
+            let deps = node["deps"]
+                .as_array()
+                .unwrap()
+                .iter()
+                .filter(|d| {
+                    d["dep_kinds"]
+                        .as_array()
+                        .unwrap()
+                        .iter()
+                        .any(|k| k["kind"].is_null())
+                })
+                .map(|d| d["pkg"].as_str().unwrap().to_owned())
+                .collect();
+            (name_of(&id), id, deps)
+        })
+        .collect()
+}
+
+/// The internal dependencies are the ones docs/ARCHITECTURE.md states, and only the crates it
+/// names link libtorch (tch), counting dependencies of dependencies.
+#[test]
+fn crate_dependencies_point_one_way_and_only_three_crates_link_libtorch() {
+    let meta = metadata();
+    let graph = normal_graph(&meta);
+    let expected: &[(&str, &[&str])] = &[
+        ("seads-games", &[]),
+        ("seads-embodiment", &["seads-games"]),
+        ("seads-skillmodel", &["seads-games"]),
+        (
+            "seads-rl",
+            &["seads-embodiment", "seads-games", "seads-skillmodel"],
+        ),
+        ("seads-planner", &["seads-embodiment", "seads-games"]),
+        ("seads-uarm", &["seads-embodiment", "seads-games"]),
+        (
+            "seads-cli",
+            &[
+                "seads-embodiment",
+                "seads-games",
+                "seads-planner",
+                "seads-rl",
+                "seads-skillmodel",
+                "seads-uarm",
+            ],
+        ),
+    ];
+    let by_id = |id: &String| graph.iter().find(|(_, i, _)| i == id).unwrap();
+    for (name, internal) in expected {
+        let (_, _, deps) = graph.iter().find(|(n, _, _)| n == name).unwrap();
+        let mut found: Vec<&str> = deps
+            .iter()
+            .map(|d| by_id(d).0.as_str())
+            .filter(|n| n.starts_with("seads-"))
+            .collect();
+        found.sort_unstable();
+        assert_eq!(&found, internal, "internal dependencies of {name}");
+    }
+    let links_tch = |name: &str| {
+        let start = graph.iter().find(|(n, _, _)| n == name).unwrap();
+        let mut stack = vec![start.1.clone()];
+        let mut seen = Vec::new();
+        while let Some(id) = stack.pop() {
+            if seen.contains(&id) {
+                continue;
+            }
+            let node = by_id(&id);
+            if node.0 == "tch" {
+                return true;
+            }
+            stack.extend(node.2.iter().cloned());
+            seen.push(id);
+        }
+        false
+    };
+    let linking: Vec<&str> = expected
+        .iter()
+        .map(|(n, _)| *n)
+        .filter(|n| links_tch(n))
+        .collect();
+    assert_eq!(linking, ["seads-skillmodel", "seads-rl", "seads-cli"]);
+}
+
+/// Every `.rs` file under `crates/`, with its text.
+fn sources() -> Vec<(std::path::PathBuf, String)> {
+    let mut out = Vec::new();
+    let mut dirs = vec![root().join("crates")];
+    while let Some(dir) = dirs.pop() {
+        for entry in std::fs::read_dir(dir).unwrap() {
+            let path = entry.unwrap().path();
+            if path.is_dir() {
+                dirs.push(path);
+            } else if path.extension().is_some_and(|e| e == "rs") {
+                let text = std::fs::read_to_string(&path).unwrap();
+                out.push((path, text));
+            }
+        }
+    }
+    out
+}
+
+/// No code draws from libtorch's global generator: every random number comes from a stream of
+/// the run's seed (docs/ARCHITECTURE.md, "Determinism").
+#[test]
+fn nothing_uses_libtorchs_global_generator() {
+    let calls = [
+        "manual_seed",
+        "Tensor::rand",
+        "Tensor::randn",
+        "Tensor::randint",
+        "Tensor::randperm",
+        "rand_like",
+        "randn_like",
+        ".bernoulli",
+        ".multinomial",
+        ".normal_(",
+        ".uniform_(",
+        "dropout",
+        "nn::init::",
+    ];
+    for (path, text) in sources() {
+        for call in calls {
+            assert!(
+                !text.contains(call),
+                "{} uses libtorch's generator ({call})",
+                path.display()
+            );
+        }
+    }
+}
+
+/// Every registered environment has a shipped preset, and the trainer embeds every preset.
+#[test]
+fn every_environment_has_a_preset() {
+    let embedded = read("crates/seads-rl/src/config.rs");
+    for env in seads_embodiment::env_names() {
+        let file = format!("configs/{env}.toml");
+        let text = read(&file);
+        assert!(
+            text.contains(&format!("env = \"{env}\"")),
+            "{file} trains {env}"
+        );
+        assert!(
+            embedded.contains(&format!("\"../../../{file}\"")),
+            "crates/seads-rl/src/config.rs embeds {file}"
+        );
+    }
+}

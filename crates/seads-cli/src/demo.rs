@@ -80,7 +80,7 @@ pub fn run(args: RunArgs) -> Result<()> {
     let once = run_evaluation(&mut agent, &args.out, tasks(false), false)?;
     let (a, b) = (summarise(&replan), summarise(&once));
     for r in &replan {
-        let key = r.depth.to_string();
+        let key = r.depth;
         let steps = a.solution_steps[&key].map_or("-".to_owned(), |s| format!("{s:.0}"));
         println!(
             "{:>6}   {:>15.0}%   {:>8.0}%   {:>10}",

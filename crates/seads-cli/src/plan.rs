@@ -305,7 +305,7 @@ pub fn evaluate_run(args: EvaluateArgs) -> Result<()> {
         );
         println!(" depth  success  plan found  search s  median steps  median skill steps");
         for r in &results {
-            let key = r.depth.to_string();
+            let key = r.depth;
             let fmt = |v: Option<f64>| v.map_or("-".to_owned(), |x| format!("{x:.1}"));
             println!(
                 "{:>6}  {:>6.0}%  {:>9.0}%  {:>8.3}  {:>12}  {:>18}",

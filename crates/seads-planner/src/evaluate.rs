@@ -103,19 +103,20 @@ pub fn evaluate(
 }
 
 /// The machine-readable summary: per depth, success rate, plan-found rate, mean planning
-/// seconds, median solution steps and median skill steps (solved tasks only).
+/// seconds, median solution steps and median skill steps (solved tasks only). Keyed by depth as a
+/// number, so that depth 10 follows depth 9 (JSON writes the keys as strings, in that order).
 #[derive(Debug, Clone, Serialize)]
 pub struct EvaluationSummary {
     /// Fraction of tasks solved.
-    pub success_rate: BTreeMap<String, f64>,
+    pub success_rate: BTreeMap<usize, f64>,
     /// Fraction of tasks whose first search found a plan.
-    pub plan_found: BTreeMap<String, f64>,
+    pub plan_found: BTreeMap<usize, f64>,
     /// Mean seconds of search per task.
-    pub planning_s: BTreeMap<String, f64>,
+    pub planning_s: BTreeMap<usize, f64>,
     /// Median manipulator steps of solved tasks.
-    pub solution_steps: BTreeMap<String, Option<f64>>,
+    pub solution_steps: BTreeMap<usize, Option<f64>>,
     /// Median manipulator steps per skill in solved tasks.
-    pub skill_steps: BTreeMap<String, Option<f64>>,
+    pub skill_steps: BTreeMap<usize, Option<f64>>,
 }
 
 fn median<T: Copy + Into<f64>>(values: &[T]) -> Option<f64> {
@@ -134,7 +135,7 @@ fn median<T: Copy + Into<f64>>(values: &[T]) -> Option<f64> {
 
 /// Summarises per-depth results.
 pub fn summarise(results: &[DepthResult]) -> EvaluationSummary {
-    let key = |r: &DepthResult| r.depth.to_string();
+    let key = |r: &DepthResult| r.depth;
     let rate = |n: usize, r: &DepthResult| n as f64 / r.tasks.max(1) as f64;
     let to_f64 = |v: &[usize]| v.iter().map(|&x| x as u32).collect::<Vec<u32>>();
     EvaluationSummary {

@@ -9,7 +9,8 @@ use seads_games::{
     TileSwap,
 };
 use seads_planner::{
-    Evaluation, PlanError, PlannerConfig, SolveConfig, bfs_plan, evaluate, solve, summarise,
+    DepthResult, Evaluation, PlanError, PlannerConfig, SolveConfig, bfs_plan, evaluate, solve,
+    summarise,
 };
 use std::sync::LazyLock;
 
@@ -291,7 +292,25 @@ fn evaluation_protocol_reports_per_depth() {
         vec![(1, 4, 4), (3, 4, 4)]
     );
     let summary = summarise(&results);
-    assert_eq!(summary.success_rate["3"], 1.0);
-    assert_eq!(summary.plan_found["1"], 1.0);
-    assert!(summary.solution_steps["3"].unwrap() >= 3.0);
+    assert_eq!(summary.success_rate[&3], 1.0);
+    assert_eq!(summary.plan_found[&1], 1.0);
+    assert!(summary.solution_steps[&3].unwrap() >= 3.0);
+}
+
+/// Depths are keyed as numbers: depth 10 follows depth 9 (issue 13: keyed by string, "10" came
+/// before "2").
+#[test]
+fn summaries_order_depths_numerically() {
+    let result = |depth| DepthResult {
+        depth,
+        tasks: 1,
+        solved: 1,
+        plan_found: 1,
+        planning_s: vec![0.0],
+        solution_steps: vec![depth],
+        skill_steps: vec![1],
+    };
+    let summary = summarise(&[result(10), result(2), result(9)]);
+    let depths: Vec<usize> = summary.success_rate.keys().copied().collect();
+    assert_eq!(depths, [2, 9, 10]);
 }

@@ -97,8 +97,8 @@ impl Default for TrainConfig {
             eval_every: 100,
             eval_seeds: 20,
             checkpoint_every: 100,
-            threads: 0,
-            sac_threads_alone: 0,
+            threads: 1,
+            sac_threads_alone: 2,
             portable_numerics: false,
         }
     }
@@ -180,8 +180,7 @@ impl TrainConfig {
                 env_names().join(", ")
             )));
         }
-        seads_embodiment::make_env(&self.env, &self.env_config)
-            .map_err(|e| RlError::Config(e.to_string()))?;
+        seads_embodiment::make_env(&self.env, &self.env_config)?;
         self.validate_values()
     }
 
@@ -189,8 +188,8 @@ impl TrainConfig {
     /// the trainer that gets one checks it).
     pub fn validate_values(&self) -> Result<(), RlError> {
         let bad = |m: String| Err(RlError::Config(m));
-        self.sac.validate().map_err(RlError::Config)?;
-        self.skill_model.validate().map_err(RlError::Config)?;
+        self.sac.validate()?;
+        self.skill_model.validate()?;
         if self.num_skills == Some(0) {
             return bad("num_skills must be at least 1".into());
         }

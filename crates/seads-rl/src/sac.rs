@@ -50,9 +50,10 @@ impl Default for SacConfig {
 
 impl SacConfig {
     /// Checks the values.
-    pub fn validate(&self) -> Result<(), String> {
+    pub fn validate(&self) -> Result<(), RlError> {
+        let bad = |m: String| Err(RlError::Config(m));
         if self.hidden.is_empty() || self.hidden.iter().any(|&h| h <= 0) {
-            return Err(format!(
+            return bad(format!(
                 "sac.hidden must be positive layer sizes, got {:?}",
                 self.hidden
             ));
@@ -61,19 +62,19 @@ impl SacConfig {
             if v > 0.0 && v.is_finite() {
                 Ok(())
             } else {
-                Err(format!("sac.{name} must be positive, got {v}"))
+                bad(format!("sac.{name} must be positive, got {v}"))
             }
         };
         positive("lr", self.lr)?;
         positive("alpha", self.alpha)?;
         if !(0.0..=1.0).contains(&self.gamma) {
-            return Err(format!("sac.gamma must lie in [0, 1], got {}", self.gamma));
+            return bad(format!("sac.gamma must lie in [0, 1], got {}", self.gamma));
         }
         if !(self.tau > 0.0 && self.tau <= 1.0) {
-            return Err(format!("sac.tau must lie in (0, 1], got {}", self.tau));
+            return bad(format!("sac.tau must lie in (0, 1], got {}", self.tau));
         }
         if self.batch_size == 0 {
-            return Err("sac.batch_size must be at least 1".into());
+            return bad("sac.batch_size must be at least 1".into());
         }
         Ok(())
     }

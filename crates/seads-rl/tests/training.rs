@@ -397,4 +397,10 @@ fn presets_parse_and_round_trip() {
         let expected_alpha = if env.contains("cursor") { 0.1 } else { 0.01 };
         assert_eq!(config.sac.alpha, expected_alpha, "{env}");
     }
+    // `TrainConfig::default` is documented as the LightsOutCursor preset (issue 13: its thread
+    // settings differed).
+    assert_eq!(
+        TrainConfig::default(),
+        TrainConfig::preset("lightsout-cursor").unwrap()
+    );
 }

@@ -26,8 +26,17 @@ pub use reward::{
 #[derive(Debug, thiserror::Error)]
 pub enum SkillModelError {
     /// Writing a checkpoint failed.
-    #[error("writing a skill-model checkpoint: {0}")]
-    Io(String),
+    #[error("writing skill-model checkpoint {path}")]
+    Io {
+        /// The file.
+        path: String,
+        /// What went wrong.
+        #[source]
+        source: tch::TchError,
+    },
+    /// A configuration value that cannot be used.
+    #[error("invalid configuration: {0}")]
+    Config(String),
     /// A checkpoint is missing, corrupt or of another shape.
     #[error("cannot load skill-model checkpoint {path}: {reason}")]
     Checkpoint {

@@ -1,7 +1,7 @@
 //! Skill models: the symbolic forward model q(z_T | z_0, k) of SEADS (SPEC §3.4) and the VIC
 //! discriminator q(k | z_0, z_T) (SPEC §3.9), behind one trait.
 
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
@@ -76,18 +76,19 @@ impl Default for SkillModelConfig {
 
 impl SkillModelConfig {
     /// Checks the values.
-    pub fn validate(&self) -> Result<(), String> {
+    pub fn validate(&self) -> Result<(), SkillModelError> {
+        let bad = |m: String| Err(SkillModelError::Config(m));
         if self.hidden.is_empty() || self.hidden.iter().any(|&h| h <= 0) {
-            return Err(format!(
+            return bad(format!(
                 "skill_model.hidden must be positive layer sizes, got {:?}",
                 self.hidden
             ));
         }
         if !(self.lr > 0.0 && self.lr.is_finite()) {
-            return Err(format!("skill_model.lr must be positive, got {}", self.lr));
+            return bad(format!("skill_model.lr must be positive, got {}", self.lr));
         }
         if self.batch_size == 0 {
-            return Err("skill_model.batch_size must be at least 1".into());
+            return bad("skill_model.batch_size must be at least 1".into());
         }
         Ok(())
     }
@@ -372,14 +373,16 @@ impl Trainable {
     }
 
     fn save(&self, dir: &Path) -> Result<(), SkillModelError> {
-        let io = |e: tch::TchError| SkillModelError::Io(e.to_string());
-        self.vs
-            .save(dir.join(format!("{}.safetensors", self.name)))
-            .map_err(io)?;
-        self.opt
-            .state()
-            .save(dir.join(format!("{}_adam.safetensors", self.name)))
-            .map_err(io)
+        let io = |path: PathBuf| {
+            move |source| SkillModelError::Io {
+                path: path.display().to_string(),
+                source,
+            }
+        };
+        let path = dir.join(format!("{}.safetensors", self.name));
+        self.vs.save(&path).map_err(io(path.clone()))?;
+        let path = dir.join(format!("{}_adam.safetensors", self.name));
+        self.opt.state().save(&path).map_err(io(path.clone()))
     }
 
     fn load(&mut self, dir: &Path, optimiser: bool) -> Result<(), SkillModelError> {

@@ -154,23 +154,28 @@ impl Calibration {
 
     /// Reads and validates a calibration TOML file.
     pub fn load(path: &Path) -> Result<Self, UarmError> {
-        let text = std::fs::read_to_string(path)
-            .map_err(|e| UarmError::Io(format!("{}: {e}", path.display())))?;
+        let text = std::fs::read_to_string(path).map_err(|e| UarmError::Io {
+            what: path.display().to_string(),
+            source: Box::new(e),
+        })?;
         let file: CalibrationFile = toml::from_str(&text)
             .map_err(|e| UarmError::Calibration(format!("{}: {}", path.display(), e.message())))?;
         Self::fit(file)
     }
 
-    /// Writes the calibration as TOML (atomically).
+    /// Writes the calibration as TOML (atomically and durably: temporary file, fsync, rename).
     pub fn save(&self, path: &Path) -> Result<(), UarmError> {
         let text = format!(
             "# uArm screen calibration (seads uarm calibrate). Corners: TL, TR, BR, BL in mm.\n{}",
             toml::to_string(&self.file).expect("serialises")
         );
-        let tmp = path.with_extension("tmp");
-        std::fs::write(&tmp, text)
-            .and_then(|()| std::fs::rename(&tmp, path))
-            .map_err(|e| UarmError::Io(format!("{}: {e}", path.display())))
+        let io = |e: std::io::Error| UarmError::Io {
+            what: path.display().to_string(),
+            source: Box::new(e),
+        };
+        let mut file = atomic_write_file::AtomicWriteFile::open(path).map_err(io)?;
+        std::io::Write::write_all(&mut file, text.as_bytes()).map_err(io)?;
+        file.commit().map_err(io)
     }
 }
 

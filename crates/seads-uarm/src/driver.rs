@@ -27,7 +27,10 @@ impl SerialTransport {
         let serial = serialport::new(port, 115_200)
             .timeout(Duration::from_millis(50))
             .open()
-            .map_err(|e| UarmError::Io(format!("opening serial port {port}: {e}")))?;
+            .map_err(|e| UarmError::Io {
+                what: format!("opening serial port {port}"),
+                source: Box::new(e),
+            })?;
         Ok(Self {
             reader: BufReader::new(serial),
             name: port.to_owned(),
@@ -44,7 +47,10 @@ impl Transport for SerialTransport {
                 std::io::ErrorKind::BrokenPipe | std::io::ErrorKind::NotConnected => {
                     UarmError::Disconnected
                 }
-                _ => UarmError::Io(format!("{}: {e}", self.name)),
+                _ => UarmError::Io {
+                    what: self.name.clone(),
+                    source: Box::new(e),
+                },
             })
     }
 
@@ -67,7 +73,12 @@ impl Transport for SerialTransport {
                         return Ok(None);
                     }
                 }
-                Err(e) => return Err(UarmError::Io(format!("{}: {e}", self.name))),
+                Err(e) => {
+                    return Err(UarmError::Io {
+                        what: self.name.clone(),
+                        source: Box::new(e),
+                    });
+                }
             }
         }
     }

@@ -26,11 +26,17 @@ pub use tablet::{AdbTablet, Tablet, TabletReport};
 pub use twin::{Faults, Twin, twin_screen_corners};
 
 /// What can go wrong with the robot.
-#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[derive(Debug, thiserror::Error)]
 pub enum UarmError {
     /// Opening, reading or writing a file or the serial port failed.
-    #[error("{0}")]
-    Io(String),
+    #[error("{what}")]
+    Io {
+        /// The file or port, and what was done with it.
+        what: String,
+        /// What went wrong.
+        #[source]
+        source: Box<dyn std::error::Error + Send + Sync>,
+    },
     /// The arm did not acknowledge a command in time.
     #[error("the arm did not answer `{command}` within {seconds:.1} s")]
     Timeout {
