@@ -217,8 +217,9 @@ impl Manipulator for Reacher {
 mod tests {
     use super::*;
 
-    /// One physics step from `q`, `qd` under `u`, against values computed by hand (an independent
-    /// NumPy transcription of SPEC §2.3.1 with explicit matrices and `linalg.solve`).
+    /// One physics step from `q`, `qd` under `u`, against values computed by an independent NumPy
+    /// transcription of SPEC §2.3.1 with explicit matrices and `linalg.solve`
+    /// (`scripts/reference/reacher_step.py` prints them).
     fn check(q: [f64; 2], qd: [f64; 2], u: [f64; 2], q_next: [f64; 2], qd_next: [f64; 2]) {
         let mut arm = Reacher { q, qd };
         arm.physics_step(u);

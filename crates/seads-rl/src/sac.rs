@@ -264,9 +264,23 @@ impl Sac {
         q[0].forward(&xa).minimum(&q[1].forward(&xa))
     }
 
-    /// One SAC step: critics, then actor, then the Polyak update of the targets.
+    /// One SAC step: critics, then actor, then the Polyak update of the targets, with the
+    /// policy's noise drawn from `rng` (for the next actions first, then for the actor's).
     pub fn update(&mut self, batch: &TransitionBatch, rng: &mut ChaCha8Rng) -> SacLosses {
         let rows = batch.rewards.len();
+        let next_noise = self.gaussian(rows, rng);
+        let policy_noise = self.gaussian(rows, rng);
+        self.update_with_noise(batch, &next_noise, &policy_noise)
+    }
+
+    /// [`Sac::update`] with given standard-normal noise (rows × action_dim each): for the next
+    /// actions of the target and for the actor's reparameterised actions.
+    pub fn update_with_noise(
+        &mut self,
+        batch: &TransitionBatch,
+        next_noise: &Tensor,
+        policy_noise: &Tensor,
+    ) -> SacLosses {
         let obs = self.tensor(&batch.obs, self.input_dim);
         let actions = self.tensor(&batch.actions, self.action_dim);
         let next_obs = self.tensor(&batch.next_obs, self.input_dim);
@@ -275,7 +289,7 @@ impl Sac {
         let (alpha, gamma) = (self.config.alpha, self.config.gamma);
 
         let target = tch::no_grad(|| {
-            let (next_action, next_log_prob) = self.sample(&next_obs, &self.gaussian(rows, rng));
+            let (next_action, next_log_prob) = self.sample(&next_obs, next_noise);
             let soft_q =
                 Self::min_q(&self.q_target, &next_obs, &next_action) - next_log_prob * alpha;
             &rewards + (1.0 - &dones) * gamma * soft_q
@@ -291,7 +305,7 @@ impl Sac {
 
         // The actor's loss flows through the critics to the action; only the actor's parameters
         // receive gradients (`backward_step` differentiates with respect to its own parameters).
-        let (new_action, log_prob) = self.sample(&obs, &self.gaussian(rows, rng));
+        let (new_action, log_prob) = self.sample(&obs, policy_noise);
         let q = Self::min_q(&self.q, &obs, &new_action);
         let actor_loss = (log_prob * alpha - &q).mean(Kind::Float);
         self.actor_opt.backward_step(&actor_loss);
