@@ -23,7 +23,7 @@ pub struct RunArgs {
     env: String,
     /// Training budget in environment steps (the paper's Cursor budget is 500000; most skills
     /// appear within 10⁵).
-    #[arg(long, default_value_t = 100_000)]
+    #[arg(long, default_value_t = 160_000)]
     env_steps: u64,
     /// Seed of the run.
     #[arg(long, default_value_t = 1)]

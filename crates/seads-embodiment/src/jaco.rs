@@ -262,9 +262,17 @@ pub struct Jaco {
     ctrl: [f32; 9],
     /// Physics steps per environment step.
     substeps: usize,
+    /// Resets and re-initialisations that found no reachable pose and fell back to a fixed one.
+    ik_fallbacks: u64,
 }
 
 impl Jaco {
+    /// How many initial poses (resets, and re-initialisations after a move) found no reachable
+    /// pose by inverse kinematics and used the fixed fallback pose, since this arm was built.
+    pub fn ik_fallbacks(&self) -> u64 {
+        self.ik_fallbacks
+    }
+
     /// A Jaco in front of `board` simulated with `substeps` physics steps per 0.1 s environment
     /// step ([`DEFAULT_SUBSTEPS`] as the reference), in a fixed pose until the first reset.
     pub fn new(board: JacoBoard, substeps: usize) -> Self {
@@ -354,6 +362,7 @@ impl Jaco {
             robot,
             ctrl: [0.0; 9],
             substeps,
+            ik_fallbacks: 0,
         };
         let dofs: Vec<usize> = (0..LINKS.len()).map(|i| jaco.dof(i)).collect();
         let mb = jaco.multibody_mut();
@@ -513,7 +522,8 @@ impl Jaco {
                 }
             }
         }
-        // No pose found (very rare): a fixed pose above the board centre.
+        // No pose found (rare; counted, see `ik_fallbacks`): a fixed pose above the board centre.
+        self.ik_fallbacks += 1;
         self.set_joints(&[0.0, 3.0, 1.0, 0.0, 0.0, 0.0, 0.15, 0.15, 0.15]);
     }
 
@@ -647,6 +657,7 @@ impl Clone for Jaco {
         let ctrl = self.ctrl;
         let action: Vec<f32> = ctrl.iter().zip(&LINKS).map(|(c, d)| c / d.ctrl).collect();
         copy.set_controls(&action);
+        copy.ik_fallbacks = self.ik_fallbacks;
         copy
     }
 }
@@ -671,7 +682,9 @@ impl Manipulator for Jaco {
     fn reset(&mut self, rng: &mut ChaCha8Rng) {
         // A fresh world: rapier keeps contacts and solver warm starts from the previous step,
         // and a reset must depend on nothing but the seed (a resumed run has a fresh world).
+        let fallbacks = self.ik_fallbacks;
         *self = Jaco::new(self.board, self.substeps);
+        self.ik_fallbacks = fallbacks;
         self.randomize(rng);
         self.set_controls(&[0.0; 9]);
     }

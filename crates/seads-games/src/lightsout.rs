@@ -137,8 +137,12 @@ mod tests {
 
     #[test]
     fn sizes_outside_3_to_13_are_rejected() {
-        assert!(LightsOut::new(2).is_err());
-        assert!(LightsOut::new(14).is_err());
+        for n in [2, 14] {
+            assert!(matches!(
+                LightsOut::new(n),
+                Err(GameError::UnsupportedSize { .. })
+            ));
+        }
         assert_eq!(LightsOut::new(13).unwrap().num_moves(), 169);
     }
 

@@ -204,7 +204,10 @@ mod tests {
                 ..
             })
         ));
-        assert!(TileSwap::with_size(4).is_err());
+        assert!(matches!(
+            TileSwap::with_size(4),
+            Err(GameError::UnsupportedSize { .. })
+        ));
         assert!(!g.is_valid(SymbolicState::from_u64(3)));
     }
 }

@@ -9,6 +9,8 @@
 //! from libtorch's global generator.
 
 mod agent;
+mod buffers;
+mod checkpoint;
 mod config;
 mod episode;
 mod numerics;

@@ -22,20 +22,6 @@ use crate::store::{
 };
 use crate::{EpochStats, RlError, Timings, TrainConfig, Trainer};
 
-/// Files of a checkpoint that only resuming needs; dropped from checkpoints older than the two
-/// newest.
-const RESUME_ONLY: &[&str] = &[
-    "sac_critic.safetensors",
-    "sac_target.safetensors",
-    "sac_actor_adam.safetensors",
-    "sac_critic_adam.safetensors",
-    "forward_model_adam.safetensors",
-    "discriminator_adam.safetensors",
-    "episodes.safetensors",
-    "progress.json",
-    crate::trainer::PREPARED_FILE,
-];
-
 /// Moments of a run at which a crash leaves a different state on disk. A hook set with
 /// [`Run::set_hook`] is called at each (the crash-point tests stop the process there).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -324,7 +310,7 @@ impl Run {
             .map(|(_, p)| p)
             .collect();
         for old in older.iter().rev().skip(2) {
-            for file in RESUME_ONLY {
+            for file in crate::checkpoint::resume_only_files() {
                 match fs::remove_file(old.join(file)) {
                     Err(e) if e.kind() != std::io::ErrorKind::NotFound => {
                         return Err(RlError::io(&old.join(file), e));

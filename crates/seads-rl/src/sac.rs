@@ -135,6 +135,16 @@ pub struct Sac {
     target_flat: Tensor,
 }
 
+/// The checkpoint file of the actor: all that executing skills needs.
+pub const ACTOR_FILE: &str = "sac_actor.safetensors";
+/// The other checkpoint files of SAC (critics, targets, optimiser states): what resuming needs.
+pub const RESUME_FILES: [&str; 4] = [
+    "sac_critic.safetensors",
+    "sac_target.safetensors",
+    "sac_actor_adam.safetensors",
+    "sac_critic_adam.safetensors",
+];
+
 const LOG_STD_MIN: f64 = -20.0;
 const LOG_STD_MAX: f64 = 2.0;
 
@@ -321,10 +331,10 @@ impl Sac {
         }
     }
 
-    /// Writes networks and optimiser states into `dir`.
+    /// Writes networks and optimiser states into `dir` ([`ACTOR_FILE`] and [`RESUME_FILES`]).
     pub fn save(&self, dir: &Path) -> Result<(), RlError> {
-        for (name, vs) in self.stores() {
-            let path = dir.join(format!("{name}.safetensors"));
+        for (file, vs) in self.stores() {
+            let path = dir.join(file);
             vs.save(&path).map_err(|e| RlError::io(&path, e))?;
         }
         Ok(())
@@ -332,37 +342,38 @@ impl Sac {
 
     /// Writes only the actor (enough to execute skills).
     pub fn save_actor(&self, dir: &Path) -> Result<(), RlError> {
-        let path = dir.join("sac_actor.safetensors");
+        let path = dir.join(ACTOR_FILE);
         self.actor_vs.save(&path).map_err(|e| RlError::io(&path, e))
     }
 
     /// Reads what [`Sac::save`] wrote; with `actor_only`, just the actor.
     pub fn load(&mut self, dir: &Path, actor_only: bool) -> Result<(), RlError> {
-        let stores: Vec<(&str, &mut nn::VarStore)> = if actor_only {
-            vec![("sac_actor", &mut self.actor_vs)]
-        } else {
-            vec![
-                ("sac_actor", &mut self.actor_vs),
-                ("sac_critic", &mut self.critic_vs),
-                ("sac_target", &mut self.target_vs),
-                ("sac_actor_adam", self.actor_opt.state_mut()),
-                ("sac_critic_adam", self.critic_opt.state_mut()),
-            ]
-        };
-        for (name, vs) in stores {
-            let path = dir.join(format!("{name}.safetensors"));
+        let count = if actor_only { 1 } else { 5 };
+        for (file, vs) in self.stores_mut().into_iter().take(count) {
+            let path = dir.join(file);
             vs.load(&path).map_err(|e| RlError::unreadable(&path, e))?;
         }
         Ok(())
     }
 
-    fn stores(&self) -> [(&str, &nn::VarStore); 5] {
+    /// The var stores and their files, the actor first.
+    fn stores(&self) -> [(&'static str, &nn::VarStore); 5] {
         [
-            ("sac_actor", &self.actor_vs),
-            ("sac_critic", &self.critic_vs),
-            ("sac_target", &self.target_vs),
-            ("sac_actor_adam", self.actor_opt.state()),
-            ("sac_critic_adam", self.critic_opt.state()),
+            (ACTOR_FILE, &self.actor_vs),
+            (RESUME_FILES[0], &self.critic_vs),
+            (RESUME_FILES[1], &self.target_vs),
+            (RESUME_FILES[2], self.actor_opt.state()),
+            (RESUME_FILES[3], self.critic_opt.state()),
+        ]
+    }
+
+    fn stores_mut(&mut self) -> [(&'static str, &mut nn::VarStore); 5] {
+        [
+            (ACTOR_FILE, &mut self.actor_vs),
+            (RESUME_FILES[0], &mut self.critic_vs),
+            (RESUME_FILES[1], &mut self.target_vs),
+            (RESUME_FILES[2], self.actor_opt.state_mut()),
+            (RESUME_FILES[3], self.critic_opt.state_mut()),
         ]
     }
 }

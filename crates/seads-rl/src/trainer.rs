@@ -9,12 +9,14 @@ use std::time::Instant;
 use rand::RngExt;
 use rand_chacha::ChaCha8Rng;
 use seads_embodiment::{EnvConfig, EnvSpec, Environment, make_env};
-use seads_games::{Split, SymbolicState};
-use seads_skillmodel::{SkillModel, SkillTransition, episode_rewards, minimum_reward, relabel};
+use seads_games::Split;
+use seads_skillmodel::{SkillModel, SkillTransition};
 use serde::{Deserialize, Serialize};
-use tch::{Device, Kind, Tensor};
+use tch::Device;
 
-use crate::episode::{policy_input, run_episodes, skill_coverage};
+use crate::buffers::Buffers;
+use crate::checkpoint;
+use crate::episode::{run_episodes, skill_coverage};
 use crate::seeds::{Purpose, derived_seed, stream, train_env_seed};
 use crate::{Episode, Moment, RlError, Sac, SacLosses, TrainConfig, TransitionBatch};
 
@@ -79,9 +81,6 @@ struct Progress {
     streams: Streams,
 }
 
-/// The checkpoint file of the prepared next updates (absent when there are none).
-pub(crate) const PREPARED_FILE: &str = "prepared.safetensors";
-
 /// A SEADS agent in training.
 pub struct Trainer {
     config: TrainConfig,
@@ -100,10 +99,10 @@ pub struct Trainer {
 
 /// An epoch's skill-model update done and its SAC minibatches relabelled, ready for SAC.
 #[derive(Debug)]
-struct Prepared {
-    minibatches: Vec<TransitionBatch>,
-    mean_reward: f32,
-    skill_model_loss: f32,
+pub(crate) struct Prepared {
+    pub(crate) minibatches: Vec<TransitionBatch>,
+    pub(crate) mean_reward: f32,
+    pub(crate) skill_model_loss: f32,
 }
 
 impl Trainer {
@@ -353,16 +352,17 @@ impl Trainer {
         self.save_agent(dir)?;
         self.sac.save(dir)?;
         self.model.save(dir)?;
-        self.save_buffer(&dir.join("episodes.safetensors"))?;
+        checkpoint::save_episodes(
+            &dir.join(checkpoint::EPISODES_FILE),
+            &self.episodes,
+            self.spec.action_dim,
+        )?;
         if let Some(prepared) = &self.prepared {
-            prepared.save(&dir.join(PREPARED_FILE))?;
+            prepared.save(&dir.join(checkpoint::PREPARED_FILE))?;
         }
-        let path = dir.join("progress.json");
-        std::fs::write(
-            &path,
-            serde_json::to_string(&self.progress).expect("progress serialises"),
-        )
-        .map_err(|e| RlError::io(&path, e))
+        let path = dir.join(checkpoint::PROGRESS_FILE);
+        let text = serde_json::to_string(&self.progress).map_err(|e| RlError::io(&path, e))?;
+        std::fs::write(&path, text).map_err(|e| RlError::io(&path, e))
     }
 
     /// Writes what is needed to execute and plan with the agent: the actor and the skill model.
@@ -372,218 +372,28 @@ impl Trainer {
         Ok(())
     }
 
-    /// Restores the complete training state written by [`Trainer::save`].
+    /// Restores the complete training state written by [`Trainer::save`]; every file must be
+    /// there (a fresh optimiser or buffer would change the run).
     pub fn load(&mut self, dir: &Path) -> Result<(), RlError> {
         self.sac.load(dir, false)?;
         self.model.load(dir, true)?;
-        self.load_buffer(&dir.join("episodes.safetensors"))?;
-        let path = dir.join(PREPARED_FILE);
+        self.episodes = checkpoint::load_episodes(
+            &dir.join(checkpoint::EPISODES_FILE),
+            self.spec.obs_dim,
+            self.spec.action_dim,
+            self.k,
+        )?;
+        let path = dir.join(checkpoint::PREPARED_FILE);
         self.prepared = if path.exists() {
             let width = self.spec.obs_dim + self.k;
             Some(Prepared::load(&path, width, self.spec.action_dim)?)
         } else {
             None
         };
-        let path = dir.join("progress.json");
+        let path = dir.join(checkpoint::PROGRESS_FILE);
         let text = std::fs::read_to_string(&path).map_err(|e| RlError::io(&path, e))?;
         self.progress = serde_json::from_str(&text).map_err(|e| RlError::unreadable(&path, e))?;
         Ok(())
-    }
-
-    fn save_buffer(&self, path: &Path) -> Result<(), RlError> {
-        let a = self.spec.action_dim;
-        let obs: Vec<f32> = self
-            .episodes
-            .iter()
-            .flat_map(|e| e.obs.iter().copied())
-            .collect();
-        let actions: Vec<f32> = self
-            .episodes
-            .iter()
-            .flat_map(|e| e.actions.iter().copied())
-            .collect();
-        let meta: Vec<i64> = self
-            .episodes
-            .iter()
-            .flat_map(|e| {
-                let (z0, zt) = (e.z0.words(), e.zt.words());
-                [
-                    e.len(a) as i64,
-                    e.skill as i64,
-                    e.game_move.map_or(-1, |m| m as i64),
-                ]
-                .into_iter()
-                .chain(z0.into_iter().chain(zt).map(|w| w as i64))
-            })
-            .collect();
-        let tensors = [
-            ("obs", Tensor::from_slice(&obs)),
-            ("actions", Tensor::from_slice(&actions)),
-            ("meta", Tensor::from_slice(&meta).view([-1, 9])),
-        ];
-        Tensor::write_safetensors(&tensors, path).map_err(|e| RlError::io(path, e))
-    }
-
-    fn load_buffer(&mut self, path: &Path) -> Result<(), RlError> {
-        let file = TensorFile::read(path)?;
-        let corrupt = |reason: String| file.corrupt(reason);
-        let (obs, actions) = (file.floats("obs")?, file.floats("actions")?);
-        let meta = file.ints("meta")?;
-        let (o, a) = (self.spec.obs_dim, self.spec.action_dim);
-        let (mut po, mut pa) = (0, 0);
-        self.episodes.clear();
-        let mismatch = || corrupt("episode table does not match the environment".into());
-        for m in meta.chunks(9) {
-            // The length is checked against the data before it is used: no negative or
-            // overflowing lengths.
-            if m.len() != 9
-                || !(0..=obs.len() as i64).contains(&m[0])
-                || m[1] < 0
-                || m[1] as usize >= self.k
-            {
-                return Err(mismatch());
-            }
-            let len = m[0] as usize;
-            let (obs_end, act_end) = (po + (len + 1) * o, pa + len * a);
-            if obs_end > obs.len() || act_end > actions.len() {
-                return Err(mismatch());
-            }
-            let word = |i: usize| m[i] as u64;
-            self.episodes.push_back(Episode {
-                skill: m[1] as usize,
-                obs: obs[po..obs_end].to_vec(),
-                actions: actions[pa..act_end].to_vec(),
-                z0: SymbolicState::from_words([word(3), word(4), word(5)]),
-                zt: SymbolicState::from_words([word(6), word(7), word(8)]),
-                game_move: (m[2] >= 0).then_some(m[2] as usize),
-            });
-            (po, pa) = (obs_end, act_end);
-        }
-        if po != obs.len() || pa != actions.len() {
-            return Err(corrupt("trailing episode data".into()));
-        }
-        Ok(())
-    }
-}
-
-/// The tensors of a checkpoint file, by name; every error names the file.
-struct TensorFile<'a> {
-    path: &'a Path,
-    tensors: Vec<(String, Tensor)>,
-}
-
-impl<'a> TensorFile<'a> {
-    fn read(path: &'a Path) -> Result<Self, RlError> {
-        let tensors = Tensor::read_safetensors(path).map_err(|e| RlError::unreadable(path, e))?;
-        Ok(Self { path, tensors })
-    }
-
-    fn corrupt(&self, reason: String) -> RlError {
-        RlError::Checkpoint {
-            path: self.path.display().to_string(),
-            reason,
-        }
-    }
-
-    fn get(&self, name: &str) -> Result<&Tensor, RlError> {
-        self.tensors
-            .iter()
-            .find(|(n, _)| n == name)
-            .map(|(_, t)| t)
-            .ok_or_else(|| self.corrupt(format!("no tensor {name:?}")))
-    }
-
-    /// The named tensor's values as f32, flattened.
-    fn floats(&self, name: &str) -> Result<Vec<f32>, RlError> {
-        Vec::<f32>::try_from(self.get(name)?.to_kind(Kind::Float).view([-1]))
-            .map_err(|e| self.corrupt(e.to_string()))
-    }
-
-    /// The named tensor's values as i64, flattened.
-    fn ints(&self, name: &str) -> Result<Vec<i64>, RlError> {
-        Vec::<i64>::try_from(self.get(name)?.to_kind(Kind::Int64).view([-1]))
-            .map_err(|e| self.corrupt(e.to_string()))
-    }
-}
-
-impl Prepared {
-    /// Writes the minibatches (stacked) and the two statistics.
-    fn save(&self, path: &Path) -> Result<(), RlError> {
-        let stack = |part: fn(&TransitionBatch) -> &[f32]| {
-            Tensor::from_slice(
-                &self
-                    .minibatches
-                    .iter()
-                    .flat_map(|b| part(b).iter().copied())
-                    .collect::<Vec<f32>>(),
-            )
-        };
-        let rows: Vec<i64> = self
-            .minibatches
-            .iter()
-            .map(|b| b.rewards.len() as i64)
-            .collect();
-        let tensors = [
-            ("obs", stack(|b| &b.obs)),
-            ("actions", stack(|b| &b.actions)),
-            ("rewards", stack(|b| &b.rewards)),
-            ("next_obs", stack(|b| &b.next_obs)),
-            ("dones", stack(|b| &b.dones)),
-            ("rows", Tensor::from_slice(&rows)),
-            (
-                "stats",
-                Tensor::from_slice(&[self.mean_reward, self.skill_model_loss]),
-            ),
-        ];
-        Tensor::write_safetensors(&tensors, path).map_err(|e| RlError::io(path, e))
-    }
-
-    /// Reads what [`Prepared::save`] wrote, for policy inputs of `width` and actions of
-    /// `action_dim` values.
-    fn load(path: &Path, width: usize, action_dim: usize) -> Result<Self, RlError> {
-        let file = TensorFile::read(path)?;
-        let rows: Vec<usize> = file
-            .ints("rows")?
-            .into_iter()
-            .map(usize::try_from)
-            .collect::<Result<_, _>>()
-            .map_err(|_| file.corrupt("negative minibatch size".into()))?;
-        let total = rows
-            .iter()
-            .try_fold(0usize, |sum, &n| sum.checked_add(n))
-            .ok_or_else(|| file.corrupt("minibatch sizes overflow".into()))?;
-        let floats = |name| file.floats(name);
-        let (obs, actions, rewards) = (floats("obs")?, floats("actions")?, floats("rewards")?);
-        let (next_obs, dones, stats) = (floats("next_obs")?, floats("dones")?, floats("stats")?);
-        // Rewards first: their length bounds `total`, so the products below cannot overflow.
-        if rewards.len() != total
-            || dones.len() != total
-            || obs.len() != total * width
-            || next_obs.len() != total * width
-            || actions.len() != total * action_dim
-            || stats.len() != 2
-        {
-            return Err(file.corrupt("prepared minibatches do not match the environment".into()));
-        }
-        let mut minibatches = Vec::with_capacity(rows.len());
-        let mut first = 0;
-        for n in rows {
-            let part =
-                |values: &[f32], cols: usize| values[first * cols..(first + n) * cols].to_vec();
-            minibatches.push(TransitionBatch {
-                obs: part(&obs, width),
-                actions: part(&actions, action_dim),
-                rewards: part(&rewards, 1),
-                next_obs: part(&next_obs, width),
-                dones: part(&dones, 1),
-            });
-            first += n;
-        }
-        Ok(Self {
-            minibatches,
-            mean_reward: stats[0],
-            skill_model_loss: stats[1],
-        })
     }
 }
 
@@ -667,206 +477,5 @@ impl Prepare<'_> {
             mean_reward,
             skill_model_loss: loss / config.updates_per_epoch.max(1) as f32,
         }
-    }
-}
-
-/// The episode buffers with what an update needs to draw from them: the long-term buffer is the
-/// last `buffer_capacity` episodes, the short-term list its last `recent_episodes`.
-struct Buffers<'a> {
-    config: &'a TrainConfig,
-    k: usize,
-    episodes: &'a mut VecDeque<Episode>,
-    rng: &'a mut ChaCha8Rng,
-}
-
-impl Buffers<'_> {
-    /// Updates start once the buffer holds `sampled_episodes` episodes.
-    fn ready(&self) -> bool {
-        self.episodes.len() >= self.config.sampled_episodes
-    }
-
-    /// Appends new episodes, dropping the oldest beyond the capacity.
-    fn push(&mut self, new: Vec<Episode>) {
-        for episode in new {
-            if self.episodes.len() == self.config.buffer_capacity {
-                self.episodes.pop_front();
-            }
-            self.episodes.push_back(episode);
-        }
-    }
-
-    /// Indices of an update batch: `sampled_episodes` drawn with replacement from the long-term
-    /// buffer (all of it if it holds exactly that many), followed by the recent episodes.
-    fn update_batch(&mut self) -> Vec<usize> {
-        let n = self.episodes.len();
-        let mut batch: Vec<usize> = if n == self.config.sampled_episodes {
-            (0..n).collect()
-        } else {
-            (0..self.config.sampled_episodes)
-                .map(|_| self.rng.random_range(0..n))
-                .collect()
-        };
-        batch.extend(n.saturating_sub(self.config.recent_episodes)..n);
-        batch
-    }
-
-    /// Clipped posteriors C and rewards R (K per episode, row-major) of the given episodes.
-    fn score(&self, model: &dyn SkillModel, batch: &[usize]) -> (Vec<f32>, Vec<f32>) {
-        let pairs: Vec<(SymbolicState, SymbolicState)> = batch
-            .iter()
-            .map(|&i| (self.episodes[i].z0, self.episodes[i].zt))
-            .collect();
-        let scores = model.scores(&pairs);
-        let likelihoods = model.scores_are_likelihoods();
-        let mut clipped = Vec::with_capacity(scores.len());
-        let mut rewards = Vec::with_capacity(scores.len());
-        for row in scores.chunks(self.k) {
-            let (c, r) = episode_rewards(row, likelihoods, &self.config.reward);
-            clipped.extend(c);
-            rewards.extend(r);
-        }
-        (clipped, rewards)
-    }
-
-    /// Final labels: each episode of `batch` is chosen with probability `p` (among `eligible`),
-    /// and the chosen ones are relabelled together. `clipped` holds the K clipped posteriors of
-    /// each eligible episode, in `eligible` order.
-    fn relabelled(
-        &mut self,
-        batch: &[usize],
-        eligible: &[usize],
-        clipped: &[f32],
-        p: f64,
-    ) -> Vec<usize> {
-        let mut labels: Vec<usize> = batch.iter().map(|&i| self.episodes[i].skill).collect();
-        if p <= 0.0 {
-            return labels;
-        }
-        let k = self.k;
-        let chosen: Vec<usize> = (0..eligible.len())
-            .filter(|_| self.rng.random::<f64>() < p)
-            .collect();
-        let chosen_clipped: Vec<f32> = chosen
-            .iter()
-            .flat_map(|&e| clipped[e * k..(e + 1) * k].iter().copied())
-            .collect();
-        let chosen_labels: Vec<usize> = chosen.iter().map(|&e| labels[eligible[e]]).collect();
-        for (&e, new) in chosen.iter().zip(relabel(
-            self.config.relabel.kind,
-            &chosen_clipped,
-            k,
-            &chosen_labels,
-        )) {
-            labels[eligible[e]] = new;
-        }
-        labels
-    }
-
-    /// The skill-model batch: every episode of an update batch relabelled with p = 1 (episodes
-    /// that did not change the board take part), as (z_0, label, z_T) tuples.
-    fn skill_model_batch(&mut self, model: &dyn SkillModel) -> Vec<SkillTransition> {
-        let batch = self.update_batch();
-        let eligible: Vec<usize> = (0..batch.len()).collect();
-        let (clipped, _) = if self.config.relabel.skill_model_p > 0.0 {
-            self.score(model, &batch)
-        } else {
-            Default::default()
-        };
-        let labels = self.relabelled(
-            &batch,
-            &eligible,
-            &clipped,
-            self.config.relabel.skill_model_p,
-        );
-        batch
-            .iter()
-            .zip(labels)
-            .map(|(&i, skill)| SkillTransition {
-                z0: self.episodes[i].z0,
-                skill,
-                zt: self.episodes[i].zt,
-            })
-            .collect()
-    }
-
-    /// The SAC minibatches of an epoch: an update batch relabelled with p = 0.5 among the
-    /// board-changing episodes; each episode's last transition carries R of its final label (or
-    /// the minimum reward if the board did not change). Returns the minibatches and the mean
-    /// final reward.
-    fn sac_minibatches(
-        &mut self,
-        model: &dyn SkillModel,
-        spec: &EnvSpec,
-    ) -> (Vec<TransitionBatch>, f32) {
-        let config = self.config;
-        let batch = self.update_batch();
-        // Only board-changing episodes need scores: the others get the minimum reward and are
-        // never relabelled.
-        let eligible: Vec<usize> = (0..batch.len())
-            .filter(|&j| self.episodes[batch[j]].changed())
-            .collect();
-        let changed: Vec<usize> = eligible.iter().map(|&j| batch[j]).collect();
-        let (clipped, rewards) = self.score(model, &changed);
-        let labels = self.relabelled(&batch, &eligible, &clipped, config.relabel.sac_p);
-        let mut finals = vec![minimum_reward(self.k); batch.len()];
-        for (e, &j) in eligible.iter().enumerate() {
-            finals[j] = rewards[e * self.k + labels[j]];
-        }
-        let a = spec.action_dim;
-        let transitions: Vec<(usize, usize)> = batch
-            .iter()
-            .enumerate()
-            .flat_map(|(j, &i)| (0..self.episodes[i].len(a)).map(move |t| (j, t)))
-            .collect();
-        let minibatches = (0..config.sac.updates_per_epoch)
-            .map(|_| {
-                let picks: Vec<(usize, usize)> = (0..config.sac.batch_size)
-                    .map(|_| transitions[self.rng.random_range(0..transitions.len())])
-                    .collect();
-                self.transition_batch(spec, &batch, &labels, &finals, &picks)
-            })
-            .collect();
-        let mean_reward = finals.iter().sum::<f32>() / finals.len().max(1) as f32;
-        (minibatches, mean_reward)
-    }
-
-    /// SAC inputs for the picked transitions: `[s, onehot(final label)]`, the reward only on an
-    /// episode's last transition, done = 1 there (moves and time-outs alike).
-    fn transition_batch(
-        &self,
-        spec: &EnvSpec,
-        batch: &[usize],
-        labels: &[usize],
-        finals: &[f32],
-        picks: &[(usize, usize)],
-    ) -> TransitionBatch {
-        let (o, a) = (spec.obs_dim, spec.action_dim);
-        let width = o + self.k;
-        let mut out = TransitionBatch {
-            obs: vec![0.0; picks.len() * width],
-            actions: Vec::with_capacity(picks.len() * a),
-            rewards: Vec::with_capacity(picks.len()),
-            next_obs: vec![0.0; picks.len() * width],
-            dones: Vec::with_capacity(picks.len()),
-        };
-        for (row, &(j, t)) in picks.iter().enumerate() {
-            let e = &self.episodes[batch[j]];
-            let last = t + 1 == e.len(a);
-            policy_input(
-                &e.obs[t * o..(t + 1) * o],
-                labels[j],
-                &mut out.obs[row * width..(row + 1) * width],
-            );
-            policy_input(
-                &e.obs[(t + 1) * o..(t + 2) * o],
-                labels[j],
-                &mut out.next_obs[row * width..(row + 1) * width],
-            );
-            out.actions
-                .extend_from_slice(&e.actions[t * a..(t + 1) * a]);
-            out.rewards.push(if last { finals[j] } else { 0.0 });
-            out.dones.push(if last { 1.0 } else { 0.0 });
-        }
-        out
     }
 }

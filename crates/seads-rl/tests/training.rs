@@ -4,8 +4,8 @@
 use rand::{RngExt, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use seads_rl::{
-    Run, Sac, SacConfig, TrainConfig, Trainer, TransitionBatch, checkpoints, latest_checkpoint,
-    read_metrics,
+    RlError, Run, Sac, SacConfig, TrainConfig, Trainer, TransitionBatch, checkpoints,
+    latest_checkpoint, read_metrics,
 };
 use tch::Device;
 
@@ -186,7 +186,10 @@ fn resume_continues_from_the_last_checkpoint() {
     );
     drop(run);
     // Creating again in the same directory is refused.
-    assert!(Run::create(&path, small(11, 2500)).is_err());
+    assert!(matches!(
+        Run::create(&path, small(11, 2500)),
+        Err(RlError::Config(m)) if m.contains("already holds a run")
+    ));
     let mut resumed = Run::resume(&path).unwrap();
     assert_eq!(
         (resumed.trainer().epoch(), resumed.trainer().env_steps()),
@@ -290,8 +293,8 @@ fn corrupt_checkpoints_are_errors_not_panics() {
     // Well-formed tensors whose episode table gives the second episode a negative length.
     std::fs::write(&episodes, &intact).unwrap();
     let mut tensors = tch::Tensor::read_safetensors(&episodes).unwrap();
-    let meta = &mut tensors.iter_mut().find(|(n, _)| n == "meta").unwrap().1;
-    let _ = meta.get(1).get(0).fill_(-1);
+    let lengths = &mut tensors.iter_mut().find(|(n, _)| n == "lengths").unwrap().1;
+    let _ = lengths.get(1).fill_(-1);
     tch::Tensor::write_safetensors(&tensors, &episodes).unwrap();
     let err = Run::resume(&path)
         .err()
@@ -305,8 +308,8 @@ fn corrupt_checkpoints_are_errors_not_panics() {
     assert!(chain(&err).contains("sac_critic_adam"), "{}", chain(&err));
     std::fs::remove_dir_all(latest).unwrap();
     assert!(
-        Run::resume(&path).is_err(),
-        "checkpoints were written, none is left"
+        matches!(Run::resume(&path), Err(RlError::NoCheckpoint { .. })),
+        "checkpoints were written, none that resuming can load is left"
     );
 }
 
@@ -383,7 +386,10 @@ fn bad_configurations_are_rejected_with_a_reason() {
         assert!(err.to_string().contains(needle), "{needle}: {err}");
     }
     assert!(
-        TrainConfig::from_toml("env = \"lightsout-cursor\"\nalpha = 0.1").is_err(),
+        matches!(
+            TrainConfig::from_toml("env = \"lightsout-cursor\"\nalpha = 0.1"),
+            Err(RlError::Config(m)) if m.contains("unknown field")
+        ),
         "unknown fields are errors"
     );
 }

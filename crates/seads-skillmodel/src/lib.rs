@@ -14,7 +14,8 @@ mod reward;
 
 pub use groundtruth::{agreement_with_game, fit_to_game};
 pub use model::{
-    ForwardModel, SkillDiscriminator, SkillModel, SkillModelConfig, SkillModelKind, SkillTransition,
+    ForwardModel, OPTIMISER_FILES, SkillDiscriminator, SkillModel, SkillModelConfig,
+    SkillModelKind, SkillTransition,
 };
 pub use relabel::{RelabelKind, relabel, relabel_assignment, relabel_max};
 pub use reward::{

@@ -340,8 +340,14 @@ impl SkillModel for SkillDiscriminator {
     }
 }
 
+/// The checkpoint files of the skill models' optimiser states (read only when resuming).
+pub const OPTIMISER_FILES: [&str; 2] = [
+    "forward_model_adam.safetensors",
+    "discriminator_adam.safetensors",
+];
+
 /// A named network with its own var store and optimiser, saved as `<name>.safetensors` and
-/// `<name>_adam.safetensors` (the optimiser file is read only when resuming training).
+/// `<name>_adam.safetensors` (one of [`OPTIMISER_FILES`]; read only when resuming training).
 #[derive(Debug)]
 struct Trainable {
     name: &'static str,

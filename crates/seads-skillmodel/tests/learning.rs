@@ -2,7 +2,10 @@
 
 use proptest::prelude::*;
 use seads_games::{BoardGame, LightsOut, SymbolicState, TileSwap};
-use seads_skillmodel::{SkillModelConfig, SkillModelKind, SkillTransition, relabel_assignment};
+use seads_skillmodel::{
+    OPTIMISER_FILES, SkillModelConfig, SkillModelError, SkillModelKind, SkillTransition,
+    relabel_assignment,
+};
 use tch::Device;
 
 /// Every permutation of 0..n (Heap's algorithm).
@@ -211,10 +214,26 @@ fn checkpoints_round_trip_and_bad_files_are_errors() {
         b"not a checkpoint",
     )
     .unwrap();
-    assert!(other.load(dir.path(), true).is_err());
+    assert!(matches!(
+        other.load(dir.path(), true),
+        Err(SkillModelError::Checkpoint { path, .. }) if path.ends_with("forward_model.safetensors")
+    ));
     let mut wrong_shape = config.build(81, 12, Device::Cpu, 5);
     model.save(dir.path()).unwrap();
-    assert!(wrong_shape.load(dir.path(), true).is_err());
+    assert!(matches!(
+        wrong_shape.load(dir.path(), true),
+        Err(SkillModelError::Checkpoint { .. })
+    ));
+    // The optimiser files are the ones the trainer lists as resume-only.
+    assert!(dir.path().join(OPTIMISER_FILES[0]).exists());
+    let vic = SkillModelConfig {
+        kind: SkillModelKind::Vic,
+        ..SkillModelConfig::default()
+    }
+    .build(25, 25, Device::Cpu, 3);
+    let vic_dir = tempfile::tempdir().unwrap();
+    vic.save(vic_dir.path()).unwrap();
+    assert!(vic_dir.path().join(OPTIMISER_FILES[1]).exists());
     // Resuming needs the optimiser state (a fresh one would change the run); evaluating does not.
     std::fs::remove_file(dir.path().join("forward_model_adam.safetensors")).unwrap();
     other.load(dir.path(), false).unwrap();

@@ -326,22 +326,22 @@ mod tests {
             .to_string();
             assert!(err.contains(needle), "{needle}: {err}");
         }
-        assert!(
+        assert!(matches!(
             Calibration::fit(CalibrationFile {
                 corners: good,
                 d_max_mm: 0.0
-            })
-            .is_err()
-        );
+            }),
+            Err(UarmError::Calibration(_))
+        ));
         let mut nan = good;
         nan[0][1] = f64::NAN;
-        assert!(
+        assert!(matches!(
             Calibration::fit(CalibrationFile {
                 corners: nan,
                 d_max_mm: 100.0
-            })
-            .is_err()
-        );
+            }),
+            Err(UarmError::Calibration(_))
+        ));
     }
 
     #[test]
@@ -357,7 +357,10 @@ mod tests {
         cal.save(&path).unwrap();
         assert_eq!(Calibration::load(&path).unwrap(), cal);
         std::fs::write(&path, "corners = 3\n").unwrap();
-        assert!(Calibration::load(&path).is_err());
+        assert!(matches!(
+            Calibration::load(&path),
+            Err(UarmError::Calibration(_))
+        ));
         std::fs::remove_dir_all(&dir).unwrap();
     }
 }

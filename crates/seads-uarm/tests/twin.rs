@@ -100,7 +100,11 @@ fn driver_faults_are_clear_errors() {
     });
     assert!(matches!(arm.position(), Err(UarmError::Disconnected)));
     assert!(matches!(arm.attach(), Err(UarmError::Disconnected)));
-    assert!(arm.move_to([f64::NAN, 0.0, 0.0]).is_err());
+    // Refused before anything is sent, so not a disconnect.
+    assert!(matches!(
+        arm.move_to([f64::NAN, 0.0, 0.0]),
+        Err(UarmError::Protocol(_))
+    ));
 }
 
 #[test]
