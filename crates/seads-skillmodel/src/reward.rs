@@ -167,7 +167,7 @@ mod tests {
         // runner-up clipped to −2 ln 2 = −1.3862944, so R_0 = 1.2907489. A bonus
         // min(0.1, ln 2) = 0.1 wrongly added would give 1.3907489.
         let (_, vic) = episode_rewards(&[-0.1, -2.4], false, &RewardConfig::default());
-        assert!(close(vic[0], 1.290_748_9), "{}", vic[0]);
+        assert!(close(vic[0], 1.290_749), "{}", vic[0]);
     }
 
     #[test]
