@@ -755,8 +755,9 @@ fn the_run_decides_the_kernels() {
     .unwrap();
     let losses = |config: &std::path::Path, mkl: &str, name: &str| -> Vec<String> {
         let out = dir.path().join(name);
+        // Long enough (~60 epochs) for the kernels' last-bit differences to show.
         let status = std::process::Command::new(env!("CARGO_BIN_EXE_seads"))
-            .args(["train", "--quiet", "--config"])
+            .args(["train", "--quiet", "--env-steps", "3000", "--config"])
             .arg(config)
             .arg("--out")
             .arg(&out)

@@ -5,7 +5,7 @@
 //! of the run (after collecting an epoch, while SAC updates, after an epoch, after a metrics
 //! append, between the steps of a checkpoint write) and waits there to be killed. CI kills at 32
 //! moments spread over the run plus the first of each kind; `SEADS_CRASH_TEST_ALL=1` kills at
-//! every moment (the long variant, hundreds of kills).
+//! every moment (the long variant, ~900 kills), `SEADS_CRASH_TEST_EVERY=N` at every N-th.
 
 use std::io::{BufRead, BufReader};
 use std::path::{Path, PathBuf};
@@ -116,13 +116,10 @@ fn baseline() -> &'static Baseline {
     })
 }
 
-/// Starts a fresh run, kills it with SIGKILL where it stopped at moment `point`, then resumes it
-/// to the end; returns the resumed run's stderr.
-fn kill_and_resume(point: usize, tear: bool) -> String {
-    let base = baseline();
-    let dir = tempfile::tempdir().unwrap();
-    let out = dir.path().join("run");
-    let mut child = train(&base.config, &out)
+/// Starts a fresh run of `config` into `out` and kills it with SIGKILL where it stopped, at
+/// moment `point`.
+fn start_and_kill(config: &Path, out: &Path, point: usize) {
+    let mut child = train(config, out)
         .env("SEADS_CRASH_POINT", point.to_string())
         .stdout(Stdio::null())
         .stderr(Stdio::piped())
@@ -139,6 +136,15 @@ fn kill_and_resume(point: usize, tear: bool) -> String {
     assert!(stopped, "the run never reached moment {point}");
     child.kill().unwrap(); // SIGKILL
     child.wait().unwrap();
+}
+
+/// Starts a fresh run, kills it at moment `point`, then resumes it to the end; returns the
+/// resumed run's stderr.
+fn kill_and_resume(point: usize, tear: bool) -> String {
+    let base = baseline();
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("run");
+    start_and_kill(&base.config, &out, point);
     if tear {
         // A crash during the append: the last line lost its second half and its newline.
         let path = out.join("metrics.jsonl");
@@ -159,13 +165,17 @@ fn kill_and_resume(point: usize, tear: bool) -> String {
 }
 
 /// The moments to kill at: 32 spread over the run and the first of each kind; every moment with
-/// `SEADS_CRASH_TEST_ALL=1`.
+/// `SEADS_CRASH_TEST_ALL=1`, every N-th with `SEADS_CRASH_TEST_EVERY=N`.
 fn points() -> Vec<usize> {
     let moments = &baseline().moments;
     let n = moments.len();
     assert!(n >= 60, "{n} moments");
     if std::env::var_os("SEADS_CRASH_TEST_ALL").is_some() {
         return (1..=n).collect();
+    }
+    if let Ok(every) = std::env::var("SEADS_CRASH_TEST_EVERY") {
+        let every: usize = every.parse().expect("SEADS_CRASH_TEST_EVERY is a number");
+        return (1..=n).step_by(every.max(1)).collect();
     }
     let mut points: Vec<usize> = (0..32).map(|i| 1 + i * (n - 1) / 31).collect();
     for kind in [
@@ -224,19 +234,7 @@ fn a_torn_line_and_a_corrupt_latest_checkpoint_are_repaired() {
         .0;
     let dir = tempfile::tempdir().unwrap();
     let out = dir.path().join("run");
-    let mut child = train(&base.config, &out)
-        .env("SEADS_CRASH_POINT", point.to_string())
-        .stdout(Stdio::null())
-        .stderr(Stdio::piped())
-        .spawn()
-        .unwrap();
-    for line in BufReader::new(child.stderr.take().unwrap()).lines() {
-        if line.unwrap().starts_with("seads: stopped") {
-            break;
-        }
-    }
-    child.kill().unwrap();
-    child.wait().unwrap();
+    start_and_kill(&base.config, &out, point);
     let latest = std::fs::read_to_string(out.join("checkpoints/latest")).unwrap();
     std::fs::write(
         out.join("checkpoints")

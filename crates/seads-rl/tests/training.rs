@@ -243,14 +243,8 @@ fn a_checkpoint_keeps_the_prepared_updates() {
 }
 
 /// An error and its sources, as the CLI prints them.
-fn chain(err: &dyn std::error::Error) -> String {
-    let mut text = err.to_string();
-    let mut source = err.source();
-    while let Some(e) = source {
-        text += &format!(": {e}");
-        source = e.source();
-    }
-    text
+fn chain(err: impl std::error::Error + Send + Sync + 'static) -> String {
+    format!("{:#}", anyhow::Error::from(err))
 }
 
 /// A corrupt latest checkpoint is passed over for the one before it (resuming says so); when no
@@ -285,11 +279,8 @@ fn corrupt_checkpoints_are_errors_not_panics() {
     let err = Run::resume(&path)
         .err()
         .expect("no loadable checkpoint is an error");
-    assert!(
-        chain(&err).contains("episodes.safetensors"),
-        "{}",
-        chain(&err)
-    );
+    let text = chain(err);
+    assert!(text.contains("episodes.safetensors"), "{text}");
     // Well-formed tensors whose episode table gives the second episode a negative length.
     std::fs::write(&episodes, &intact).unwrap();
     let mut tensors = tch::Tensor::read_safetensors(&episodes).unwrap();
@@ -299,13 +290,15 @@ fn corrupt_checkpoints_are_errors_not_panics() {
     let err = Run::resume(&path)
         .err()
         .expect("a negative episode length is an error");
-    assert!(chain(&err).contains("episode table"), "{}", chain(&err));
+    let text = chain(err);
+    assert!(text.contains("episode table"), "{text}");
     // A missing optimiser state is an error on resume (a fresh optimiser would change the run).
     std::fs::write(&episodes, &intact).unwrap();
     std::fs::remove_file(latest.join("sac_critic_adam.safetensors")).unwrap();
     std::fs::remove_dir_all(before).unwrap();
     let err = Run::resume(&path).err().expect("a missing optimiser state");
-    assert!(chain(&err).contains("sac_critic_adam"), "{}", chain(&err));
+    let text = chain(err);
+    assert!(text.contains("sac_critic_adam"), "{text}");
     std::fs::remove_dir_all(latest).unwrap();
     assert!(
         matches!(Run::resume(&path), Err(RlError::NoCheckpoint { .. })),

@@ -167,14 +167,8 @@ fn displacements_move_and_press_like_the_cursor() {
 }
 
 /// An error and its sources, as the CLI prints them.
-fn chain(err: &dyn std::error::Error) -> String {
-    let mut text = err.to_string();
-    let mut source = err.source();
-    while let Some(e) = source {
-        text += &format!(": {e}");
-        source = e.source();
-    }
-    text
+fn chain(err: impl std::error::Error + Send + Sync + 'static) -> String {
+    format!("{:#}", anyhow::Error::from(err))
 }
 
 /// A reset that cannot move the arm is an error (issue 13: resets swallowed hardware errors).
@@ -189,7 +183,8 @@ fn a_failed_reset_is_an_error() {
     });
     let err = env.reset().unwrap_err();
     assert!(matches!(err, EnvError::Hardware { .. }), "{err}");
-    assert!(chain(&err).contains("disconnected"), "{}", chain(&err));
+    let text = chain(err);
+    assert!(text.contains("disconnected"), "{text}");
 }
 
 #[test]
@@ -205,7 +200,8 @@ fn faults_mid_move_end_in_an_error_with_the_pen_lifted() {
     });
     let err = env.step(&[0.5, 0.5]).unwrap_err();
     assert!(matches!(err, EnvError::Hardware { .. }), "{err}");
-    assert!(chain(&err).contains("did not answer"), "{}", chain(&err));
+    let text = chain(err);
+    assert!(text.contains("did not answer"), "{text}");
     assert!(
         (twin.pen_height_mm() - 20.0).abs() < 0.01,
         "the pen is lifted to hover height"
@@ -227,7 +223,8 @@ fn faults_mid_move_end_in_an_error_with_the_pen_lifted() {
         ..Faults::default()
     });
     let err = env.step(&[0.3, 0.3]).unwrap_err();
-    assert!(chain(&err).contains("disconnected"), "{}", chain(&err));
+    let text = chain(err);
+    assert!(text.contains("disconnected"), "{text}");
     twin.reconnect();
     env.reset_step_counter();
     assert!(env.step(&[0.9, 0.9]).is_ok());
