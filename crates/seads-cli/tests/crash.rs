@@ -5,7 +5,7 @@
 //! of the run (after collecting an epoch, while SAC updates, after an epoch, after a metrics
 //! append, between the steps of a checkpoint write) and waits there to be killed. CI kills at 32
 //! moments spread over the run plus the first of each kind; `SEADS_CRASH_TEST_ALL=1` kills at
-//! every moment (the long variant, ~900 kills), `SEADS_CRASH_TEST_EVERY=N` at every N-th.
+//! every moment (the long variant, 552 kills), `SEADS_CRASH_TEST_EVERY=N` at every N-th.
 
 use std::io::{BufRead, BufReader};
 use std::path::{Path, PathBuf};
@@ -16,8 +16,8 @@ use serde_json::Value;
 
 const SEADS: &str = env!("CARGO_BIN_EXE_seads");
 
-/// A small run: ~150 epochs of 8 short episodes, updates from epoch 4, an evaluation every 4
-/// epochs and a checkpoint every 5 (so checkpoints fall between evaluations too); ~900 moments.
+/// A small run: 144 epochs of 8 short episodes, updates from epoch 4, an evaluation every 4
+/// epochs and a checkpoint every 5 (so checkpoints fall between evaluations too); 552 moments.
 fn config(dir: &Path) -> PathBuf {
     let text = std::fs::read_to_string(concat!(
         env!("CARGO_MANIFEST_DIR"),
