@@ -286,6 +286,20 @@ mod tests {
         config
     }
 
+    /// Buffers of K = 2 skills over `episodes`.
+    fn buffers<'a>(
+        config: &'a TrainConfig,
+        episodes: &'a mut VecDeque<Episode>,
+        rng: &'a mut ChaCha8Rng,
+    ) -> Buffers<'a> {
+        Buffers {
+            config,
+            k: 2,
+            episodes,
+            rng,
+        }
+    }
+
     fn spec() -> EnvSpec {
         let mut spec = seads_embodiment::make_env("lightsout-cursor", &Default::default())
             .unwrap()
@@ -299,12 +313,7 @@ mod tests {
     fn the_oldest_episodes_are_evicted_and_updates_wait_for_a_full_batch() {
         let config = config(3, 1, 3);
         let (mut episodes, mut rng) = (VecDeque::new(), ChaCha8Rng::seed_from_u64(0));
-        let mut buffers = Buffers {
-            config: &config,
-            k: 2,
-            episodes: &mut episodes,
-            rng: &mut rng,
-        };
+        let mut buffers = buffers(&config, &mut episodes, &mut rng);
         buffers.push((0..2).map(|s| episode(s, 1, 0.0, None)).collect());
         assert!(!buffers.ready());
         buffers.push((2..5).map(|s| episode(s, 1, 0.0, None)).collect());
@@ -323,12 +332,7 @@ mod tests {
         let mut episodes: VecDeque<Episode> =
             [episode(0, 2, 10.0, Some(0)), episode(1, 1, 20.0, None)].into();
         let mut rng = ChaCha8Rng::seed_from_u64(0);
-        let buffers = Buffers {
-            config: &config,
-            k: 2,
-            episodes: &mut episodes,
-            rng: &mut rng,
-        };
+        let buffers = buffers(&config, &mut episodes, &mut rng);
         let rows = buffers.transition_batch(
             &spec(),
             &[0, 1],
@@ -358,12 +362,7 @@ mod tests {
         let mut episodes: VecDeque<Episode> =
             [episode(0, 2, 10.0, Some(0)), episode(1, 1, 20.0, None)].into();
         let mut rng = ChaCha8Rng::seed_from_u64(0);
-        let mut buffers = Buffers {
-            config: &config,
-            k: 2,
-            episodes: &mut episodes,
-            rng: &mut rng,
-        };
+        let mut buffers = buffers(&config, &mut episodes, &mut rng);
         let (minibatches, mean_reward) = buffers.sac_minibatches(&MoveIsSkill { k: 2 }, &spec());
         let r0 = -(1.0f64 + (-10.0f64).exp()).ln() + 2.0 * 2f64.ln();
         let minimum = -2.0 * 2f64.ln();
@@ -395,12 +394,7 @@ mod tests {
         let mut episodes: VecDeque<Episode> =
             [episode(1, 1, 0.0, Some(0)), episode(0, 1, 0.0, Some(1))].into();
         let mut rng = ChaCha8Rng::seed_from_u64(0);
-        let mut buffers = Buffers {
-            config: &config,
-            k: 2,
-            episodes: &mut episodes,
-            rng: &mut rng,
-        };
+        let mut buffers = buffers(&config, &mut episodes, &mut rng);
         let tuples = buffers.skill_model_batch(&MoveIsSkill { k: 2 });
         let mut labels: Vec<usize> = tuples.iter().map(|t| t.skill).collect();
         assert_eq!(labels[0], 0);
