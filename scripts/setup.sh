@@ -2,7 +2,8 @@
 # One-time set-up of a fresh machine, idempotent: installs libtorch for tch (PyTorch 2.13.0, the
 # version tch 0.26 expects) into .venv inside the repository and links it as .libtorch, where
 # .cargo/config.toml points LIBTORCH and the binaries' rpath. Needs python3 (3.9+) with venv and
-# pip, and access to PyPI. Nothing outside the repository is touched.
+# pip, and access to PyPI. Outside the repository, only Slurm's Debian packages are installed
+# (scripts/slurm/install.sh, as root).
 set -euo pipefail
 
 root=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
@@ -10,6 +11,9 @@ venv="$root/.venv"
 link="$root/.libtorch"
 torch_version=2.13.0
 stamp="$venv/.seads-libtorch-$torch_version"
+
+# Slurm and munge for the Slurm test (root and apt-get only; otherwise the test skips).
+bash "$root/scripts/slurm/install.sh"
 
 if [[ -f "$stamp" && -f "$link/lib/libtorch_cpu.so" ]]; then
   exit 0

@@ -7,8 +7,11 @@ mod envs;
 mod episodes;
 mod games;
 mod kernels;
+mod overtraining;
 mod plan;
 mod plot;
+mod report;
+mod sweep;
 mod train;
 mod uarm;
 
@@ -56,6 +59,11 @@ enum Command {
     Record(episodes::RecordArgs),
     /// Replay recorded episodes exactly and recompute their observations and moves.
     Replay(episodes::ReplayArgs),
+    /// Tables, Mann–Whitney tests and figures over sweeps and runs (the paper's Table 1 and more).
+    Report(report::ReportArgs),
+    /// Studies over seeds and variants: plan from a manifest, run here or on Slurm, status.
+    #[command(subcommand)]
+    Sweep(sweep::SweepCommand),
     /// The real robot (uArm Swift Pro + LightsOut tablet) or its simulated twin (`--port sim`).
     #[command(subcommand)]
     Uarm(uarm::UarmCommand),
@@ -110,6 +118,8 @@ fn main() -> ExitCode {
         Command::PlanBench(args) => plan::plan_bench(args),
         Command::Record(args) => episodes::record(args),
         Command::Replay(args) => episodes::replay(args),
+        Command::Sweep(cmd) => sweep::run(cmd),
+        Command::Report(args) => report::report(args),
         Command::Uarm(uarm::UarmCommand::Calibrate(args)) => uarm::calibrate(args),
         Command::Uarm(uarm::UarmCommand::Train(args)) => uarm::train(args),
     };

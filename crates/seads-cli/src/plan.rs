@@ -181,6 +181,11 @@ pub struct EvaluateArgs {
     /// Use the checkpoint of this epoch instead of the latest.
     #[arg(long)]
     checkpoint: Option<u64>,
+    /// Success over training: evaluate `all` kept checkpoints, or every N-th (and the last),
+    /// with and without re-planning, appending to evaluation-over-training.jsonl in the run
+    /// directory. Checkpoints already there are skipped.
+    #[arg(long, conflicts_with_all = ["checkpoint", "replan", "seed"])]
+    checkpoints: Option<crate::overtraining::Selection>,
     /// Time limit per search, seconds (the authors' evaluation used 60).
     #[arg(long, default_value_t = 60.0, value_parser = crate::positive_finite)]
     timeout: f64,
@@ -216,6 +221,35 @@ pub struct Tasks {
     pub timeout: f64,
 }
 
+/// Evaluates the agent on `tasks`, advancing `bar` by one per task.
+pub fn evaluate_agent(
+    agent: &mut Agent,
+    tasks: &Tasks,
+    bar: &ProgressBar,
+) -> Result<Vec<DepthResult>> {
+    let evaluation = Evaluation {
+        env: agent.config.env.clone(),
+        env_config: agent.config.env_config.clone(),
+        depths: tasks.depths.clone(),
+        seeds: tasks.seeds.clone(),
+        split: tasks.split,
+        solve: SolveConfig {
+            replan: tasks.replan,
+            planner: PlannerConfig {
+                timeout_s: Some(tasks.timeout),
+                ..PlannerConfig::default()
+            },
+            ..SolveConfig::default()
+        },
+    };
+    let (policy, model) = agent.parts()?;
+    evaluate(&evaluation, policy, model, |depth, _| {
+        bar.set_message(format!("depth {depth}"));
+        bar.inc(1);
+    })
+    .map_err(|e| BadInput(e.into()).into())
+}
+
 /// Evaluates the agent and saves the per-depth results into the run directory
 /// (`evaluation-replan.json` or `evaluation-plan-once.json`).
 pub fn run_evaluation(
@@ -224,51 +258,25 @@ pub fn run_evaluation(
     tasks: Tasks,
     quiet: bool,
 ) -> Result<Vec<DepthResult>> {
-    let Tasks {
-        depths,
-        seeds,
-        split,
-        replan,
-        timeout,
-    } = tasks;
-    let evaluation = Evaluation {
-        env: agent.config.env.clone(),
-        env_config: agent.config.env_config.clone(),
-        depths: depths.clone(),
-        seeds: seeds.clone(),
-        split,
-        solve: SolveConfig {
-            replan,
-            planner: PlannerConfig {
-                timeout_s: Some(timeout),
-                ..PlannerConfig::default()
-            },
-            ..SolveConfig::default()
-        },
-    };
     let bar = if quiet {
         ProgressBar::hidden()
     } else {
-        ProgressBar::new((depths.len() * seeds.len()) as u64)
+        ProgressBar::new((tasks.depths.len() * tasks.seeds.len()) as u64)
     };
-    let (policy, model) = agent.parts()?;
-    let results = evaluate(&evaluation, policy, model, |depth, _| {
-        bar.set_message(format!("depth {depth}"));
-        bar.inc(1);
-    })
-    .map_err(|e| BadInput(e.into()))?;
+    let results = evaluate_agent(agent, &tasks, &bar)?;
     bar.finish_and_clear();
     // The standard depths 1–5 are what `seads plot` draws; other studies are kept beside them.
-    let mode = if replan { "replan" } else { "plan-once" };
+    let depths = &tasks.depths;
+    let mode = if tasks.replan { "replan" } else { "plan-once" };
     let name = match (depths.first(), depths.last()) {
         (Some(1), Some(5)) if depths.len() == 5 => format!("evaluation-{mode}.json"),
         (Some(a), Some(b)) => format!("evaluation-{mode}-depths-{a}-{b}.json"),
         _ => format!("evaluation-{mode}.json"),
     };
-    let path = run.join(name);
-    let tmp = path.with_extension("tmp");
-    std::fs::write(&tmp, serde_json::to_string_pretty(&results)?)?;
-    std::fs::rename(&tmp, &path)?;
+    seads_rl::write_atomic(
+        &run.join(name),
+        serde_json::to_string_pretty(&results)?.as_bytes(),
+    )?;
     Ok(results)
 }
 
@@ -277,6 +285,42 @@ pub fn evaluate_run(args: EvaluateArgs) -> Result<()> {
     let depths = parse_depths(&args.depths)?;
     if args.boards == 0 {
         bail!(BadInput(anyhow::anyhow!("--boards must be at least 1")));
+    }
+    if let Some(selection) = args.checkpoints {
+        let added = crate::overtraining::evaluate_checkpoints(
+            &args.run,
+            selection,
+            &depths,
+            args.boards,
+            args.timeout,
+            args.json,
+        )?;
+        let lines = crate::overtraining::read(&args.run)?;
+        if args.json {
+            println!("{}", serde_json::to_string(&lines)?);
+        } else {
+            println!(
+                "{added} new evaluation(s); {} in {}",
+                lines.len(),
+                args.run.join(crate::overtraining::FILE).display()
+            );
+            println!("     epoch   env steps  mode            success per depth");
+            for l in &lines {
+                let rates: Vec<String> = l
+                    .results
+                    .iter()
+                    .map(|r| format!("{:.0}%", 100.0 * r.solved as f64 / r.tasks.max(1) as f64))
+                    .collect();
+                println!(
+                    "{:>10}  {:>10}  {:<14}  {}",
+                    l.epoch,
+                    l.env_steps,
+                    if l.replan { "re-planning" } else { "plan once" },
+                    rates.join(" ")
+                );
+            }
+        }
+        return Ok(());
     }
     let mut agent = load_agent(&args.run, args.checkpoint)?;
     let seeds = task_seeds(args.boards, args.seed);

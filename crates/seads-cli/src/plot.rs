@@ -63,7 +63,6 @@ pub fn write_figures(
     quiet: bool,
 ) -> Result<Vec<PathBuf>> {
     std::fs::create_dir_all(out).with_context(|| format!("creating {}", out.display()))?;
-    let mut agent = load_agent(run, checkpoint)?;
     let mut written = Vec::new();
     let mut both = |name: &str, f: &dyn Fn(&Path) -> Result<()>| -> Result<()> {
         for ext in ["png", "svg"] {
@@ -74,11 +73,36 @@ pub fn write_figures(
         Ok(())
     };
     let metrics = read_metrics(run)?;
+    let config = seads_rl::load_config(run)?;
+    let title = format!("{} (seed {})", config.env, config.seed);
+    if !seads_embodiment::env_names().contains(&config.env.as_str()) {
+        // A robot run: its environment is the hardware (or its twin), so only what the run
+        // directory holds is drawn; `seads uarm train` evaluates and draws the rest itself.
+        let k = config
+            .num_skills
+            .unwrap_or(seads_uarm::BOARD_SIZE * seads_uarm::BOARD_SIZE);
+        both("coverage", &|p| coverage_figure(p, &metrics, k, &title))?;
+        if !quiet {
+            eprintln!(
+                "seads: {} is a robot run ({}): skill coverage only; trajectories need the robot",
+                run.display(),
+                config.env
+            );
+        }
+        return Ok(written);
+    }
+    let mut agent = load_agent(run, checkpoint)?;
     let k = agent.policy_skills();
-    let title = format!("{} (seed {})", agent.config.env, agent.config.seed);
     both("coverage", &|p| coverage_figure(p, &metrics, k, &title))?;
-    let evaluations = evaluations(&mut agent, run, boards, timeout, quiet)?;
-    both("success", &|p| success_figure(p, &evaluations, &title))?;
+    if agent.model.is_some() {
+        let evaluations = evaluations(&mut agent, run, boards, timeout, quiet)?;
+        both("success", &|p| success_figure(p, &evaluations, &title))?;
+    } else if !quiet {
+        eprintln!(
+            "seads: {} is a VIC run: its skill discriminator cannot plan, so there is no task-success figure",
+            run.display()
+        );
+    }
     let runs = skill_runs(&agent)?;
     let scene = {
         let mut env = build_env(

@@ -163,6 +163,11 @@ impl Run {
         mut build: impl FnMut(TrainConfig) -> Result<Trainer, RlError>,
     ) -> Result<Self, RlError> {
         let config = load_config(dir)?;
+        // A directory planned by a sweep holds only its config: the run starts here.
+        if !dir.join(METRICS).exists() {
+            fs::create_dir_all(dir.join(CHECKPOINTS)).map_err(|e| RlError::io(dir, e))?;
+            write_metrics(dir, &[])?;
+        }
         let mut repairs: Vec<String> = clean_leftovers(&dir.join(CHECKPOINTS))?
             .into_iter()
             .map(|name| format!("removed {name}, left by an interrupted write"))

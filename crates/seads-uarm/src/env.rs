@@ -99,7 +99,7 @@ impl UarmEnv {
                 "step_limit must be at least 1 and tap_timeout_s in [0, 3600] seconds".into(),
             ));
         }
-        let game = LightsOut::new(5).expect("5×5");
+        let game = LightsOut::new(crate::BOARD_SIZE).expect("5×5");
         let (name, low, high) = match config.action_space {
             ActionSpace::Absolute => ("uarm-lightsout-absolute", vec![0.0, 0.0], vec![1.0, 1.0]),
             ActionSpace::Displacement => (

@@ -20,6 +20,9 @@ pub mod tablet;
 mod twin;
 
 pub use calibration::{Calibration, CalibrationFile};
+
+/// Side of the LightsOut board the robot plays (on the tablet); its K is the game's 25 moves.
+pub const BOARD_SIZE: usize = 5;
 pub use driver::{DriverConfig, SerialTransport, Swift, Transport};
 pub use env::{ActionSpace, UarmConfig, UarmEnv};
 pub use tablet::{AdbTablet, Tablet, TabletReport};

@@ -1,0 +1,199 @@
+//! Task success over training (the paper's Fig. 3): `seads evaluate --checkpoints all|N`
+//! evaluates kept checkpoints with and without re-planning and appends one line per checkpoint
+//! and mode to `evaluation-over-training.jsonl`, keyed by environment steps. Checkpoints already
+//! in the file are skipped, so the command resumes where it stopped.
+
+use std::collections::BTreeSet;
+use std::io::Write as _;
+use std::path::Path;
+
+use anyhow::{Context, Result, anyhow};
+use indicatif::{ProgressBar, ProgressStyle};
+use seads_planner::DepthResult;
+use seads_rl::Agent;
+use serde::{Deserialize, Serialize};
+
+use crate::BadInput;
+use crate::plan::{Tasks, evaluate_agent};
+
+/// The file, in the run directory.
+pub const FILE: &str = "evaluation-over-training.jsonl";
+
+/// One line: a checkpoint evaluated in one mode.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+pub struct CheckpointEvaluation {
+    /// Epoch of the checkpoint.
+    pub epoch: u64,
+    /// Environment steps of training at the checkpoint.
+    pub env_steps: u64,
+    /// With re-planning.
+    pub replan: bool,
+    /// Boards per depth.
+    pub boards: usize,
+    /// Seconds per search.
+    pub timeout_s: f64,
+    /// Per depth.
+    pub results: Vec<DepthResult>,
+}
+
+/// Which checkpoints: `all`, or every N-th kept one (the last always).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Selection {
+    /// Every kept checkpoint.
+    All,
+    /// Every N-th, counted from the first, and the last.
+    Every(usize),
+}
+
+impl std::str::FromStr for Selection {
+    type Err = String;
+    fn from_str(text: &str) -> Result<Self, String> {
+        match text {
+            "all" => Ok(Self::All),
+            n => match n.parse::<usize>() {
+                Ok(n) if n > 0 => Ok(Self::Every(n)),
+                _ => Err(format!(
+                    "--checkpoints takes `all` or a number N ≥ 1 (every N-th), got {text:?}"
+                )),
+            },
+        }
+    }
+}
+
+/// Reads the lines of `run`'s file (none if it does not exist; a torn last line is ignored).
+pub fn read(run: &Path) -> Result<Vec<CheckpointEvaluation>> {
+    let path = run.join(FILE);
+    let text = match std::fs::read_to_string(&path) {
+        Ok(text) => text,
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok(Vec::new()),
+        Err(e) => return Err(e).with_context(|| format!("reading {}", path.display())),
+    };
+    let whole = text.rfind('\n').map_or("", |end| &text[..=end]);
+    whole
+        .lines()
+        .enumerate()
+        .map(|(i, line)| {
+            serde_json::from_str(line)
+                .with_context(|| format!("{}:{}: not an evaluation line", path.display(), i + 1))
+        })
+        .collect()
+}
+
+/// The environment steps of training at checkpoint `epoch`: from the run's metrics (the presets
+/// evaluate coverage wherever they checkpoint), else from the checkpoint's progress file.
+fn env_steps_at(run: &Path, metrics: &[seads_rl::Metrics], epoch: u64, dir: &Path) -> Result<u64> {
+    if let Some(m) = metrics.iter().find(|m| m.epoch == epoch) {
+        return Ok(m.env_steps);
+    }
+    #[derive(Deserialize)]
+    struct Progress {
+        env_steps: u64,
+    }
+    let path = dir.join("progress.json");
+    let text = std::fs::read_to_string(&path).map_err(|_| {
+        anyhow!(
+            "{}: no metrics line at epoch {epoch} and no progress file to tell its environment steps",
+            run.display()
+        )
+    })?;
+    Ok(serde_json::from_str::<Progress>(&text)
+        .with_context(|| format!("reading {}", path.display()))?
+        .env_steps)
+}
+
+/// Evaluates the selected checkpoints of `run` that the file does not hold yet, both modes, on
+/// test boards of `depths` with `boards` per depth. Returns the number of lines appended.
+pub fn evaluate_checkpoints(
+    run: &Path,
+    selection: Selection,
+    depths: &[usize],
+    boards: usize,
+    timeout: f64,
+    quiet: bool,
+) -> Result<usize> {
+    let config =
+        seads_rl::load_config(run).with_context(|| format!("reading {}", run.display()))?;
+    crate::kernels::use_kernels(config.portable_numerics)?;
+    let kept = seads_rl::checkpoints(run).with_context(|| format!("reading {}", run.display()))?;
+    if kept.is_empty() {
+        return Err(BadInput(anyhow!("{} has no checkpoint to evaluate", run.display())).into());
+    }
+    let chosen: Vec<_> = match selection {
+        Selection::All => kept.clone(),
+        Selection::Every(n) => kept
+            .iter()
+            .enumerate()
+            .filter(|(i, _)| i % n == 0 || *i + 1 == kept.len())
+            .map(|(_, c)| c.clone())
+            .collect(),
+    };
+    let done: BTreeSet<(u64, bool)> = read(run)?.iter().map(|l| (l.epoch, l.replan)).collect();
+    let todo: Vec<(u64, &Path, bool)> = chosen
+        .iter()
+        .flat_map(|(epoch, dir)| [true, false].map(|replan| (*epoch, dir.as_path(), replan)))
+        .filter(|(epoch, _, replan)| !done.contains(&(*epoch, *replan)))
+        .collect();
+    let metrics = seads_rl::read_metrics(run)?;
+    let seeds = crate::plan::task_seeds(boards, None);
+    let per = (depths.len() * seeds.len()) as u64;
+    let bar = if quiet {
+        ProgressBar::hidden()
+    } else {
+        ProgressBar::new(per * todo.len() as u64)
+    };
+    bar.set_style(
+        ProgressStyle::with_template(
+            "{elapsed_precise} [{bar:30}] {pos}/{len} tasks {prefix} {msg}",
+        )
+        .expect("valid template")
+        .progress_chars("=> "),
+    );
+    let path = run.join(FILE);
+    let mut loaded: Option<(u64, Agent)> = None;
+    for (epoch, dir, replan) in &todo {
+        if loaded.as_ref().is_none_or(|(e, _)| e != epoch) {
+            loaded = Some((*epoch, Agent::load_checkpoint(config.clone(), dir)?));
+        }
+        let agent = &mut loaded.as_mut().expect("just loaded").1;
+        bar.set_prefix(format!("epoch {epoch}"));
+        let tasks = Tasks {
+            depths: depths.to_vec(),
+            seeds: seeds.clone(),
+            split: seads_games::Split::Test,
+            replan: *replan,
+            timeout,
+        };
+        let results = evaluate_agent(agent, &tasks, &bar)?;
+        let line = CheckpointEvaluation {
+            epoch: *epoch,
+            env_steps: env_steps_at(run, &metrics, *epoch, dir)?,
+            replan: *replan,
+            boards,
+            timeout_s: timeout,
+            results,
+        };
+        append_line(&path, &serde_json::to_string(&line)?)?;
+    }
+    bar.finish_and_clear();
+    Ok(todo.len())
+}
+
+/// Appends a whole line and fsyncs it (a crash leaves at most a torn last line, ignored by
+/// [`read`] and completed by the next append's newline-terminated line).
+fn append_line(path: &Path, line: &str) -> Result<()> {
+    let mut file = std::fs::OpenOptions::new()
+        .create(true)
+        .append(true)
+        .open(path)
+        .with_context(|| format!("opening {}", path.display()))?;
+    // A torn tail from a crash is cut off before the new line.
+    let text = std::fs::read_to_string(path).unwrap_or_default();
+    if !text.is_empty() && !text.ends_with('\n') {
+        let keep = text.rfind('\n').map_or(0, |i| i + 1);
+        file.set_len(keep as u64)
+            .with_context(|| format!("repairing {}", path.display()))?;
+    }
+    file.write_all(format!("{line}\n").as_bytes())
+        .and_then(|()| file.sync_data())
+        .with_context(|| format!("writing {}", path.display()))
+}

@@ -1,0 +1,281 @@
+//! The report's figures, per environment: skill coverage and task success over training (mean
+//! of the variant's runs with a min–max band, the seed's Fig. S.15/S.16 style), and box plots of
+//! solution and skill length per depth (Figs. S.5, S.6); whiskers at Tukey's 1.5 × IQR fences.
+
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+
+use anyhow::Result;
+use plotters::coord::Shift;
+use plotters::prelude::*;
+
+use super::runs::Group;
+use crate::draw::{plot_err, render_to, skill_colour};
+
+/// A curve: x, mean, min, max.
+type Band = Vec<(f64, f64, f64, f64)>;
+
+/// The mean, min and max over the runs at each x-key present in every run; x is the mean of
+/// the runs' x at that key (runs of a variant evaluate at the same epochs, a few environment
+/// steps apart).
+fn band(series: &[Vec<(u64, f64, f64)>]) -> Band {
+    let mut by_key: BTreeMap<u64, Vec<(f64, f64)>> = BTreeMap::new();
+    for s in series {
+        for &(key, x, y) in s {
+            by_key.entry(key).or_default().push((x, y));
+        }
+    }
+    by_key
+        .into_values()
+        .filter(|v| v.len() == series.len())
+        .map(|v| {
+            let n = v.len() as f64;
+            let x = v.iter().map(|p| p.0).sum::<f64>() / n;
+            let ys = v.iter().map(|p| p.1);
+            let mean = ys.clone().sum::<f64>() / n;
+            let min = ys.clone().fold(f64::INFINITY, f64::min);
+            let max = ys.fold(f64::NEG_INFINITY, f64::max);
+            (x, mean, min, max)
+        })
+        .collect()
+}
+
+/// Draws one band per variant into `out`.
+fn band_figure(
+    out: &Path,
+    title: &str,
+    y_desc: &str,
+    y_max: f64,
+    curves: &[(String, Band)],
+) -> Result<()> {
+    render_to!(out, (900, 520), |area: &DrawingArea<_, Shift>| {
+        let x_max = curves
+            .iter()
+            .flat_map(|(_, b)| b.iter().map(|p| p.0))
+            .fold(1.0, f64::max);
+        let mut chart = ChartBuilder::on(area)
+            .caption(title, ("sans-serif", 20))
+            .margin(12)
+            .x_label_area_size(45)
+            .y_label_area_size(60)
+            .build_cartesian_2d(0.0..x_max, 0.0..y_max)
+            .map_err(plot_err)?;
+        chart
+            .configure_mesh()
+            .x_desc("environment steps")
+            .y_desc(y_desc)
+            .x_label_formatter(&|x| format!("{x:.0}"))
+            .draw()
+            .map_err(plot_err)?;
+        for (i, (name, band)) in curves.iter().enumerate() {
+            let colour = skill_colour(i);
+            let mut outline: Vec<(f64, f64)> = band.iter().map(|p| (p.0, p.3)).collect();
+            outline.extend(band.iter().rev().map(|p| (p.0, p.2)));
+            chart
+                .draw_series(std::iter::once(Polygon::new(
+                    outline,
+                    colour.mix(0.18).filled(),
+                )))
+                .map_err(plot_err)?;
+            chart
+                .draw_series(LineSeries::new(
+                    band.iter().map(|p| (p.0, p.1)),
+                    colour.stroke_width(2),
+                ))
+                .map_err(plot_err)?
+                .label(name.as_str())
+                .legend(move |(x, y)| {
+                    PathElement::new(vec![(x, y), (x + 20, y)], colour.stroke_width(2))
+                });
+        }
+        chart
+            .configure_series_labels()
+            .position(SeriesLabelPosition::LowerRight)
+            .border_style(BLACK)
+            .background_style(WHITE.mix(0.9))
+            .draw()
+            .map_err(plot_err)?;
+        anyhow::Ok(())
+    })
+}
+
+/// Writes PNG and SVG of a figure; returns both paths.
+fn both(out: &Path, name: &str, draw: &dyn Fn(&Path) -> Result<()>) -> Result<Vec<PathBuf>> {
+    let mut written = Vec::new();
+    for ext in ["png", "svg"] {
+        let path = out.join(format!("{name}.{ext}"));
+        draw(&path)?;
+        written.push(path);
+    }
+    Ok(written)
+}
+
+/// Coverage over training per environment; returns the files written.
+pub fn coverage_figures(
+    out: &Path,
+    groups: &[Group<'_>],
+    k_of: &dyn Fn(&Group<'_>) -> usize,
+) -> Result<Vec<PathBuf>> {
+    let mut written = Vec::new();
+    for env in envs(groups) {
+        let mut curves = Vec::new();
+        let mut k = 1;
+        for g in groups.iter().filter(|g| g.env == env) {
+            k = k.max(k_of(g));
+            let series: Vec<Vec<(u64, f64, f64)>> = g
+                .runs
+                .iter()
+                .map(|r| {
+                    r.metrics
+                        .iter()
+                        .map(|m| (m.epoch, m.env_steps as f64, m.skill_coverage))
+                        .collect()
+                })
+                .collect();
+            curves.push((
+                format!("{} (n = {})", g.variant, g.runs.len()),
+                band(&series),
+            ));
+        }
+        let title = format!("Skill coverage: {env} (mean, min–max band)");
+        written.extend(both(out, &format!("coverage-{env}"), &|p| {
+            band_figure(
+                p,
+                &title,
+                "distinct moves by the K skills",
+                k as f64 + 0.5,
+                &curves,
+            )
+        })?);
+    }
+    Ok(written)
+}
+
+/// Task success over training (with re-planning, mean over the depths) per environment, for
+/// the groups whose runs were evaluated over training; returns the files written.
+pub fn success_figures(out: &Path, groups: &[Group<'_>]) -> Result<Vec<PathBuf>> {
+    let mut written = Vec::new();
+    for env in envs(groups) {
+        let mut curves = Vec::new();
+        for g in groups.iter().filter(|g| g.env == env) {
+            let series: Vec<Vec<(u64, f64, f64)>> = g
+                .runs
+                .iter()
+                .map(|r| {
+                    r.over_training
+                        .iter()
+                        .filter(|l| l.replan)
+                        .map(|l| {
+                            let (solved, tasks) = l
+                                .results
+                                .iter()
+                                .fold((0, 0), |(s, t), d| (s + d.solved, t + d.tasks));
+                            (
+                                l.epoch,
+                                l.env_steps as f64,
+                                100.0 * solved as f64 / tasks.max(1) as f64,
+                            )
+                        })
+                        .collect()
+                })
+                .collect();
+            let band = band(&series);
+            if !band.is_empty() {
+                curves.push((format!("{} (n = {})", g.variant, g.runs.len()), band));
+            }
+        }
+        if curves.is_empty() {
+            continue;
+        }
+        let title = format!("Task success over training: {env} (re-planning, depths pooled)");
+        written.extend(both(out, &format!("success-{env}"), &|p| {
+            band_figure(p, &title, "test tasks solved (%)", 105.0, &curves)
+        })?);
+    }
+    Ok(written)
+}
+
+/// Box plots of solution length and skill length per depth (with re-planning, solved tasks of
+/// all runs of the variant), one figure per environment and variant; returns the files written.
+pub fn length_figures(out: &Path, groups: &[Group<'_>]) -> Result<Vec<PathBuf>> {
+    let mut written = Vec::new();
+    for g in groups {
+        let mut per_depth: BTreeMap<usize, (Vec<f64>, Vec<f64>)> = BTreeMap::new();
+        for e in g.runs.iter().filter_map(|r| r.replan.as_ref()) {
+            for r in e {
+                let entry = per_depth.entry(r.depth).or_default();
+                entry.0.extend(r.solution_steps.iter().map(|&s| s as f64));
+                entry.1.extend(r.skill_steps.iter().map(|&s| s as f64));
+            }
+        }
+        per_depth.retain(|_, (solutions, _)| !solutions.is_empty());
+        if per_depth.is_empty() {
+            continue;
+        }
+        let name = format!("lengths-{}-{}", g.env, g.variant);
+        let title = format!("{} / {}", g.env, g.variant);
+        written.extend(both(out, &name, &|p| box_figure(p, &title, &per_depth))?);
+    }
+    Ok(written)
+}
+
+fn box_figure(
+    out: &Path,
+    title: &str,
+    per_depth: &BTreeMap<usize, (Vec<f64>, Vec<f64>)>,
+) -> Result<()> {
+    render_to!(out, (1000, 450), |area: &DrawingArea<_, Shift>| {
+        let panels = area.split_evenly((1, 2));
+        let depths: Vec<u32> = per_depth.keys().map(|&d| d as u32).collect();
+        let (lo, hi) = (depths[0], depths[depths.len() - 1]);
+        for (panel, (label, pick)) in panels.iter().zip([
+            ("solution length (manipulator steps)", 0usize),
+            ("skill length (manipulator steps)", 1),
+        ]) {
+            let values =
+                |v: &(Vec<f64>, Vec<f64>)| if pick == 0 { v.0.clone() } else { v.1.clone() };
+            // Room for the whiskers (Tukey's 1.5 × IQR fences, as plotters draws them).
+            let y_max = per_depth
+                .values()
+                .map(|v| {
+                    let v = values(v);
+                    let fence = Quartiles::new(&v).values()[4];
+                    v.iter().fold(fence, |m, &x| m.max(x as f32))
+                })
+                .fold(1.0, f32::max)
+                * 1.1;
+            let mut chart = ChartBuilder::on(panel)
+                .caption(format!("{label}: {title}"), ("sans-serif", 15))
+                .margin(10)
+                .x_label_area_size(40)
+                .y_label_area_size(50)
+                .build_cartesian_2d((lo..hi).into_segmented(), 0f32..y_max)
+                .map_err(plot_err)?;
+            chart
+                .configure_mesh()
+                .x_desc("solution depth")
+                .y_desc("steps")
+                .draw()
+                .map_err(plot_err)?;
+            chart
+                .draw_series(per_depth.iter().map(|(d, v)| {
+                    let q = Quartiles::new(&values(v));
+                    Boxplot::new_vertical(SegmentValue::CenterOf(*d as u32), &q)
+                        .width(30)
+                        .style(BLUE)
+                }))
+                .map_err(plot_err)?;
+        }
+        anyhow::Ok(())
+    })
+}
+
+fn envs<'a>(groups: &'a [Group<'_>]) -> Vec<&'a str> {
+    let mut envs: Vec<&str> = Vec::new();
+    for g in groups {
+        if !envs.contains(&g.env.as_str()) {
+            envs.push(&g.env);
+        }
+    }
+    envs
+}

@@ -1,0 +1,115 @@
+//! `seads report`: tables, tests and figures over any set of sweeps and runs — the paper's
+//! Table 1 with its Mann–Whitney tests, task success and lengths, coverage and success curves
+//! and length box plots — written to `report.md`, CSV files and PNG + SVG figures.
+
+mod figures;
+mod runs;
+mod stats;
+mod tables;
+
+use std::fmt::Write as _;
+use std::path::PathBuf;
+
+use anyhow::{Context, Result, anyhow};
+use clap::Args;
+
+use crate::BadInput;
+
+/// Arguments of `seads report`.
+#[derive(Debug, Args)]
+pub struct ReportArgs {
+    /// Sweep directories (from `seads sweep plan`) and run directories, in any mix. A run outside
+    /// a sweep is its own variant, named by its directory.
+    #[arg(required = true)]
+    inputs: Vec<PathBuf>,
+    /// Folder for report.md, the CSV tables and the figures.
+    #[arg(long)]
+    out: PathBuf,
+    /// The variant the others are tested against (default: the first sweep's reference).
+    #[arg(long)]
+    reference: Option<String>,
+}
+
+/// Runs `seads report`.
+pub fn report(args: ReportArgs) -> Result<()> {
+    let collection = runs::collect(&args.inputs).map_err(BadInput)?;
+    let reference = args.reference.clone().or(collection.reference.clone());
+    let (groups, unfinished) = runs::group(&collection.runs).map_err(BadInput)?;
+    if let Some(r) = &reference
+        && args.reference.is_some()
+        && !collection.runs.iter().any(|run| run.variant == *r)
+    {
+        return Err(BadInput(anyhow!("--reference {r:?} is not a variant of these runs")).into());
+    }
+    std::fs::create_dir_all(&args.out)
+        .with_context(|| format!("creating {}", args.out.display()))?;
+    let write = |name: &str, text: &str| -> Result<()> {
+        seads_rl::write_atomic(&args.out.join(name), text.as_bytes())?;
+        Ok(())
+    };
+    let cells = tables::coverage_cells(&groups, reference.as_deref());
+    write("table1.csv", &tables::coverage_csv(&cells))?;
+    let (success_md, success_csv) = tables::success_tables(&groups);
+    write("success.csv", &success_csv)?;
+    let (length_md, length_csv) = tables::length_tables(&groups);
+    write("lengths.csv", &length_csv)?;
+    let k_of = |g: &runs::Group<'_>| tables::skills(g.runs[0]);
+    let mut figures = figures::coverage_figures(&args.out, &groups, &k_of)?;
+    figures.extend(figures::success_figures(&args.out, &groups)?);
+    figures.extend(figures::length_figures(&args.out, &groups)?);
+
+    let mut md = String::new();
+    let title = if collection.sweeps.is_empty() {
+        "runs".to_owned()
+    } else {
+        collection.sweeps.join(", ")
+    };
+    let _ = writeln!(md, "# Report: {title}\n");
+    let _ = writeln!(
+        md,
+        "Written by `seads report` from {} run(s): {} finished, {} unfinished (left out of every table and figure).\n",
+        collection.runs.len(),
+        collection.runs.len() - unfinished.len(),
+        unfinished.len()
+    );
+    for run in &unfinished {
+        let steps = run.metrics.last().map_or(0, |m| m.env_steps);
+        let _ = writeln!(
+            md,
+            "- unfinished: `{}` ({steps} of {} steps)",
+            run.dir.display(),
+            run.config.env_steps
+        );
+    }
+    if !unfinished.is_empty() {
+        md.push('\n');
+    }
+    let _ = writeln!(md, "## Skill coverage at the end of training (Table 1)\n");
+    md += &tables::coverage_markdown(&cells, reference.as_deref());
+    let _ = writeln!(md, "\nAs CSV: `table1.csv`.\n");
+    let _ = writeln!(md, "## Task success at the end of training\n");
+    md += &success_md;
+    let _ = writeln!(md, "\nAs CSV: `success.csv`.\n");
+    let _ = writeln!(md, "## Skill and solution length\n");
+    md += &length_md;
+    let _ = writeln!(md, "\nAs CSV: `lengths.csv`.\n");
+    let _ = writeln!(md, "## Figures\n");
+    for f in figures
+        .iter()
+        .filter(|f| f.extension().is_some_and(|e| e == "png"))
+    {
+        let name = f
+            .file_name()
+            .map_or(String::new(), |n| n.to_string_lossy().into_owned());
+        let _ = writeln!(md, "![{name}]({name})\n");
+    }
+    write("report.md", &md)?;
+    println!(
+        "report of {} finished run(s) in {} groups: {} (and {} figure files)",
+        collection.runs.len() - unfinished.len(),
+        groups.len(),
+        args.out.join("report.md").display(),
+        figures.len()
+    );
+    Ok(())
+}

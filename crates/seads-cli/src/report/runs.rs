@@ -1,0 +1,170 @@
+//! The runs a report reads: sweeps (their index names each run's variant) and single run
+//! directories, grouped by environment and variant.
+
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+
+use anyhow::{Context, Result, anyhow, bail};
+use seads_planner::DepthResult;
+use seads_rl::{Metrics, TrainConfig};
+
+use crate::overtraining::CheckpointEvaluation;
+use crate::sweep::Sweep;
+
+/// One run, as read from its directory.
+pub struct RunData {
+    /// Run directory.
+    pub dir: PathBuf,
+    /// Variant (from the sweep; a single run is named by its directory).
+    pub variant: String,
+    /// Configuration.
+    pub config: TrainConfig,
+    /// Skill-coverage evaluations.
+    pub metrics: Vec<Metrics>,
+    /// Final task evaluation with re-planning, if any.
+    pub replan: Option<Vec<DepthResult>>,
+    /// Final task evaluation without re-planning, if any.
+    pub plan_once: Option<Vec<DepthResult>>,
+    /// Task success over training, if evaluated.
+    pub over_training: Vec<CheckpointEvaluation>,
+}
+
+impl RunData {
+    /// Whether training spent its budget.
+    pub fn finished(&self) -> bool {
+        self.metrics
+            .last()
+            .is_some_and(|m| m.env_steps >= self.config.env_steps)
+    }
+
+    /// Skill coverage at the end of training.
+    pub fn final_coverage(&self) -> Option<f64> {
+        self.metrics.last().map(|m| m.skill_coverage)
+    }
+
+    fn load(dir: &Path, variant: String) -> Result<Self> {
+        let config = seads_rl::load_config(dir)?;
+        let metrics = seads_rl::read_metrics(dir).unwrap_or_default();
+        let evaluation = |name: &str| -> Result<Option<Vec<DepthResult>>> {
+            let path = dir.join(name);
+            match std::fs::read_to_string(&path) {
+                Ok(text) => Ok(Some(
+                    serde_json::from_str(&text)
+                        .with_context(|| format!("reading {}", path.display()))?,
+                )),
+                Err(_) => Ok(None),
+            }
+        };
+        Ok(Self {
+            dir: dir.to_path_buf(),
+            variant,
+            replan: evaluation("evaluation-replan.json")?,
+            plan_once: evaluation("evaluation-plan-once.json")?,
+            over_training: crate::overtraining::read(dir)?,
+            config,
+            metrics,
+        })
+    }
+}
+
+/// What the report reads.
+pub struct Collection {
+    /// Every run found.
+    pub runs: Vec<RunData>,
+    /// The reference variant (the sweeps' or the user's choice).
+    pub reference: Option<String>,
+    /// Names of the sweeps read.
+    pub sweeps: Vec<String>,
+}
+
+/// Reads the sweeps and runs in `inputs`.
+pub fn collect(inputs: &[PathBuf]) -> Result<Collection> {
+    let mut collection = Collection {
+        runs: Vec::new(),
+        reference: None,
+        sweeps: Vec::new(),
+    };
+    for input in inputs {
+        if input.join(crate::sweep::INDEX).is_file() {
+            let sweep = Sweep::load(input)?;
+            for run in &sweep.runs {
+                collection
+                    .runs
+                    .push(RunData::load(&input.join(&run.dir), run.variant.clone())?);
+            }
+            collection.reference.get_or_insert(sweep.reference.clone());
+            collection.sweeps.push(sweep.name);
+        } else if input.join("config.toml").is_file() {
+            let name = input.file_name().map_or_else(
+                || input.display().to_string(),
+                |n| n.to_string_lossy().into_owned(),
+            );
+            collection.runs.push(RunData::load(input, name)?);
+        } else if input.is_dir() {
+            bail!(
+                "{} is neither a sweep (sweep.json) nor a run directory (config.toml)",
+                input.display()
+            );
+        } else {
+            bail!("{} does not exist", input.display());
+        }
+    }
+    if collection.runs.is_empty() {
+        bail!("no runs to report on");
+    }
+    Ok(collection)
+}
+
+/// The runs of one environment and variant: a row of the tables.
+pub struct Group<'a> {
+    /// Environment.
+    pub env: String,
+    /// Variant.
+    pub variant: String,
+    /// Finished runs.
+    pub runs: Vec<&'a RunData>,
+}
+
+/// Finished runs grouped by environment, then variant (in the order first seen); the runs of a
+/// group must share the environment's options (board size, spacing, depths), since a row of
+/// the table is one environment. Unfinished runs are returned apart.
+pub fn group(runs: &[RunData]) -> Result<(Vec<Group<'_>>, Vec<&RunData>)> {
+    let mut groups: Vec<Group<'_>> = Vec::new();
+    let mut unfinished = Vec::new();
+    let mut env_configs: BTreeMap<(String, String), (String, PathBuf)> = BTreeMap::new();
+    for run in runs {
+        if !run.finished() {
+            unfinished.push(run);
+            continue;
+        }
+        let key = (run.config.env.clone(), run.variant.clone());
+        let options = toml::to_string(&run.config.env_config)?;
+        match env_configs.get(&key) {
+            Some((other, first)) if *other != options => {
+                return Err(anyhow!(
+                    "variant {:?} mixes different {} environments in one table row: {} and {} differ in their env_config",
+                    run.variant,
+                    run.config.env,
+                    first.display(),
+                    run.dir.display()
+                ));
+            }
+            Some(_) => {}
+            None => {
+                env_configs.insert(key.clone(), (options, run.dir.clone()));
+            }
+        }
+        match groups
+            .iter_mut()
+            .find(|g| g.env == key.0 && g.variant == key.1)
+        {
+            Some(g) => g.runs.push(run),
+            None => groups.push(Group {
+                env: key.0,
+                variant: key.1,
+                runs: vec![run],
+            }),
+        }
+    }
+    Ok((groups, unfinished))
+}

@@ -1,0 +1,277 @@
+//! The report's tables, as Markdown for `report.md` and as CSV: final skill coverage with the
+//! Mann–Whitney test against the reference (Table 1), final task success per depth, and the
+//! median skill and solution lengths.
+
+use std::fmt::Write as _;
+
+use seads_planner::DepthResult;
+
+use super::runs::{Group, RunData};
+use super::stats::{Summary, Test, median, summary, worse_than};
+
+/// One cell of Table 1.
+pub struct CoverageCell {
+    /// Environment.
+    pub env: String,
+    /// Variant.
+    pub variant: String,
+    /// Final coverage over the runs.
+    pub summary: Summary,
+    /// Skills K of the runs.
+    pub skills: usize,
+    /// The test against the reference (none for the reference itself).
+    pub test: Option<Test>,
+}
+
+/// Skills of a run: the configured K, or the game's moves.
+pub fn skills(run: &RunData) -> usize {
+    run.config.num_skills.unwrap_or_else(|| {
+        seads_embodiment::make_env(&run.config.env, &run.config.env_config)
+            .map_or(0, |e| e.spec().num_skills)
+    })
+}
+
+/// The cells of Table 1, in group order.
+pub fn coverage_cells(groups: &[Group<'_>], reference: Option<&str>) -> Vec<CoverageCell> {
+    let finals =
+        |g: &Group<'_>| -> Vec<f64> { g.runs.iter().filter_map(|r| r.final_coverage()).collect() };
+    groups
+        .iter()
+        .filter_map(|g| {
+            let values = finals(g);
+            let summary = summary(&values)?;
+            let test = reference
+                .filter(|r| *r != g.variant)
+                .and_then(|r| groups.iter().find(|o| o.env == g.env && o.variant == r))
+                .and_then(|o| worse_than(&values, &finals(o)));
+            Some(CoverageCell {
+                env: g.env.clone(),
+                variant: g.variant.clone(),
+                summary,
+                skills: skills(g.runs[0]),
+                test,
+            })
+        })
+        .collect()
+}
+
+/// In order of first appearance.
+fn ordered<'a>(items: impl Iterator<Item = &'a str>) -> Vec<&'a str> {
+    let mut out: Vec<&str> = Vec::new();
+    for item in items {
+        if !out.contains(&item) {
+            out.push(item);
+        }
+    }
+    out
+}
+
+/// Table 1 in Markdown: a row per variant, a column per environment.
+pub fn coverage_markdown(cells: &[CoverageCell], reference: Option<&str>) -> String {
+    let envs = ordered(cells.iter().map(|c| c.env.as_str()));
+    let variants = ordered(cells.iter().map(|c| c.variant.as_str()));
+    let mut md = String::from("| variant |");
+    for env in &envs {
+        let k = cells.iter().find(|c| c.env == *env).map_or(0, |c| c.skills);
+        let _ = write!(md, " {env} (of {k}) |");
+    }
+    md += "\n|---|";
+    md += &"---|".repeat(envs.len());
+    md.push('\n');
+    for variant in &variants {
+        let _ = write!(md, "| {variant} |");
+        for env in &envs {
+            match cells
+                .iter()
+                .find(|c| c.env == *env && c.variant == *variant)
+            {
+                None => md += " – |",
+                Some(c) => {
+                    let value = format!("{:.2} ± {:.2}", c.summary.mean, c.summary.std);
+                    let value = if c.test.is_some_and(|t| t.significant()) {
+                        format!("**{value}**")
+                    } else {
+                        value
+                    };
+                    let test = c
+                        .test
+                        .map_or(String::new(), |t| format!("; U = {}, p = {:.4}", t.u, t.p));
+                    let _ = write!(md, " {value} (n = {}{test}) |", c.summary.n);
+                }
+            }
+        }
+        md.push('\n');
+    }
+    let _ = write!(
+        md,
+        "\nMean ± sample standard deviation of the skill coverage at the end of training (distinct game \
+         moves of the K skills, mean over 20 test initialisations). U and p: one-sided Mann–Whitney U \
+         test that the variant is worse than `{}` (SciPy's `mannwhitneyu(variant, reference, \
+         alternative=\"less\")`: exact without ties for up to 8 values, tie-corrected normal otherwise); \
+         **bold**: p < 0.01.\n",
+        reference.unwrap_or("-")
+    );
+    md
+}
+
+/// Table 1 as CSV.
+pub fn coverage_csv(cells: &[CoverageCell]) -> String {
+    let mut csv = String::from("env,variant,skills,n,mean,std,min,max,u,p,significantly_worse\n");
+    for c in cells {
+        let s = &c.summary;
+        let (u, p, sig) = c
+            .test
+            .map_or((String::new(), String::new(), String::new()), |t| {
+                (
+                    t.u.to_string(),
+                    format!("{:.6}", t.p),
+                    t.significant().to_string(),
+                )
+            });
+        let _ = writeln!(
+            csv,
+            "{},{},{},{},{:.4},{:.4},{:.4},{:.4},{u},{p},{sig}",
+            c.env, c.variant, c.skills, s.n, s.mean, s.std, s.min, s.max
+        );
+    }
+    csv
+}
+
+/// The final evaluation of a run in one mode.
+fn evaluation(run: &RunData, replan: bool) -> Option<&Vec<DepthResult>> {
+    if replan {
+        run.replan.as_ref()
+    } else {
+        run.plan_once.as_ref()
+    }
+}
+
+/// Depths evaluated in a group.
+fn depths(groups: &[Group<'_>]) -> Vec<usize> {
+    let mut depths: Vec<usize> = groups
+        .iter()
+        .flat_map(|g| g.runs.iter())
+        .flat_map(|r| r.replan.iter().chain(r.plan_once.iter()))
+        .flat_map(|e| e.iter().map(|d| d.depth))
+        .collect();
+    depths.sort_unstable();
+    depths.dedup();
+    depths
+}
+
+/// Final task success per depth (mean over runs of each run's success rate), Markdown and CSV.
+pub fn success_tables(groups: &[Group<'_>]) -> (String, String) {
+    let depths = depths(groups);
+    let mut md = String::from("| environment | variant | mode | runs |");
+    for d in &depths {
+        let _ = write!(md, " depth {d} |");
+    }
+    md += "\n|---|---|---|---|";
+    md += &"---|".repeat(depths.len());
+    md.push('\n');
+    let mut csv = String::from("env,variant,mode,runs,depth,mean_success,std_success\n");
+    for g in groups {
+        for replan in [true, false] {
+            let evaluated: Vec<&Vec<DepthResult>> = g
+                .runs
+                .iter()
+                .filter_map(|r| evaluation(r, replan))
+                .collect();
+            if evaluated.is_empty() {
+                continue;
+            }
+            let mode = if replan { "re-planning" } else { "plan once" };
+            let _ = write!(
+                md,
+                "| {} | {} | {mode} | {} |",
+                g.env,
+                g.variant,
+                evaluated.len()
+            );
+            for d in &depths {
+                let rates: Vec<f64> = evaluated
+                    .iter()
+                    .filter_map(|e| e.iter().find(|r| r.depth == *d))
+                    .map(|r| r.solved as f64 / r.tasks.max(1) as f64)
+                    .collect();
+                match summary(&rates) {
+                    Some(s) => {
+                        let _ = write!(md, " {:.1} % |", 100.0 * s.mean);
+                        let _ = writeln!(
+                            csv,
+                            "{},{},{mode},{},{d},{:.4},{:.4}",
+                            g.env, g.variant, s.n, s.mean, s.std
+                        );
+                    }
+                    None => md += " – |",
+                }
+            }
+            md.push('\n');
+        }
+    }
+    md += "\nShare of test boards solved at the end of training, per solution depth, mean over the runs \
+           (20 boards per depth and run unless the sweep says otherwise).\n";
+    (md, csv)
+}
+
+/// Median skill length and median solution length (manipulator steps, solved tasks, with
+/// re-planning), pooled over the runs of a group; Markdown and CSV.
+pub fn length_tables(groups: &[Group<'_>]) -> (String, String) {
+    let depths = depths(groups);
+    let mut md = String::from("| environment | variant | median skill length |");
+    for d in &depths {
+        let _ = write!(md, " solution, depth {d} |");
+    }
+    md += "\n|---|---|---|";
+    md += &"---|".repeat(depths.len());
+    md.push('\n');
+    let mut csv =
+        String::from("env,variant,depth,solved,median_skill_steps,median_solution_steps\n");
+    let fmt = |v: Option<f64>| v.map_or("–".to_owned(), |x| format!("{x:.1}"));
+    for g in groups {
+        let evaluated: Vec<&Vec<DepthResult>> =
+            g.runs.iter().filter_map(|r| r.replan.as_ref()).collect();
+        if evaluated.is_empty() {
+            continue;
+        }
+        let all_skills: Vec<f64> = evaluated
+            .iter()
+            .flat_map(|e| {
+                e.iter()
+                    .flat_map(|r| r.skill_steps.iter().map(|&s| s as f64))
+            })
+            .collect();
+        let _ = write!(
+            md,
+            "| {} | {} | {} |",
+            g.env,
+            g.variant,
+            fmt(median(&all_skills))
+        );
+        for d in &depths {
+            let at = |f: &dyn Fn(&DepthResult) -> Vec<f64>| -> Vec<f64> {
+                evaluated
+                    .iter()
+                    .filter_map(|e| e.iter().find(|r| r.depth == *d))
+                    .flat_map(f)
+                    .collect()
+            };
+            let solutions = at(&|r| r.solution_steps.iter().map(|&s| s as f64).collect());
+            let skills = at(&|r| r.skill_steps.iter().map(|&s| s as f64).collect());
+            let _ = write!(md, " {} |", fmt(median(&solutions)));
+            let _ = writeln!(
+                csv,
+                "{},{},{d},{},{},{}",
+                g.env,
+                g.variant,
+                solutions.len(),
+                median(&skills).map_or(String::new(), |v| v.to_string()),
+                median(&solutions).map_or(String::new(), |v| v.to_string())
+            );
+        }
+        md.push('\n');
+    }
+    md += "\nMedians in manipulator steps over the solved tasks of all runs, with re-planning (the seed's \
+           Figs. S.5, S.6 show their distributions; see the box plots).\n";
+    (md, csv)
+}

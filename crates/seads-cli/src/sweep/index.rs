@@ -1,0 +1,153 @@
+//! A planned sweep on disk: `sweep.json` (the index of its runs), `manifest.toml` (the manifest
+//! it was planned from) and one run directory per run holding its full `config.toml`.
+
+use std::path::{Path, PathBuf};
+
+use anyhow::{Context, Result, anyhow, bail};
+use serde::{Deserialize, Serialize};
+
+use super::manifest::{EvaluationPlan, Manifest};
+
+/// The index file of a sweep directory.
+pub const INDEX: &str = "sweep.json";
+/// The manifest a sweep was planned from, as given.
+pub const MANIFEST: &str = "manifest.toml";
+
+/// The index of a sweep.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Sweep {
+    /// Study name.
+    pub name: String,
+    /// What the study shows.
+    pub description: String,
+    /// The variant the others are tested against.
+    pub reference: String,
+    /// Evaluation after training.
+    pub evaluation: EvaluationPlan,
+    /// The runs, in order; a run's position is its index (the Slurm array task id).
+    pub runs: Vec<SweepRun>,
+}
+
+/// One run of the index.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SweepRun {
+    /// Environment.
+    pub env: String,
+    /// Variant.
+    pub variant: String,
+    /// Seed.
+    pub seed: u64,
+    /// Run directory relative to the sweep directory.
+    pub dir: String,
+}
+
+/// What planning did.
+#[derive(Debug, Default)]
+pub struct Planned {
+    /// Number of runs of the sweep.
+    pub runs: usize,
+    /// Run directories created by this call.
+    pub created: usize,
+}
+
+impl Sweep {
+    /// Loads the sweep in `dir`; a missing folder or one that is not a sweep is a clear error.
+    pub fn load(dir: &Path) -> Result<Self> {
+        if !dir.is_dir() {
+            bail!("sweep directory {} does not exist", dir.display());
+        }
+        let path = dir.join(INDEX);
+        if !path.is_file() {
+            bail!(
+                "{} is not a sweep directory (no {INDEX}; make one with `seads sweep plan`)",
+                dir.display()
+            );
+        }
+        let text = std::fs::read_to_string(&path)
+            .with_context(|| format!("reading {}", path.display()))?;
+        serde_json::from_str(&text)
+            .map_err(|e| anyhow!("{}: not a sweep index: {e}", path.display()))
+    }
+
+    /// The absolute-or-relative path of run `index`.
+    pub fn run_dir(&self, dir: &Path, index: usize) -> Result<PathBuf> {
+        let run = self.runs.get(index).ok_or_else(|| {
+            anyhow!(
+                "run index {index} is out of range: the sweep has {} runs (0 to {})",
+                self.runs.len(),
+                self.runs.len().saturating_sub(1)
+            )
+        })?;
+        Ok(dir.join(&run.dir))
+    }
+
+    /// Writes the sweep of `manifest` into `out`. Planning the same manifest again writes
+    /// nothing (only run directories that were deleted are made again); a different manifest
+    /// in the same folder is an error, and nothing is written. Validation errors come back as
+    /// `Err` before any write.
+    pub fn plan(manifest: &Manifest, text: &str, out: &Path) -> Result<Planned> {
+        let runs = manifest.expand()?;
+        let sweep = Sweep {
+            name: manifest.name.clone(),
+            description: manifest.description.clone(),
+            reference: manifest.reference().to_owned(),
+            evaluation: manifest.evaluation.clone(),
+            runs: runs
+                .iter()
+                .map(|r| SweepRun {
+                    env: r.env.clone(),
+                    variant: r.variant.clone(),
+                    seed: r.seed,
+                    dir: r.rel_dir(),
+                })
+                .collect(),
+        };
+        let index_text = serde_json::to_string_pretty(&sweep)? + "\n";
+        if out.join(INDEX).exists() {
+            let existing = Sweep::load(out)?;
+            if existing != sweep {
+                bail!(
+                    "{} already holds a different sweep ({:?}); plan into another directory",
+                    out.display(),
+                    existing.name
+                );
+            }
+        } else if out.exists() && std::fs::read_dir(out)?.next().is_some() {
+            bail!(
+                "{} exists and is not empty; plan a sweep into a new directory",
+                out.display()
+            );
+        }
+        // Every existing run's config must be the planned one before anything is written.
+        let mut missing = Vec::new();
+        for run in &runs {
+            let config = out.join(run.rel_dir()).join("config.toml");
+            let planned = run.config.to_toml();
+            match std::fs::read_to_string(&config) {
+                Ok(text) if text == planned => {}
+                Ok(_) => bail!(
+                    "{} differs from the manifest's configuration; it was changed after planning",
+                    config.display()
+                ),
+                Err(_) => missing.push((run, planned)),
+            }
+        }
+        let created = missing.len();
+        for (run, planned) in missing {
+            let dir = out.join(run.rel_dir());
+            std::fs::create_dir_all(&dir).with_context(|| format!("creating {}", dir.display()))?;
+            seads_rl::write_atomic(&dir.join("config.toml"), planned.as_bytes())?;
+        }
+        if !out.join(INDEX).exists() {
+            seads_rl::write_atomic(&out.join(MANIFEST), text.as_bytes())?;
+            // The index last: a folder with an index is a complete plan.
+            seads_rl::write_atomic(&out.join(INDEX), index_text.as_bytes())?;
+        }
+        Ok(Planned {
+            runs: runs.len(),
+            created,
+        })
+    }
+}

@@ -1,0 +1,374 @@
+//! Study manifests: environments × variants × seeds, where a variant is a name plus overrides of
+//! the preset in the keys of `configs/*.toml`. A manifest expands into one full [`TrainConfig`]
+//! per run; every way it can be wrong is a one-line error found before anything is written.
+
+use std::collections::BTreeMap;
+
+use anyhow::{Result, anyhow, bail};
+use seads_embodiment::env_names;
+use seads_rl::TrainConfig;
+use serde::{Deserialize, Serialize};
+
+/// A study, as written in `experiments/*.toml`.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Manifest {
+    /// Name of the study (a folder name in `docs/results/`).
+    pub name: String,
+    /// What the study shows, for the report.
+    #[serde(default)]
+    pub description: String,
+    /// Environments (see `seads envs`); each run starts from the environment's preset.
+    pub environments: Vec<String>,
+    /// Seeds; every variant is trained with each.
+    pub seeds: Vec<u64>,
+    /// The variant the others are tested against in the report (default: the first).
+    #[serde(default)]
+    pub reference: Option<String>,
+    /// Overrides of every run, applied before the variant's (e.g. a shorter budget).
+    #[serde(default)]
+    pub overrides: toml::Table,
+    /// What `seads sweep run` evaluates after training.
+    #[serde(default)]
+    pub evaluation: EvaluationPlan,
+    /// The variants.
+    #[serde(rename = "variant")]
+    pub variants: Vec<Variant>,
+}
+
+/// One variant: a name and overrides of the preset.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Variant {
+    /// Name (a folder name: letters, digits, `-` and `_`).
+    pub name: String,
+    /// Overrides for every environment, in the keys of `configs/*.toml`.
+    #[serde(default)]
+    pub overrides: toml::Table,
+    /// Overrides for one environment, applied after `overrides` (e.g. K = 30 on LightsOut and
+    /// 15 on TileSwap for "more skills").
+    #[serde(default)]
+    pub env_overrides: BTreeMap<String, toml::Table>,
+}
+
+/// Task-success evaluation of each run after training (SPEC §4.4): test boards of depths 1–5.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct EvaluationPlan {
+    /// Evaluate the final agent with and without re-planning (`evaluation-*.json`).
+    pub last: bool,
+    /// Also evaluate every N-th kept checkpoint into `evaluation-over-training.jsonl` (0: none).
+    pub every: usize,
+    /// Boards per depth.
+    pub boards: usize,
+    /// Seconds per search (the authors used 60; an agent that lacks a skill searches until then).
+    pub timeout: f64,
+}
+
+impl Default for EvaluationPlan {
+    fn default() -> Self {
+        Self {
+            last: true,
+            every: 0,
+            boards: 20,
+            timeout: 10.0,
+        }
+    }
+}
+
+/// One run of a study.
+#[derive(Debug, Clone, PartialEq)]
+pub struct PlannedRun {
+    /// Environment.
+    pub env: String,
+    /// Variant name.
+    pub variant: String,
+    /// Seed.
+    pub seed: u64,
+    /// The full configuration.
+    pub config: TrainConfig,
+}
+
+impl PlannedRun {
+    /// The run's folder, relative to the sweep directory.
+    pub fn rel_dir(&self) -> String {
+        format!("runs/{}/{}/seed-{}", self.env, self.variant, self.seed)
+    }
+}
+
+/// Keys a variant may not set: the study's axes set them.
+const AXIS_KEYS: [&str; 2] = ["env", "seed"];
+
+impl Manifest {
+    /// Parses and validates a manifest; `origin` names it in errors.
+    pub fn parse(text: &str, origin: &str) -> Result<Self> {
+        let manifest: Self = toml::from_str(text)
+            .map_err(|e| anyhow!("{origin}: {}", e.message().trim().replace('\n', " ")))?;
+        manifest
+            .validate()
+            .map_err(|e| anyhow!("{origin}: {e:#}"))?;
+        Ok(manifest)
+    }
+
+    /// The variant the others are compared with.
+    pub fn reference(&self) -> &str {
+        self.reference
+            .as_deref()
+            .or(self.variants.first().map(|v| v.name.as_str()))
+            .unwrap_or("")
+    }
+
+    fn validate(&self) -> Result<()> {
+        if !is_name(&self.name) {
+            bail!(
+                "the study name {:?} must be letters, digits, '-' or '_'",
+                self.name
+            );
+        }
+        let known = env_names();
+        for env in &self.environments {
+            if !known.contains(&env.as_str()) {
+                bail!(
+                    "unknown environment {env:?}; valid environments: {}",
+                    known.join(", ")
+                );
+            }
+        }
+        let mut names = std::collections::BTreeSet::new();
+        for v in &self.variants {
+            if !is_name(&v.name) {
+                bail!(
+                    "variant name {:?} must be letters, digits, '-' or '_'",
+                    v.name
+                );
+            }
+            if !names.insert(v.name.as_str()) {
+                bail!("duplicate variant name {:?}", v.name);
+            }
+            for env in v.env_overrides.keys() {
+                if !self.environments.contains(env) {
+                    bail!(
+                        "variant {:?} overrides environment {env:?}, which the study does not train",
+                        v.name
+                    );
+                }
+            }
+        }
+        if let Some(reference) = &self.reference
+            && !names.contains(reference.as_str())
+        {
+            bail!("the reference variant {reference:?} is not a variant of the study");
+        }
+        let mut seeds = self.seeds.clone();
+        seeds.sort_unstable();
+        seeds.dedup();
+        if seeds.len() != self.seeds.len() {
+            bail!("a seed is listed twice");
+        }
+        if self.environments.is_empty() || self.seeds.is_empty() || self.variants.is_empty() {
+            bail!(
+                "the manifest expands to no run: it needs at least one environment, one seed and one variant"
+            );
+        }
+        let e = &self.evaluation;
+        if e.boards == 0 || !(e.timeout.is_finite() && e.timeout > 0.0) {
+            bail!("evaluation.boards must be at least 1 and evaluation.timeout above 0");
+        }
+        // Expanding checks every override against the configuration's keys and values.
+        self.expand()?;
+        Ok(())
+    }
+
+    /// Every run: environments, then seeds, then variants, so that a sweep stopped part way
+    /// has the same number of seeds of every variant.
+    pub fn expand(&self) -> Result<Vec<PlannedRun>> {
+        let mut runs = Vec::new();
+        for env in &self.environments {
+            for &seed in &self.seeds {
+                for variant in &self.variants {
+                    let config = self.config(env, variant, seed)?;
+                    runs.push(PlannedRun {
+                        env: env.clone(),
+                        variant: variant.name.clone(),
+                        seed,
+                        config,
+                    });
+                }
+            }
+        }
+        Ok(runs)
+    }
+
+    /// The preset of `env` with the study's, the variant's and the environment's overrides.
+    fn config(&self, env: &str, variant: &Variant, seed: u64) -> Result<TrainConfig> {
+        let preset = TrainConfig::presets()
+            .iter()
+            .find(|(name, _)| *name == env)
+            .map(|(_, text)| *text)
+            .ok_or_else(|| anyhow!("environment {env:?} has no preset"))?;
+        let mut table: toml::Table = toml::from_str(preset)?;
+        let layers = [
+            ("overrides", &self.overrides),
+            ("variant overrides", &variant.overrides),
+        ];
+        let env_layer = variant.env_overrides.get(env);
+        for (what, layer) in layers
+            .into_iter()
+            .chain(env_layer.map(|l| ("environment overrides", l)))
+        {
+            for key in AXIS_KEYS {
+                if layer.contains_key(key) {
+                    bail!(
+                        "variant {:?}: {what} may not set `{key}` (the study's axes set it)",
+                        variant.name
+                    );
+                }
+            }
+            merge(&mut table, layer);
+        }
+        table.insert("seed".into(), toml::Value::Integer(seed as i64));
+        let config: TrainConfig =
+            toml::Value::Table(table)
+                .try_into()
+                .map_err(|e: toml::de::Error| {
+                    anyhow!(
+                        "variant {:?} on {env}: {}",
+                        variant.name,
+                        e.message().trim().replace('\n', " ")
+                    )
+                })?;
+        config
+            .validate()
+            .map_err(|e| anyhow!("variant {:?} on {env}: {e}", variant.name))?;
+        Ok(config)
+    }
+}
+
+/// Writes `layer` over `base`, table by table (a nested table is merged, any other value set).
+fn merge(base: &mut toml::Table, layer: &toml::Table) {
+    for (key, value) in layer {
+        match (base.get_mut(key), value) {
+            (Some(toml::Value::Table(b)), toml::Value::Table(l)) => merge(b, l),
+            _ => {
+                base.insert(key.clone(), value.clone());
+            }
+        }
+    }
+}
+
+fn is_name(name: &str) -> bool {
+    !name.is_empty()
+        && name
+            .chars()
+            .all(|c| c.is_ascii_alphanumeric() || c == '-' || c == '_')
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const SMALL: &str = r#"
+name = "small"
+environments = ["lightsout-cursor", "tileswap-cursor"]
+seeds = [1, 2]
+overrides = { env_steps = 1000 }
+
+[[variant]]
+name = "seads"
+
+[[variant]]
+name = "no-relabelling"
+overrides = { relabel = { skill_model_p = 0.0, sac_p = 0.0 } }
+
+[[variant]]
+name = "more-skills"
+env_overrides = { "lightsout-cursor" = { num_skills = 30 }, "tileswap-cursor" = { num_skills = 15 } }
+"#;
+
+    #[test]
+    fn a_manifest_expands_into_every_run_with_its_overrides() {
+        let m = Manifest::parse(SMALL, "small.toml").unwrap();
+        let runs = m.expand().unwrap();
+        assert_eq!(runs.len(), 2 * 2 * 3);
+        assert_eq!(m.reference(), "seads");
+        // Order: environment, seed, variant.
+        assert_eq!(
+            (runs[3].env.as_str(), runs[3].seed, runs[3].variant.as_str()),
+            ("lightsout-cursor", 2, "seads")
+        );
+        for run in &runs {
+            assert_eq!(run.config.env, run.env);
+            assert_eq!(run.config.seed, run.seed);
+            assert_eq!(run.config.env_steps, 1000);
+            let preset = TrainConfig::preset(&run.env).unwrap();
+            // Untouched keys keep the preset's values (a nested table is merged, not replaced).
+            assert_eq!(run.config.sac, preset.sac);
+            match run.variant.as_str() {
+                "no-relabelling" => {
+                    assert_eq!(run.config.relabel.sac_p, 0.0);
+                    assert_eq!(run.config.relabel.skill_model_p, 0.0);
+                    assert_eq!(run.config.relabel.kind, preset.relabel.kind);
+                }
+                "more-skills" => assert_eq!(
+                    run.config.num_skills,
+                    Some(if run.env == "lightsout-cursor" {
+                        30
+                    } else {
+                        15
+                    })
+                ),
+                _ => assert_eq!(run.config.relabel, preset.relabel),
+            }
+        }
+    }
+
+    #[test]
+    fn every_bad_manifest_is_one_line_naming_the_problem() {
+        let cases = [
+            (
+                SMALL.replace("env_steps = 1000", "env_stepz = 1000"),
+                "unknown field `env_stepz`",
+            ),
+            (
+                SMALL.replace("\"tileswap-cursor\"]", "\"tileswap-cursr\"]"),
+                "unknown environment \"tileswap-cursr\"",
+            ),
+            (
+                SMALL.replace("name = \"more-skills\"", "name = \"seads\""),
+                "duplicate variant name \"seads\"",
+            ),
+            (
+                SMALL.replace("seeds = [1, 2]", "seeds = []"),
+                "expands to no run",
+            ),
+            (
+                SMALL.replace("sac_p = 0.0 }", "sac_p = 2.0 }"),
+                "relabel.sac_p must lie in [0, 1]",
+            ),
+            (
+                SMALL.replace("env_steps = 1000", "seed = 3"),
+                "may not set `seed`",
+            ),
+            (
+                SMALL.replace("seeds = [1, 2]", "seeds = [1, 1]"),
+                "listed twice",
+            ),
+            (
+                SMALL.replace("name = \"small\"", "name = \"small\"\nreference = \"sead\""),
+                "reference variant \"sead\"",
+            ),
+            (
+                SMALL.replace(
+                    "{ num_skills = 15 }",
+                    "{ num_skills = 15 }, \"lightsout-reacher\" = {}",
+                ),
+                "does not train",
+            ),
+        ];
+        for (text, expected) in cases {
+            let e = Manifest::parse(&text, "m.toml").unwrap_err().to_string();
+            assert!(e.contains(expected), "{e:?} should say {expected:?}");
+            assert!(!e.contains('\n'), "{e:?} is one line");
+        }
+    }
+}

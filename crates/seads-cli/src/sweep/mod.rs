@@ -1,0 +1,325 @@
+//! `seads sweep`: studies over many seeds and variants — plan them from a manifest, run them on
+//! this machine or as a Slurm job array, and see where each run stands.
+
+mod index;
+mod manifest;
+mod pool;
+mod slurm;
+mod state;
+mod task;
+
+use std::path::PathBuf;
+
+use anyhow::{Context, Result, anyhow};
+use clap::{Args, Subcommand};
+use serde::Serialize;
+
+pub use index::{INDEX, Sweep};
+pub use manifest::Manifest;
+pub use state::Status;
+
+use crate::BadInput;
+
+/// `seads sweep …`.
+#[derive(Debug, Subcommand)]
+pub enum SweepCommand {
+    /// Expand a study manifest (experiments/*.toml) into one run directory per environment ×
+    /// variant × seed, each with its full config.toml, plus the sweep's index. Planning the same
+    /// manifest again changes nothing.
+    Plan(PlanArgs),
+    /// Train and evaluate every run of a sweep that is not done, on this machine: new runs
+    /// start, killed ones resume, failed ones are tried again. Stop it at any time; running it
+    /// again loses nothing.
+    Run(RunArgs),
+    /// Train and evaluate one run of a sweep (what each Slurm array task runs); resumes a run
+    /// that a killed or re-queued task left.
+    Task(TaskArgs),
+    /// Write an sbatch script for a Slurm job array (one task per run) and a dependent job that
+    /// writes the report; with --submit, submit both.
+    Slurm(SlurmArgs),
+    /// Done / running / failed / pending per run and in total, read from the run directories.
+    Status(StatusArgs),
+}
+
+/// Arguments of `seads sweep plan`.
+#[derive(Debug, Args)]
+pub struct PlanArgs {
+    /// The study manifest (see experiments/).
+    manifest: PathBuf,
+    /// The sweep directory to create.
+    #[arg(long)]
+    out: PathBuf,
+}
+
+fn cores() -> usize {
+    std::thread::available_parallelism().map_or(1, |n| n.get())
+}
+
+/// Arguments of `seads sweep run`.
+#[derive(Debug, Args)]
+pub struct RunArgs {
+    /// The sweep directory (from `seads sweep plan`).
+    dir: PathBuf,
+    /// Runs trained at once. Each gets an equal share of the cores (a run trains on two threads,
+    /// so the default gives each two cores; --workers 2 on two cores gives each one).
+    #[arg(long, value_parser = clap::value_parser!(u64).range(1..))]
+    workers: Option<u64>,
+    /// Cores to share among the workers (default: all of this machine's).
+    #[arg(long, value_parser = clap::value_parser!(u64).range(1..))]
+    cores: Option<u64>,
+    /// No progress bar.
+    #[arg(long)]
+    quiet: bool,
+}
+
+/// Arguments of `seads sweep task`.
+#[derive(Debug, Args)]
+pub struct TaskArgs {
+    /// The sweep directory.
+    dir: PathBuf,
+    /// Index of the run in the sweep (0-based; a Slurm array task passes $SLURM_ARRAY_TASK_ID).
+    #[arg(long)]
+    index: usize,
+    /// Cores of this task; its libtorch threads follow them (Slurm: $SLURM_CPUS_PER_TASK).
+    #[arg(long, default_value_t = 2, value_parser = clap::value_parser!(u64).range(1..))]
+    cores: u64,
+    /// Started by `seads sweep run`: die with the parent.
+    #[arg(long, hide = true)]
+    child: bool,
+}
+
+/// Arguments of `seads sweep slurm`.
+#[derive(Debug, Args)]
+pub struct SlurmArgs {
+    /// The sweep directory.
+    dir: PathBuf,
+    /// Slurm partition of the jobs.
+    #[arg(long)]
+    partition: Option<String>,
+    /// Time limit per task, in Slurm's format (a task that hits it is resumed when re-queued).
+    #[arg(long, default_value = "04:00:00")]
+    time: String,
+    /// Cores per task; the task's libtorch threads follow them.
+    #[arg(long, default_value_t = 2, value_parser = clap::value_parser!(u64).range(1..))]
+    cpus_per_task: u64,
+    /// At most this many tasks at once (the array's %M throttle).
+    #[arg(long, value_parser = clap::value_parser!(u64).range(1..))]
+    max_parallel: Option<u64>,
+    /// The seads binary the tasks run (default: this one; it must be reachable from the nodes).
+    #[arg(long)]
+    seads: Option<PathBuf>,
+    /// Submit the array and the report job with sbatch, and print their job ids.
+    #[arg(long)]
+    submit: bool,
+}
+
+/// Arguments of `seads sweep status`.
+#[derive(Debug, Args)]
+pub struct StatusArgs {
+    /// The sweep directory.
+    dir: PathBuf,
+    /// Print JSON.
+    #[arg(long)]
+    json: bool,
+}
+
+/// Runs `seads sweep …`.
+pub fn run(command: SweepCommand) -> Result<()> {
+    match command {
+        SweepCommand::Plan(args) => plan(args),
+        SweepCommand::Run(args) => {
+            let cores = args.cores.map_or_else(cores, |c| c as usize);
+            let workers = args.workers.map_or((cores / 2).max(1), |w| w as usize);
+            pool::run_sweep(&args.dir, workers, cores, args.quiet)
+        }
+        SweepCommand::Task(args) => {
+            if args.child {
+                die_with_parent();
+            }
+            task::run_task(&args.dir, args.index, args.cores as usize)
+        }
+        SweepCommand::Slurm(args) => slurm(args),
+        SweepCommand::Status(args) => status(args),
+    }
+}
+
+fn plan(args: PlanArgs) -> Result<()> {
+    let text = std::fs::read_to_string(&args.manifest)
+        .map_err(|e| BadInput(anyhow!("reading {}: {e}", args.manifest.display())))?;
+    let manifest =
+        Manifest::parse(&text, &args.manifest.display().to_string()).map_err(BadInput)?;
+    let planned = Sweep::plan(&manifest, &text, &args.out).map_err(BadInput)?;
+    if planned.created == 0 {
+        println!(
+            "sweep {:?} in {} is already planned ({} runs); nothing changed",
+            manifest.name,
+            args.out.display(),
+            planned.runs
+        );
+    } else {
+        println!(
+            "planned sweep {:?}: {} runs ({} new) in {}",
+            manifest.name,
+            planned.runs,
+            planned.created,
+            args.out.display()
+        );
+        println!(
+            "next: seads sweep run {}   or   seads sweep slurm {} --submit",
+            args.out.display(),
+            args.out.display()
+        );
+    }
+    Ok(())
+}
+
+fn slurm(args: SlurmArgs) -> Result<()> {
+    let dir = std::fs::canonicalize(&args.dir).map_err(|_| {
+        BadInput(anyhow!(
+            "sweep directory {} does not exist",
+            args.dir.display()
+        ))
+    })?;
+    let sweep = Sweep::load(&dir).map_err(BadInput)?;
+    let seads = match args.seads {
+        Some(path) => std::fs::canonicalize(&path)
+            .map_err(|_| BadInput(anyhow!("--seads {} does not exist", path.display())))?,
+        None => std::env::current_exe().context("locating the seads binary")?,
+    };
+    let options = slurm::SlurmOptions {
+        partition: args.partition,
+        time: args.time,
+        cpus_per_task: args.cpus_per_task as usize,
+        max_parallel: args.max_parallel.map(|m| m as usize),
+        seads,
+    };
+    let (array, report) = slurm::write_scripts(&dir, &sweep, &options)?;
+    println!("wrote {} and {}", array.display(), report.display());
+    if args.submit {
+        let (array_id, report_id) = slurm::submit(&array, &report)?;
+        println!(
+            "submitted job array {array_id} ({} tasks) and report job {report_id}",
+            sweep.runs.len()
+        );
+        println!("follow with: seads sweep status {}", dir.display());
+    } else {
+        println!(
+            "submit with: sbatch {}, then sbatch --dependency=afterany:<array id> {}",
+            array.display(),
+            report.display()
+        );
+    }
+    Ok(())
+}
+
+#[derive(Serialize)]
+struct RunStatus {
+    index: usize,
+    env: String,
+    variant: String,
+    seed: u64,
+    dir: String,
+    status: Status,
+    env_steps: u64,
+    budget: u64,
+    attempts: u32,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    error: Option<String>,
+}
+
+fn status(args: StatusArgs) -> Result<()> {
+    let sweep = Sweep::load(&args.dir).map_err(BadInput)?;
+    let mut rows = Vec::new();
+    for (index, run) in sweep.runs.iter().enumerate() {
+        let dir = args.dir.join(&run.dir);
+        let (status, record) = state::status(&dir)?;
+        let budget = seads_rl::load_config(&dir).map_or(0, |c| c.env_steps);
+        let env_steps = seads_rl::read_metrics(&dir)
+            .ok()
+            .and_then(|m| m.last().map(|m| m.env_steps))
+            .unwrap_or(0);
+        rows.push(RunStatus {
+            index,
+            env: run.env.clone(),
+            variant: run.variant.clone(),
+            seed: run.seed,
+            dir: dir.display().to_string(),
+            status,
+            env_steps,
+            budget,
+            attempts: record.as_ref().map_or(0, |r| r.attempts),
+            error: record.and_then(|r| r.error),
+        });
+    }
+    let count = |s: Status| rows.iter().filter(|r| r.status == s).count();
+    if args.json {
+        #[derive(Serialize)]
+        struct Report<'a> {
+            sweep: &'a str,
+            total: usize,
+            done: usize,
+            running: usize,
+            failed: usize,
+            pending: usize,
+            runs: &'a [RunStatus],
+        }
+        let report = Report {
+            sweep: &sweep.name,
+            total: rows.len(),
+            done: count(Status::Done),
+            running: count(Status::Running),
+            failed: count(Status::Failed),
+            pending: count(Status::Pending),
+            runs: &rows,
+        };
+        println!("{}", serde_json::to_string(&report)?);
+        return Ok(());
+    }
+    println!(
+        " index  status   env                variant                   seed      steps / budget  tries"
+    );
+    for r in &rows {
+        println!(
+            "{:>6}  {:<7}  {:<17}  {:<24}  {:>4}  {:>9} / {:<9} {:>3}{}",
+            r.index,
+            r.status.name(),
+            r.env,
+            r.variant,
+            r.seed,
+            r.env_steps,
+            r.budget,
+            r.attempts,
+            r.error.as_ref().map_or(String::new(), |e| format!(
+                "  error: {}",
+                e.lines().next().unwrap_or("")
+            )),
+        );
+    }
+    println!(
+        "sweep {:?}: {} runs: {} done, {} running, {} failed, {} pending",
+        sweep.name,
+        rows.len(),
+        count(Status::Done),
+        count(Status::Running),
+        count(Status::Failed),
+        count(Status::Pending)
+    );
+    Ok(())
+}
+
+/// A task started by `seads sweep run` is killed when that process dies, however it dies, so
+/// that a killed sweep leaves no orphan training on.
+fn die_with_parent() {
+    #[cfg(target_os = "linux")]
+    #[allow(unsafe_code)]
+    // SAFETY: prctl(PR_SET_PDEATHSIG) only sets a flag of this process; the arguments are valid
+    // constants. Called before any other thread is started.
+    unsafe {
+        libc::prctl(libc::PR_SET_PDEATHSIG, libc::SIGKILL);
+    }
+    // The parent may have died before the flag was set.
+    #[cfg(unix)]
+    if std::os::unix::process::parent_id() == 1 {
+        std::process::exit(1);
+    }
+}

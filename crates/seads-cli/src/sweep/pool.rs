@@ -1,0 +1,154 @@
+//! `seads sweep run`: every run of a sweep that is not done, on this machine, by a few workers.
+//! Each run is a child process (`seads sweep task`), because libtorch's thread count and
+//! kernels are per process; its output goes to the run's `task.log`. The children die with
+//! the parent, so killing `seads sweep run` and starting it again resumes every run.
+
+use std::path::Path;
+use std::process::{Command, Stdio};
+use std::sync::Mutex;
+use std::time::Duration;
+
+use anyhow::{Context, Result, bail};
+use indicatif::{ProgressBar, ProgressStyle};
+
+use super::index::Sweep;
+use super::state::{LOG, Status, status};
+
+/// What a worker reports for a run.
+struct Finished {
+    index: usize,
+    ok: bool,
+}
+
+/// The environment steps a run has trained so far (from its metrics; its budget when done).
+fn progress(run: &Path, done: bool) -> u64 {
+    let budget = seads_rl::load_config(run).map_or(0, |c| c.env_steps);
+    if done {
+        return budget;
+    }
+    seads_rl::read_metrics(run)
+        .ok()
+        .and_then(|m| m.last().map(|m| m.env_steps))
+        .unwrap_or(0)
+        .min(budget)
+}
+
+/// Runs the sweep in `dir` with `workers` parallel tasks sharing `cores` cores.
+pub fn run_sweep(dir: &Path, workers: usize, cores: usize, quiet: bool) -> Result<()> {
+    let sweep = Sweep::load(dir).map_err(crate::BadInput)?;
+    let mut todo = Vec::new();
+    let mut skipped_running = 0;
+    for i in 0..sweep.runs.len() {
+        let run = sweep.run_dir(dir, i)?;
+        match status(&run)?.0 {
+            Status::Done => {}
+            Status::Running => skipped_running += 1,
+            Status::Failed | Status::Pending => todo.push(i),
+        }
+    }
+    let per_task = (cores / workers).max(1);
+    println!(
+        "sweep {:?}: {} runs, {} to train or resume, {skipped_running} running elsewhere; {workers} worker(s) × {per_task} core(s)",
+        sweep.name,
+        sweep.runs.len(),
+        todo.len()
+    );
+    let total: u64 = (0..sweep.runs.len())
+        .map(|i| {
+            let run = dir.join(&sweep.runs[i].dir);
+            seads_rl::load_config(&run).map_or(0, |c| c.env_steps)
+        })
+        .sum();
+    let bar = if quiet {
+        ProgressBar::hidden()
+    } else {
+        ProgressBar::new(total)
+    };
+    bar.set_style(
+        ProgressStyle::with_template(
+            "{elapsed_precise} [{bar:30}] {percent}% of all steps, eta {eta} {msg}",
+        )
+        .expect("valid template")
+        .progress_chars("=> "),
+    );
+    let exe = std::env::current_exe().context("locating the seads binary")?;
+    let queue = Mutex::new(todo.into_iter());
+    let finished = Mutex::new(Vec::<Finished>::new());
+    let mut failures = Vec::new();
+    std::thread::scope(|scope| -> Result<()> {
+        let mut handles = Vec::new();
+        for _ in 0..workers {
+            handles.push(scope.spawn(|| -> Result<()> {
+                loop {
+                    let next = queue.lock().expect("queue lock").next();
+                    let Some(index) = next else { return Ok(()) };
+                    let run = dir.join(&sweep.runs[index].dir);
+                    let log = std::fs::OpenOptions::new()
+                        .create(true)
+                        .append(true)
+                        .open(run.join(LOG))
+                        .with_context(|| format!("opening {}", run.join(LOG).display()))?;
+                    let ok = Command::new(&exe)
+                        .args(["sweep", "task"])
+                        .arg(dir)
+                        .args(["--index", &index.to_string()])
+                        .args(["--cores", &per_task.to_string(), "--child"])
+                        .stdin(Stdio::null())
+                        .stdout(log.try_clone()?)
+                        .stderr(log)
+                        .status()
+                        .with_context(|| format!("starting the task of {}", run.display()))?
+                        .success();
+                    finished
+                        .lock()
+                        .expect("finished lock")
+                        .push(Finished { index, ok });
+                }
+            }));
+        }
+        // The bar follows the runs' own files until every worker has finished.
+        while handles.iter().any(|h| !h.is_finished()) {
+            let mut position = 0;
+            let mut counts = [0usize; 4];
+            for run in &sweep.runs {
+                let run = dir.join(&run.dir);
+                let s = status(&run).map_or(Status::Pending, |s| s.0);
+                counts[Status::ALL.iter().position(|x| *x == s).unwrap_or(3)] += 1;
+                position += progress(&run, s == Status::Done);
+            }
+            bar.set_position(position);
+            bar.set_message(format!(
+                "done {} running {} failed {} pending {}",
+                counts[0], counts[1], counts[2], counts[3]
+            ));
+            std::thread::sleep(Duration::from_millis(if quiet { 5000 } else { 1000 }));
+        }
+        for handle in handles {
+            handle.join().expect("a worker panicked")?;
+        }
+        Ok(())
+    })?;
+    bar.finish_and_clear();
+    for f in finished.into_inner().expect("finished lock") {
+        let run = dir.join(&sweep.runs[f.index].dir);
+        if f.ok {
+            println!("done    {}", run.display());
+        } else {
+            println!(
+                "failed  {} (see {})",
+                run.display(),
+                run.join(LOG).display()
+            );
+            failures.push(run);
+        }
+    }
+    if !failures.is_empty() {
+        bail!(
+            "{} run(s) failed; `seads sweep status {}` lists them, their task.log says why",
+            failures.len(),
+            dir.display()
+        );
+    }
+    println!("sweep {:?} complete", sweep.name);
+    Ok(())
+}

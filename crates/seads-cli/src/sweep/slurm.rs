@@ -1,0 +1,130 @@
+//! `seads sweep slurm`: the sweep as one Slurm job array (a task per run, `%M` throttle, each
+//! task `seads sweep task DIR --index $SLURM_ARRAY_TASK_ID`, re-queueable) and a dependent job
+//! that writes the report once every task has ended. Slurm schedules; we only write the
+//! scripts and, with `--submit`, hand them to `sbatch`.
+
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+use anyhow::{Context, Result, bail};
+
+use super::index::Sweep;
+
+/// Where the scripts go, inside the sweep directory.
+pub const SLURM_DIR: &str = "slurm";
+
+/// Options of the job array.
+#[derive(Debug, Clone)]
+pub struct SlurmOptions {
+    /// Partition (`--partition`), if any.
+    pub partition: Option<String>,
+    /// Time limit per task (`--time`, Slurm's format).
+    pub time: String,
+    /// Cores per task; the task's libtorch threads follow them.
+    pub cpus_per_task: usize,
+    /// At most this many tasks at once (`%M`), if any.
+    pub max_parallel: Option<usize>,
+    /// The `seads` binary the tasks run (it must be reachable from the compute nodes).
+    pub seads: PathBuf,
+}
+
+/// A word for bash, single-quoted.
+fn quote(text: &str) -> String {
+    format!("'{}'", text.replace('\'', r"'\''"))
+}
+
+/// The job array script and the report script, as text.
+pub fn scripts(dir: &Path, sweep: &Sweep, options: &SlurmOptions) -> (String, String) {
+    let d = dir.display().to_string();
+    let seads = quote(&options.seads.display().to_string());
+    let logs = format!("{d}/{SLURM_DIR}/logs");
+    let throttle = options
+        .max_parallel
+        .map_or(String::new(), |m| format!("%{m}"));
+    let partition = options
+        .partition
+        .as_ref()
+        .map_or(String::new(), |p| format!("#SBATCH --partition={p}\n"));
+    let array = format!(
+        "#!/bin/bash\n\
+         # One task per run of sweep {name:?}; written by `seads sweep slurm`.\n\
+         # A task resumes its run when it is re-queued or submitted again.\n\
+         #SBATCH --job-name=seads-{name}\n\
+         #SBATCH --array=0-{last}{throttle}\n\
+         #SBATCH --cpus-per-task={cpus}\n\
+         #SBATCH --time={time}\n\
+         {partition}\
+         #SBATCH --output={logs}/task-%a.out\n\
+         #SBATCH --requeue\n\
+         exec {seads} sweep task {dir} --index \"$SLURM_ARRAY_TASK_ID\" --cores \"${{SLURM_CPUS_PER_TASK:-{cpus}}}\"\n",
+        name = sweep.name,
+        last = sweep.runs.len().saturating_sub(1),
+        cpus = options.cpus_per_task,
+        time = options.time,
+        dir = quote(&d),
+    );
+    let report = format!(
+        "#!/bin/bash\n\
+         # The report of sweep {name:?}, once every task has ended; written by `seads sweep slurm`.\n\
+         #SBATCH --job-name=seads-{name}-report\n\
+         #SBATCH --cpus-per-task=1\n\
+         #SBATCH --time={time}\n\
+         {partition}\
+         #SBATCH --output={logs}/report.out\n\
+         {seads} sweep status {dir}\n\
+         exec {seads} report {dir} --out {out}\n",
+        name = sweep.name,
+        time = options.time,
+        dir = quote(&d),
+        out = quote(&format!("{d}/report")),
+    );
+    (array, report)
+}
+
+/// Writes the scripts into `dir/slurm/`; returns their paths.
+pub fn write_scripts(
+    dir: &Path,
+    sweep: &Sweep,
+    options: &SlurmOptions,
+) -> Result<(PathBuf, PathBuf)> {
+    let (array, report) = scripts(dir, sweep, options);
+    let folder = dir.join(SLURM_DIR);
+    std::fs::create_dir_all(folder.join("logs"))
+        .with_context(|| format!("creating {}", folder.display()))?;
+    let paths = (folder.join("array.sbatch"), folder.join("report.sbatch"));
+    seads_rl::write_atomic(&paths.0, array.as_bytes())?;
+    seads_rl::write_atomic(&paths.1, report.as_bytes())?;
+    Ok(paths)
+}
+
+/// `sbatch --parsable [extra] script`: the job id.
+fn sbatch(script: &Path, extra: &[String]) -> Result<String> {
+    let output = Command::new("sbatch")
+        .arg("--parsable")
+        .args(extra)
+        .arg(script)
+        .output()
+        .context("running sbatch (is Slurm installed and SLURM_CONF set?)")?;
+    if !output.status.success() {
+        bail!(
+            "sbatch {} failed: {}",
+            script.display(),
+            String::from_utf8_lossy(&output.stderr).trim()
+        );
+    }
+    let text = String::from_utf8_lossy(&output.stdout);
+    // `--parsable` prints "id" or "id;cluster".
+    let id = text.trim().split(';').next().unwrap_or("").to_owned();
+    if id.is_empty() {
+        bail!("sbatch printed no job id");
+    }
+    Ok(id)
+}
+
+/// Submits the array, then the report job after it (`afterany`: the report is written even
+/// when tasks failed, and shows them). Returns both job ids.
+pub fn submit(array: &Path, report: &Path) -> Result<(String, String)> {
+    let array_id = sbatch(array, &[])?;
+    let report_id = sbatch(report, &[format!("--dependency=afterany:{array_id}")])?;
+    Ok((array_id, report_id))
+}

@@ -1,0 +1,196 @@
+//! The state of one run of a sweep, read from its directory alone (never from Slurm), so that
+//! `seads sweep status` tells the same on a laptop, a login node or inside a job:
+//! - `task.lock` is locked (an OS file lock) while a task works on the run: a killed task
+//!   releases it, so "running" can never be stale;
+//! - `task.json` records the last task's outcome: running, done or failed (with the error).
+
+use std::fs::File;
+use std::path::Path;
+
+use anyhow::{Context, Result, bail};
+use serde::{Deserialize, Serialize};
+
+/// The lock file of a run directory.
+pub const LOCK: &str = "task.lock";
+/// The task record of a run directory.
+pub const RECORD: &str = "task.json";
+/// The log of the tasks' output (`seads sweep run` appends each task's stdout and stderr).
+pub const LOG: &str = "task.log";
+
+/// What the last task recorded.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Outcome {
+    /// A task started (if the lock is free now, it was killed).
+    Running,
+    /// Trained and evaluated.
+    Done,
+    /// Stopped with an error.
+    Failed,
+}
+
+/// `task.json`.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+pub struct Record {
+    /// Outcome.
+    pub outcome: Outcome,
+    /// Host of the task.
+    pub host: String,
+    /// Process id of the task.
+    pub pid: u32,
+    /// Tasks started on this run so far (re-queues and re-runs included).
+    pub attempts: u32,
+    /// Seconds since the Unix epoch when the record was written.
+    pub written_unix: u64,
+    /// The error of a failed task.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub error: Option<String>,
+}
+
+impl Record {
+    /// Reads the record of `run` (`None` before the first task).
+    pub fn read(run: &Path) -> Result<Option<Self>> {
+        let path = run.join(RECORD);
+        match std::fs::read_to_string(&path) {
+            Ok(text) => {
+                Ok(Some(serde_json::from_str(&text).with_context(|| {
+                    format!("{} is not a task record", path.display())
+                })?))
+            }
+            Err(e) if e.kind() == std::io::ErrorKind::NotFound => Ok(None),
+            Err(e) => Err(e).with_context(|| format!("reading {}", path.display())),
+        }
+    }
+
+    /// Writes a record of this process with `outcome` into `run`.
+    pub fn write(run: &Path, outcome: Outcome, attempts: u32, error: Option<String>) -> Result<()> {
+        let record = Self {
+            outcome,
+            host: hostname(),
+            pid: std::process::id(),
+            attempts,
+            written_unix: std::time::SystemTime::now()
+                .duration_since(std::time::UNIX_EPOCH)
+                .map_or(0, |d| d.as_secs()),
+            error,
+        };
+        seads_rl::write_atomic(
+            &run.join(RECORD),
+            (serde_json::to_string_pretty(&record)? + "\n").as_bytes(),
+        )?;
+        Ok(())
+    }
+}
+
+/// The host name, for the record (empty if unknown).
+fn hostname() -> String {
+    std::fs::read_to_string("/proc/sys/kernel/hostname")
+        .map(|s| s.trim().to_owned())
+        .unwrap_or_default()
+}
+
+/// The exclusive claim of a task on a run, held until dropped (or the process dies).
+#[derive(Debug)]
+pub struct Claim {
+    _file: File,
+}
+
+impl Claim {
+    /// Claims `run`; an error if another task holds it.
+    pub fn take(run: &Path) -> Result<Self> {
+        let path = run.join(LOCK);
+        let file = File::options()
+            .create(true)
+            .truncate(false)
+            .write(true)
+            .open(&path)
+            .with_context(|| format!("opening {}", path.display()))?;
+        // `sweep status` holds the lock for an instant while it looks: try a few times.
+        for _ in 0..20 {
+            match file.try_lock() {
+                Ok(()) => return Ok(Self { _file: file }),
+                Err(std::fs::TryLockError::WouldBlock) => {
+                    std::thread::sleep(std::time::Duration::from_millis(50));
+                }
+                Err(std::fs::TryLockError::Error(e)) => {
+                    return Err(e).with_context(|| format!("locking {}", path.display()));
+                }
+            }
+        }
+        bail!("{} is already being trained by another task", run.display())
+    }
+}
+
+/// Whether a task holds `run` now.
+pub fn is_claimed(run: &Path) -> bool {
+    let Ok(file) = File::open(run.join(LOCK)) else {
+        return false;
+    };
+    matches!(file.try_lock(), Err(std::fs::TryLockError::WouldBlock))
+}
+
+/// Where a run stands.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Status {
+    /// Trained and evaluated.
+    Done,
+    /// A task works on it now.
+    Running,
+    /// The last task failed.
+    Failed,
+    /// Not started, or interrupted (killed) and waiting to be resumed.
+    Pending,
+}
+
+impl Status {
+    /// Every status, in the order of the summary.
+    pub const ALL: [Status; 4] = [Self::Done, Self::Running, Self::Failed, Self::Pending];
+
+    /// Lower-case name.
+    pub fn name(self) -> &'static str {
+        match self {
+            Self::Done => "done",
+            Self::Running => "running",
+            Self::Failed => "failed",
+            Self::Pending => "pending",
+        }
+    }
+}
+
+/// The status of `run` and its record.
+pub fn status(run: &Path) -> Result<(Status, Option<Record>)> {
+    let record = Record::read(run)?;
+    let status = if is_claimed(run) {
+        Status::Running
+    } else {
+        match record.as_ref().map(|r| r.outcome) {
+            Some(Outcome::Done) => Status::Done,
+            Some(Outcome::Failed) => Status::Failed,
+            Some(Outcome::Running) | None => Status::Pending,
+        }
+    };
+    Ok((status, record))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_claim_shows_as_running_and_excludes_a_second_task() {
+        let dir = tempfile::tempdir().unwrap();
+        assert_eq!(status(dir.path()).unwrap().0, Status::Pending);
+        let claim = Claim::take(dir.path()).unwrap();
+        Record::write(dir.path(), Outcome::Running, 1, None).unwrap();
+        assert_eq!(status(dir.path()).unwrap().0, Status::Running);
+        assert!(Claim::take(dir.path()).is_err());
+        drop(claim);
+        // Released without a final record: a killed task, to be resumed.
+        assert_eq!(status(dir.path()).unwrap().0, Status::Pending);
+        Record::write(dir.path(), Outcome::Failed, 1, Some("boom".into())).unwrap();
+        let (s, r) = status(dir.path()).unwrap();
+        assert_eq!(s, Status::Failed);
+        assert_eq!(r.unwrap().error.as_deref(), Some("boom"));
+    }
+}

@@ -1,0 +1,118 @@
+//! `seads sweep task`: one run of a sweep, start to finish — claim it, train it (resuming what
+//! a killed or re-queued task left), evaluate it, record the outcome. A Slurm array task and a
+//! worker of `seads sweep run` both come here, so the two behave alike.
+
+use std::path::Path;
+
+use anyhow::{Context, Result};
+use seads_rl::{Run, Trainer};
+use seads_skillmodel::SkillModelKind;
+
+use super::index::Sweep;
+use super::state::{Claim, Outcome, Record};
+use crate::overtraining::{Selection, evaluate_checkpoints};
+use crate::plan::{Tasks, load_agent, run_evaluation, task_seeds};
+
+/// libtorch threads for a task with `cores` cores: two training threads of `cores / 2` each,
+/// and all cores for SAC when the other thread waits (0 = keep: a task alone on one core).
+pub fn thread_split(cores: usize) -> (usize, usize) {
+    let cores = cores.max(1);
+    ((cores / 2).max(1), if cores >= 2 { cores } else { 0 })
+}
+
+/// Runs task `index` of the sweep in `dir` with `cores` cores. A run already done is left as it
+/// is. Errors are recorded in the run's `task.json` before they are returned.
+pub fn run_task(dir: &Path, index: usize, cores: usize) -> Result<()> {
+    let sweep = Sweep::load(dir).map_err(crate::BadInput)?;
+    let run = sweep.run_dir(dir, index).map_err(crate::BadInput)?;
+    let claim = Claim::take(&run)?;
+    let previous = Record::read(&run)?;
+    if previous
+        .as_ref()
+        .is_some_and(|r| r.outcome == Outcome::Done)
+    {
+        println!("{}: already done", run.display());
+        return Ok(());
+    }
+    let attempts = previous.map_or(0, |r| r.attempts) + 1;
+    Record::write(&run, Outcome::Running, attempts, None)?;
+    let result = train_and_evaluate(&sweep, &run, cores);
+    match &result {
+        Ok(()) => Record::write(&run, Outcome::Done, attempts, None)?,
+        Err(e) => Record::write(&run, Outcome::Failed, attempts, Some(format!("{e:#}")))?,
+    }
+    drop(claim);
+    result
+}
+
+fn train_and_evaluate(sweep: &Sweep, run: &Path, cores: usize) -> Result<()> {
+    let config =
+        seads_rl::load_config(run).with_context(|| format!("loading {}", run.display()))?;
+    crate::kernels::use_kernels(config.portable_numerics)?;
+    let (threads, alone) = thread_split(cores);
+    let mut training = crate::train::resume(
+        run,
+        Run::resume_with(run, |mut c| {
+            c.threads = threads;
+            c.sac_threads_alone = alone;
+            Trainer::new(c)
+        }),
+    )?;
+    if !training.finished() {
+        println!(
+            "{}: training from epoch {} with {threads} libtorch thread(s) per training thread",
+            run.display(),
+            training.trainer().epoch()
+        );
+        crate::train::drive(&mut training, true)?;
+    }
+    drop(training);
+    let plan = &sweep.evaluation;
+    if config.skill_model.kind == SkillModelKind::Vic {
+        println!(
+            "{}: a VIC agent cannot plan; no task evaluation",
+            run.display()
+        );
+        return Ok(());
+    }
+    seads_rl::set_threads(cores.max(1));
+    if plan.every > 0 {
+        let added = evaluate_checkpoints(
+            run,
+            Selection::Every(plan.every),
+            &[1, 2, 3, 4, 5],
+            plan.boards,
+            plan.timeout,
+            true,
+        )?;
+        println!(
+            "{}: {added} checkpoint evaluation(s) over training",
+            run.display()
+        );
+    }
+    if plan.last {
+        let mut agent = load_agent(run, None)?;
+        for replan in [true, false] {
+            let tasks = Tasks {
+                depths: (1..=5).collect(),
+                seeds: task_seeds(plan.boards, None),
+                split: seads_games::Split::Test,
+                replan,
+                timeout: plan.timeout,
+            };
+            let results = run_evaluation(&mut agent, run, tasks, true)?;
+            let solved: usize = results.iter().map(|r| r.solved).sum();
+            let tasks: usize = results.iter().map(|r| r.tasks).sum();
+            println!(
+                "{}: {} {solved}/{tasks} solved",
+                run.display(),
+                if replan {
+                    "with re-planning"
+                } else {
+                    "plan once"
+                }
+            );
+        }
+    }
+    Ok(())
+}

@@ -1,0 +1,467 @@
+//! End-to-end tests of studies: `seads sweep plan / run / task / status`, `seads report` and
+//! `seads evaluate --checkpoints`, on tiny runs; and killing `seads sweep run` at deterministic
+//! points, which must lose nothing (the resumed sweep equals the uninterrupted one).
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output, Stdio};
+use std::time::{Duration, Instant};
+
+fn seads(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_seads"))
+        .args(args)
+        .output()
+        .expect("run seads")
+}
+
+fn seads_ok(args: &[&str]) -> Output {
+    let out = seads(args);
+    assert!(
+        out.status.success(),
+        "seads {args:?}: {}{}",
+        String::from_utf8_lossy(&out.stdout),
+        String::from_utf8_lossy(&out.stderr)
+    );
+    out
+}
+
+/// Exit code 2 and a single `error:` line on stderr.
+fn check_bad_input(args: &[&str], needle: &str) {
+    let out = seads(args);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "seads {args:?}: {stderr}");
+    assert_eq!(stderr.lines().count(), 1, "one line: {stderr}");
+    assert!(
+        stderr.starts_with("error: ") && stderr.contains(needle),
+        "seads {args:?}: {stderr:?} should say {needle:?}"
+    );
+}
+
+/// A study of tiny runs: small networks, 600 steps, checkpoints every 5 epochs.
+const MANIFEST: &str = r#"
+name = "tiny"
+environments = ["lightsout-cursor"]
+seeds = [1, 2]
+
+[overrides]
+env_steps = 600
+sampled_episodes = 32
+recent_episodes = 16
+eval_every = 5
+checkpoint_every = 5
+eval_seeds = 1
+portable_numerics = true
+sac = { hidden = [32, 32] }
+skill_model = { hidden = [32, 32] }
+
+[evaluation]
+every = 2
+boards = 1
+timeout = 0.2
+
+[[variant]]
+name = "seads"
+
+[[variant]]
+name = "no-relabelling"
+overrides = { relabel = { skill_model_p = 0.0, sac_p = 0.0 } }
+"#;
+
+fn write_manifest(dir: &Path, text: &str) -> PathBuf {
+    let path = dir.join("manifest.toml");
+    std::fs::write(&path, text).unwrap();
+    path
+}
+
+fn s(p: &Path) -> &str {
+    p.to_str().unwrap()
+}
+
+fn status_json(sweep: &Path) -> serde_json::Value {
+    serde_json::from_slice(&seads_ok(&["sweep", "status", s(sweep), "--json"]).stdout).unwrap()
+}
+
+/// Every file under `dir` with its bytes.
+fn snapshot(dir: &Path) -> Vec<(PathBuf, Vec<u8>)> {
+    let mut files = Vec::new();
+    let mut stack = vec![dir.to_path_buf()];
+    while let Some(d) = stack.pop() {
+        for entry in std::fs::read_dir(&d).unwrap() {
+            let path = entry.unwrap().path();
+            if path.is_dir() {
+                stack.push(path);
+            } else {
+                files.push((path.clone(), std::fs::read(&path).unwrap()));
+            }
+        }
+    }
+    files.sort();
+    files
+}
+
+#[test]
+fn a_sweep_is_planned_once_run_to_the_end_and_reported() {
+    let tmp = tempfile::tempdir().unwrap();
+    let manifest = write_manifest(tmp.path(), MANIFEST);
+    let sweep = tmp.path().join("sweep");
+    let out = seads_ok(&["sweep", "plan", s(&manifest), "--out", s(&sweep)]);
+    assert!(String::from_utf8_lossy(&out.stdout).contains("4 runs (4 new)"));
+    let planned = snapshot(&sweep);
+    assert_eq!(
+        planned.len(),
+        4 + 2,
+        "four configs, the index and the manifest"
+    );
+    // Planning the same manifest again changes nothing.
+    let out = seads_ok(&["sweep", "plan", s(&manifest), "--out", s(&sweep)]);
+    assert!(String::from_utf8_lossy(&out.stdout).contains("nothing changed"));
+    assert_eq!(snapshot(&sweep), planned);
+    let config = std::fs::read_to_string(
+        sweep.join("runs/lightsout-cursor/no-relabelling/seed-2/config.toml"),
+    )
+    .unwrap();
+    assert!(config.contains("seed = 2") && config.contains("sac_p = 0.0"));
+    assert!(config.contains("env_steps = 600"));
+
+    let status = status_json(&sweep);
+    assert_eq!(
+        (status["total"].as_u64(), status["pending"].as_u64()),
+        (Some(4), Some(4))
+    );
+
+    seads_ok(&["sweep", "run", s(&sweep), "--workers", "2", "--quiet"]);
+    let status = status_json(&sweep);
+    assert_eq!(status["done"].as_u64(), Some(4), "{status}");
+    for run in status["runs"].as_array().unwrap() {
+        let dir = PathBuf::from(run["dir"].as_str().unwrap());
+        assert!(run["env_steps"].as_u64().unwrap() >= 600);
+        for file in [
+            "evaluation-replan.json",
+            "evaluation-plan-once.json",
+            "evaluation-over-training.jsonl",
+            "task.log",
+        ] {
+            assert!(dir.join(file).is_file(), "{} has {file}", dir.display());
+        }
+        // Each task trained with the sweep's threads: one per training thread on 1 core.
+        let log = std::fs::read_to_string(dir.join("task.log")).unwrap();
+        assert!(log.contains("1 libtorch thread(s)"), "{log}");
+    }
+    // Running a complete sweep again does nothing.
+    let again = seads_ok(&["sweep", "run", s(&sweep), "--quiet"]);
+    assert!(String::from_utf8_lossy(&again.stdout).contains("0 to train or resume"));
+
+    // Over-training evaluations: every 2nd checkpoint and the last, both modes; running the
+    // command again evaluates nothing new.
+    let run = sweep.join("runs/lightsout-cursor/seads/seed-1");
+    let lines = std::fs::read_to_string(run.join("evaluation-over-training.jsonl")).unwrap();
+    let checkpoints = std::fs::read_dir(run.join("checkpoints"))
+        .unwrap()
+        .filter(|e| {
+            e.as_ref()
+                .unwrap()
+                .file_name()
+                .to_string_lossy()
+                .starts_with("epoch-")
+        })
+        .count();
+    assert_eq!(
+        lines.lines().count(),
+        2 * checkpoints.div_ceil(2).max(1) + 2 * usize::from(checkpoints % 2 == 0)
+    );
+    let out = seads_ok(&[
+        "evaluate",
+        "--run",
+        s(&run),
+        "--checkpoints",
+        "2",
+        "--boards",
+        "1",
+        "--timeout",
+        "0.2",
+    ]);
+    assert!(String::from_utf8_lossy(&out.stdout).starts_with("0 new evaluation(s)"));
+    let before = lines.lines().count();
+    let out = seads_ok(&[
+        "evaluate",
+        "--run",
+        s(&run),
+        "--checkpoints",
+        "all",
+        "--boards",
+        "1",
+        "--timeout",
+        "0.2",
+    ]);
+    assert!(
+        String::from_utf8_lossy(&out.stdout)
+            .starts_with(&format!("{} new", 2 * checkpoints - before)),
+        "{}",
+        String::from_utf8_lossy(&out.stdout)
+    );
+    let all = std::fs::read_to_string(run.join("evaluation-over-training.jsonl")).unwrap();
+    assert_eq!(all.lines().count(), 2 * checkpoints);
+    let first: serde_json::Value = serde_json::from_str(all.lines().next().unwrap()).unwrap();
+    assert!(
+        first["env_steps"].as_u64().unwrap() > 0 && first["results"].as_array().unwrap().len() == 5
+    );
+
+    // The report: Table 1 with the test against the reference, CSVs and figures.
+    let report = tmp.path().join("report");
+    seads_ok(&["report", s(&sweep), "--out", s(&report)]);
+    let md = std::fs::read_to_string(report.join("report.md")).unwrap();
+    assert!(
+        md.contains("| seads |") && md.contains("| no-relabelling |"),
+        "{md}"
+    );
+    assert!(md.contains("U = ") && md.contains("n = 2"), "{md}");
+    let csv = std::fs::read_to_string(report.join("table1.csv")).unwrap();
+    assert_eq!(csv.lines().count(), 3, "{csv}");
+    for f in [
+        "success.csv",
+        "lengths.csv",
+        "coverage-lightsout-cursor.png",
+        "coverage-lightsout-cursor.svg",
+        "success-lightsout-cursor.png",
+    ] {
+        assert!(report.join(f).is_file(), "report has {f}");
+    }
+    // A run outside a sweep can join the report as its own variant.
+    seads_ok(&["report", s(&sweep), s(&run), "--out", s(&report)]);
+    let md = std::fs::read_to_string(report.join("report.md")).unwrap();
+    assert!(md.contains("| seed-1 |"), "{md}");
+
+    // Runs of one row must be one environment: the same variant name on two board sizes is an error.
+    let other = tmp.path().join("other/seed-1");
+    std::fs::create_dir_all(&other).unwrap();
+    std::fs::copy(run.join("metrics.jsonl"), other.join("metrics.jsonl")).unwrap();
+    let config = std::fs::read_to_string(run.join("config.toml"))
+        .unwrap()
+        .replace("[env_config]", "[env_config]\nboard_size = 7");
+    std::fs::write(other.join("config.toml"), config).unwrap();
+    let nowhere = tmp.path().join("nowhere");
+    check_bad_input(
+        &["report", s(&run), s(&other), "--out", s(&nowhere)],
+        "mixes different lightsout-cursor environments",
+    );
+    assert!(!nowhere.exists(), "nothing written");
+}
+
+#[test]
+fn sweep_commands_reject_bad_input_and_write_nothing() {
+    let tmp = tempfile::tempdir().unwrap();
+    let out = tmp.path().join("out");
+    let cases = [
+        (
+            MANIFEST.replace("eval_seeds = 1", "eval_seedz = 1"),
+            "unknown field `eval_seedz`",
+        ),
+        (
+            MANIFEST.replace("[\"lightsout-cursor\"]", "[\"lightsout-cursr\"]"),
+            "unknown environment",
+        ),
+        (
+            MANIFEST.replace("name = \"no-relabelling\"", "name = \"seads\""),
+            "duplicate variant name",
+        ),
+        (
+            MANIFEST.replace("seeds = [1, 2]", "seeds = []"),
+            "expands to no run",
+        ),
+        (
+            MANIFEST.replace("name = \"tiny\"", "nam = \"tiny\""),
+            "unknown field `nam`",
+        ),
+    ];
+    for (text, needle) in cases {
+        let manifest = write_manifest(tmp.path(), &text);
+        check_bad_input(&["sweep", "plan", s(&manifest), "--out", s(&out)], needle);
+        assert!(!out.exists(), "nothing written for {needle}");
+    }
+    let manifest = write_manifest(tmp.path(), MANIFEST);
+    check_bad_input(
+        &[
+            "sweep",
+            "plan",
+            s(&tmp.path().join("none.toml")),
+            "--out",
+            s(&out),
+        ],
+        "none.toml",
+    );
+    let missing = tmp.path().join("missing");
+    let not_sweep = tmp.path().join("not-a-sweep");
+    std::fs::create_dir(&not_sweep).unwrap();
+    for cmd in ["run", "status", "slurm"] {
+        check_bad_input(&["sweep", cmd, s(&missing)], "does not exist");
+        check_bad_input(&["sweep", cmd, s(&not_sweep)], "is not a sweep directory");
+    }
+    check_bad_input(
+        &["sweep", "task", s(&not_sweep), "--index", "0"],
+        "is not a sweep directory",
+    );
+    check_bad_input(
+        &["report", s(&not_sweep), "--out", s(&out)],
+        "neither a sweep",
+    );
+    seads_ok(&["sweep", "plan", s(&manifest), "--out", s(&out)]);
+    let planned = snapshot(&out);
+    // A usage error of clap's: exit 2, named on the first line.
+    for args in [
+        &["run", "--workers", "0"][..],
+        &["run", "--cores", "0"],
+        &["task", "--index", "0", "--cores", "0"],
+    ] {
+        let option = args[args.len() - 2];
+        let out = seads(&[&["sweep", args[0], s(&out)], &args[1..]].concat());
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(2), "{stderr}");
+        assert!(stderr.lines().next().unwrap().contains(option), "{stderr}");
+    }
+    check_bad_input(&["sweep", "task", s(&out), "--index", "4"], "out of range");
+    // A different manifest into the same folder.
+    let other = write_manifest(
+        tmp.path(),
+        &MANIFEST.replace("seeds = [1, 2]", "seeds = [1, 3]"),
+    );
+    check_bad_input(
+        &["sweep", "plan", s(&other), "--out", s(&out)],
+        "different sweep",
+    );
+    assert_eq!(snapshot(&out), planned, "nothing written");
+}
+
+#[test]
+fn a_failing_run_shows_as_failed_and_the_others_finish() {
+    let tmp = tempfile::tempdir().unwrap();
+    let manifest = write_manifest(
+        tmp.path(),
+        &MANIFEST
+            .replace("every = 2", "every = 0")
+            .replace("seeds = [1, 2]", "seeds = [1]"),
+    );
+    let sweep = tmp.path().join("sweep");
+    seads_ok(&["sweep", "plan", s(&manifest), "--out", s(&sweep)]);
+    // A latest pointer to a checkpoint that does not exist, and no other: resume must fail.
+    let broken = sweep.join("runs/lightsout-cursor/seads/seed-1");
+    std::fs::create_dir_all(broken.join("checkpoints")).unwrap();
+    std::fs::write(broken.join("checkpoints/latest"), "epoch-000005").unwrap();
+    std::fs::write(broken.join("metrics.jsonl"), "").unwrap();
+    let out = seads(&["sweep", "run", s(&sweep), "--workers", "2", "--quiet"]);
+    assert_eq!(out.status.code(), Some(1));
+    let status = status_json(&sweep);
+    assert_eq!(
+        (status["failed"].as_u64(), status["done"].as_u64()),
+        (Some(1), Some(1)),
+        "{status}"
+    );
+    let failed = &status["runs"][0];
+    assert_eq!(failed["status"], "failed");
+    assert!(
+        failed["error"].as_str().unwrap().contains("can be loaded"),
+        "{failed}"
+    );
+    let text =
+        String::from_utf8_lossy(&seads_ok(&["sweep", "status", s(&sweep)]).stdout).into_owned();
+    assert!(
+        text.contains("1 failed") && text.contains("error: "),
+        "{text}"
+    );
+    // Repaired, the run trains on the next call.
+    std::fs::remove_file(broken.join("checkpoints/latest")).unwrap();
+    seads_ok(&["sweep", "run", s(&sweep), "--quiet"]);
+    assert_eq!(status_json(&sweep)["done"].as_u64(), Some(2));
+}
+
+/// The metrics of a run without the wall-clock fields, and its evaluations without timings.
+fn results(run: &Path) -> (Vec<serde_json::Value>, Vec<serde_json::Value>) {
+    let metrics = std::fs::read_to_string(run.join("metrics.jsonl"))
+        .unwrap()
+        .lines()
+        .map(|l| {
+            let mut v: serde_json::Value = serde_json::from_str(l).unwrap();
+            for key in ["wall_s", "steps_per_s", "timings"] {
+                v.as_object_mut().unwrap().remove(key);
+            }
+            v
+        })
+        .collect();
+    let mut evaluations = Vec::new();
+    for file in ["evaluation-replan.json", "evaluation-plan-once.json"] {
+        let mut v: serde_json::Value =
+            serde_json::from_str(&std::fs::read_to_string(run.join(file)).unwrap()).unwrap();
+        for depth in v.as_array_mut().unwrap() {
+            depth.as_object_mut().unwrap().remove("planning_s");
+        }
+        evaluations.push(v);
+    }
+    (metrics, evaluations)
+}
+
+#[test]
+fn killing_sweep_run_at_any_point_loses_nothing() {
+    let tmp = tempfile::tempdir().unwrap();
+    let text = MANIFEST.replace("every = 2", "every = 0").replace(
+        "\n[[variant]]\nname = \"no-relabelling\"\noverrides = { relabel = { skill_model_p = 0.0, sac_p = 0.0 } }\n",
+        "",
+    );
+    let manifest = write_manifest(tmp.path(), &text);
+    let reference = tmp.path().join("reference");
+    seads_ok(&["sweep", "plan", s(&manifest), "--out", s(&reference)]);
+    seads_ok(&["sweep", "run", s(&reference), "--workers", "2", "--quiet"]);
+    let runs = [
+        "runs/lightsout-cursor/seads/seed-1",
+        "runs/lightsout-cursor/seads/seed-2",
+    ];
+    // Kill points: moments of each task's training (collection, updates, checkpoint writes,
+    // metrics appends, as `SEADS_CRASH_POINT` counts them), spread over the runs' lives.
+    for (i, moment) in [2, 9, 17].into_iter().enumerate() {
+        let sweep = tmp.path().join(format!("killed-{i}"));
+        seads_ok(&["sweep", "plan", s(&manifest), "--out", s(&sweep)]);
+        let mut parent = Command::new(env!("CARGO_BIN_EXE_seads"))
+            .args(["sweep", "run", s(&sweep), "--workers", "2", "--quiet"])
+            .env("SEADS_CRASH_POINT", moment.to_string())
+            .stdout(Stdio::null())
+            .stderr(Stdio::null())
+            .spawn()
+            .unwrap();
+        // Both tasks stop at the moment and wait there to be killed with their parent.
+        let start = Instant::now();
+        while !runs.iter().all(|r| {
+            std::fs::read_to_string(sweep.join(r).join("task.log"))
+                .is_ok_and(|l| l.contains("stopped at moment"))
+        }) {
+            assert!(
+                start.elapsed() < Duration::from_secs(120),
+                "tasks never stopped"
+            );
+            std::thread::sleep(Duration::from_millis(50));
+        }
+        assert_eq!(status_json(&sweep)["running"].as_u64(), Some(2));
+        parent.kill().unwrap();
+        parent.wait().unwrap();
+        // The tasks die with their parent: nothing stays running.
+        let start = Instant::now();
+        while status_json(&sweep)["running"].as_u64() != Some(0) {
+            assert!(
+                start.elapsed() < Duration::from_secs(30),
+                "tasks outlived the sweep"
+            );
+            std::thread::sleep(Duration::from_millis(50));
+        }
+        assert_eq!(status_json(&sweep)["pending"].as_u64(), Some(2));
+        seads_ok(&["sweep", "run", s(&sweep), "--workers", "2", "--quiet"]);
+        assert_eq!(status_json(&sweep)["done"].as_u64(), Some(2));
+        for run in runs {
+            assert_eq!(
+                results(&sweep.join(run)),
+                results(&reference.join(run)),
+                "{run} killed at moment {moment} and resumed differs from the uninterrupted run"
+            );
+            let record: serde_json::Value = serde_json::from_str(
+                &std::fs::read_to_string(sweep.join(run).join("task.json")).unwrap(),
+            )
+            .unwrap();
+            assert_eq!(record["attempts"], 2);
+        }
+    }
+}

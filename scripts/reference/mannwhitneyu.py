@@ -1,0 +1,49 @@
+"""Reference values for the report's Mann–Whitney U test: SciPy's
+`scipy.stats.mannwhitneyu(x, y, alternative="less")` with its default `method="auto"` (exact
+when both samples hold at most 8 values and there are no ties; otherwise the normal
+approximation with tie correction and continuity correction).
+
+The cases are the shapes a Table 1 comparison takes: five or ten final skill coverages per
+variant, often tied at the maximum (25.0 or 12.0), plus samples beyond 8 values and small
+samples without ties. Writes data/reference/mannwhitneyu.json, checked by the unit tests of
+crates/seads-cli/src/report/stats.rs.
+
+Run in any Python with SciPy (it was run with SciPy 1.17.1, NumPy 2.x):
+    python3 -m venv /tmp/scipyenv && /tmp/scipyenv/bin/pip install scipy
+    /tmp/scipyenv/bin/python scripts/reference/mannwhitneyu.py
+"""
+
+import json
+import pathlib
+
+import numpy as np
+import scipy
+from scipy.stats import mannwhitneyu
+
+rng = np.random.default_rng(20261124)
+cases = [
+    # No ties, exact.
+    ([1.0, 2.0, 3.0, 4.0, 5.0], [6.0, 7.0, 8.0, 9.0, 10.0]),
+    ([23.1, 24.6, 22.9, 24.0, 23.5], [24.2, 24.95, 24.8, 23.9, 24.7]),
+    ([24.85, 24.9, 24.95, 24.8, 24.7], [24.75, 24.65, 24.99, 24.6, 24.55]),
+    ([3.0, 1.0, 2.0], [4.0, 5.0, 0.5, 6.0]),
+    # Ties at the maximum, as coverage has them: normal approximation with tie correction.
+    ([25.0, 25.0, 24.95, 24.9, 25.0], [25.0, 25.0, 25.0, 25.0, 24.95]),
+    ([24.3, 24.75, 25.0, 24.9, 24.6], [25.0, 25.0, 25.0, 24.95, 25.0]),
+    ([12.0, 12.0, 12.0, 12.0, 12.0], [12.0, 12.0, 12.0, 12.0, 11.95]),
+    ([11.0, 12.0, 10.5, 12.0, 11.5], [12.0, 12.0, 12.0, 12.0, 12.0]),
+    # More than 8 values each: normal approximation even without ties.
+    (list(rng.normal(23.0, 1.0, 10)), list(rng.normal(24.0, 0.5, 10))),
+    (list(rng.normal(24.0, 1.0, 9)), list(rng.normal(24.0, 1.0, 12))),
+    # One sample of 8 or fewer and no ties: exact.
+    (list(rng.normal(22.0, 1.0, 6)), list(rng.normal(24.0, 1.0, 12))),
+]
+out = []
+for x, y in cases:
+    r = mannwhitneyu(x, y, alternative="less")
+    out.append({"x": [float(v) for v in x], "y": [float(v) for v in y],
+                "u": float(r.statistic), "p": float(r.pvalue)})
+path = pathlib.Path(__file__).resolve().parents[2] / "data/reference/mannwhitneyu.json"
+path.write_text(json.dumps({"scipy": scipy.__version__, "alternative": "less", "cases": out},
+                           indent=1) + "\n")
+print(f"wrote {len(out)} cases to {path}")
