@@ -105,12 +105,13 @@ impl Claim {
             .write(true)
             .open(&path)
             .with_context(|| format!("opening {}", path.display()))?;
-        // `sweep status` holds the lock for an instant while it looks: try a few times.
-        for _ in 0..20 {
+        // `sweep status` holds the lock for an instant while it looks, and a task that was
+        // just killed (a Slurm re-queue) may take a few seconds to die: wait up to a minute.
+        for _ in 0..600 {
             match file.try_lock() {
                 Ok(()) => return Ok(Self { _file: file }),
                 Err(std::fs::TryLockError::WouldBlock) => {
-                    std::thread::sleep(std::time::Duration::from_millis(50));
+                    std::thread::sleep(std::time::Duration::from_millis(100));
                 }
                 Err(std::fs::TryLockError::Error(e)) => {
                     return Err(e).with_context(|| format!("locking {}", path.display()));
@@ -184,8 +185,13 @@ mod tests {
         let claim = Claim::take(dir.path()).unwrap();
         Record::write(dir.path(), Outcome::Running, 1, None).unwrap();
         assert_eq!(status(dir.path()).unwrap().0, Status::Running);
-        assert!(Claim::take(dir.path()).is_err());
+        // A second claim waits for the first, and gets it once it is released.
+        let path = dir.path().to_path_buf();
+        let waiter = std::thread::spawn(move || Claim::take(&path).map(|_| ()));
+        std::thread::sleep(std::time::Duration::from_millis(300));
+        assert!(!waiter.is_finished());
         drop(claim);
+        waiter.join().unwrap().unwrap();
         // Released without a final record: a killed task, to be resumed.
         assert_eq!(status(dir.path()).unwrap().0, Status::Pending);
         Record::write(dir.path(), Outcome::Failed, 1, Some("boom".into())).unwrap();
