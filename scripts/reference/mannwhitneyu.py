@@ -32,6 +32,8 @@ cases = [
     ([24.3, 24.75, 25.0, 24.9, 24.6], [25.0, 25.0, 25.0, 24.95, 25.0]),
     ([12.0, 12.0, 12.0, 12.0, 12.0], [12.0, 12.0, 12.0, 12.0, 11.95]),
     ([11.0, 12.0, 10.5, 12.0, 11.5], [12.0, 12.0, 12.0, 12.0, 12.0]),
+    # Every value equal (a variant as perfect as the reference): no evidence, p = 1.
+    ([25.0] * 5, [25.0] * 5),
     # More than 8 values each: normal approximation even without ties.
     (list(rng.normal(23.0, 1.0, 10)), list(rng.normal(24.0, 0.5, 10))),
     (list(rng.normal(24.0, 1.0, 9)), list(rng.normal(24.0, 1.0, 12))),

@@ -4,6 +4,8 @@
 //! shows as failed, and the dependent job writes the report. Where Slurm cannot be started
 //! (not installed, not root) the test says why and passes; under `CI=true` it fails instead.
 
+#![allow(clippy::print_stderr)] // a skipped test says why
+
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 use std::time::{Duration, Instant};

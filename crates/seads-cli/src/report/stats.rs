@@ -1,11 +1,12 @@
 //! The statistics of the report: mean ± standard deviation per group, and the one-sided
 //! Mann–Whitney U test of a variant against the reference (SPEC §6.1: "significantly worse"
 //! at p < 0.01), as SciPy's `mannwhitneyu(variant, reference, alternative="less")` computes
-//! it: exact when neither sample exceeds 8 values and there are no ties, the tie-corrected
-//! normal approximation with continuity correction otherwise (statrs implements both).
+//! it with `method="auto"`: the exact null distribution when a sample holds at most 8 values
+//! and there are no ties, else the normal approximation with tie and continuity correction.
+//! (statrs 0.19's `mannwhitneyu` returns 1 − p for the exact one-sided test, so only its
+//! `erfc` is used here.) Checked against SciPy's values in `data/reference/mannwhitneyu.json`.
 
-use statrs::stats_tests::Alternative;
-use statrs::stats_tests::mannwhitneyu::{MannWhitneyUMethod, mannwhitneyu};
+use statrs::function::erf::erfc;
 
 /// The significance level of the paper's Table 1.
 pub const ALPHA: f64 = 0.01;
@@ -77,8 +78,8 @@ impl Test {
     }
 }
 
-/// One-sided Mann–Whitney U test that `variant` is smaller than `reference` (SciPy's
-/// `method="auto"`). `None` when a sample is empty or holds a NaN.
+/// One-sided Mann–Whitney U test that `variant` is smaller than `reference`. `None` when a
+/// sample is empty or holds a NaN.
 pub fn worse_than(variant: &[f64], reference: &[f64]) -> Option<Test> {
     if variant.is_empty()
         || reference.is_empty()
@@ -86,14 +87,86 @@ pub fn worse_than(variant: &[f64], reference: &[f64]) -> Option<Test> {
     {
         return None;
     }
-    mannwhitneyu(
-        variant,
-        reference,
-        MannWhitneyUMethod::Automatic,
-        Alternative::Less,
-    )
-    .ok()
-    .map(|(u, p)| Test { u, p })
+    let (n1, n2) = (variant.len(), reference.len());
+    let (ranks, ties) = average_ranks(&[variant, reference].concat());
+    let r1: f64 = ranks[..n1].iter().sum();
+    let u1 = r1 - (n1 * (n1 + 1)) as f64 / 2.0;
+    // "Less" is the upper tail of the reference's U, as SciPy computes it.
+    let u2 = (n1 * n2) as f64 - u1;
+    let tied = ties.iter().any(|&t| t > 1);
+    let p = if (n1 > 8 && n2 > 8) || tied {
+        normal_sf(u2, n1, n2, &ties)
+    } else {
+        exact_sf(u2.round() as usize, n1, n2)
+    };
+    Some(Test {
+        u: u1,
+        p: p.clamp(0.0, 1.0),
+    })
+}
+
+/// Ranks 1..=n with ties given their average rank, and the size of every group of equal values.
+fn average_ranks(values: &[f64]) -> (Vec<f64>, Vec<usize>) {
+    let mut order: Vec<usize> = (0..values.len()).collect();
+    order.sort_by(|&a, &b| values[a].total_cmp(&values[b]));
+    let mut ranks = vec![0.0; values.len()];
+    let mut ties = Vec::new();
+    let mut start = 0;
+    while start < order.len() {
+        let mut end = start + 1;
+        while end < order.len() && values[order[end]] == values[order[start]] {
+            end += 1;
+        }
+        // Positions start..end (0-based) share the mean of ranks start+1..=end.
+        let rank = (start + 1 + end) as f64 / 2.0;
+        for &i in &order[start..end] {
+            ranks[i] = rank;
+        }
+        ties.push(end - start);
+        start = end;
+    }
+    (ranks, ties)
+}
+
+/// P(U ≥ u) under the null hypothesis without ties, for samples of n1 and n2 values: the
+/// distribution of U built by the recurrence on the largest value, which belongs to the first
+/// sample (adding n2 to U) with probability n1 / (n1 + n2).
+fn exact_sf(u: usize, n1: usize, n2: usize) -> f64 {
+    // pmf[j]: the distribution of U for samples of i and j values, for the current i.
+    let mut pmf: Vec<Vec<f64>> = (0..=n2).map(|_| vec![1.0]).collect();
+    for i in 1..=n1 {
+        let mut next: Vec<Vec<f64>> = vec![vec![1.0]];
+        for j in 1..=n2 {
+            let mut dist = vec![0.0; i * j + 1];
+            let (a, b) = (i as f64 / (i + j) as f64, j as f64 / (i + j) as f64);
+            // Largest value in the first sample: it exceeds all j of the second.
+            for (k, p) in pmf[j].iter().enumerate() {
+                dist[k + j] += a * p;
+            }
+            // Largest value in the second sample: U unchanged.
+            for (k, p) in next[j - 1].iter().enumerate() {
+                dist[k] += b * p;
+            }
+            next.push(dist);
+        }
+        pmf = next;
+    }
+    pmf[n2].iter().skip(u).sum()
+}
+
+/// P(Z ≥ z) for the standardised U with tie correction and continuity correction (SciPy's
+/// asymptotic method).
+fn normal_sf(u: f64, n1: usize, n2: usize, ties: &[usize]) -> f64 {
+    let (n1f, n2f) = (n1 as f64, n2 as f64);
+    let n = n1f + n2f;
+    let tie_term: f64 = ties.iter().map(|&t| (t * t * t - t) as f64).sum();
+    let s = (n1f * n2f / 12.0 * ((n + 1.0) - tie_term / (n * (n - 1.0)))).sqrt();
+    let numerator = u - n1f * n2f / 2.0 - 0.5;
+    if s == 0.0 {
+        // Every value equal: z = ±∞ (U = mean, so the numerator is −0.5 and p = 1).
+        return if numerator > 0.0 { 0.0 } else { 1.0 };
+    }
+    0.5 * erfc(numerator / s / std::f64::consts::SQRT_2)
 }
 
 #[cfg(test)]
