@@ -371,4 +371,78 @@ env_overrides = { "lightsout-cursor" = { num_skills = 30 }, "tileswap-cursor" = 
             assert!(!e.contains('\n'), "{e:?} is one line");
         }
     }
+
+    #[test]
+    fn the_shipped_manifests_expand_to_the_paper_s_studies() {
+        let shipped = [
+            (
+                include_str!("../../../../experiments/table1.toml"),
+                2 * 7 * 5,
+            ),
+            (
+                include_str!("../../../../experiments/table1-arms.toml"),
+                4 * 7 * 5,
+            ),
+            (include_str!("../../../../experiments/vic.toml"), 4 * 3),
+            (
+                include_str!("../../../../experiments/board-size.toml"),
+                5 * 5,
+            ),
+        ];
+        for (text, count) in shipped {
+            let m = Manifest::parse(text, "experiments").unwrap();
+            let runs = m.expand().unwrap();
+            assert_eq!(runs.len(), count, "{}", m.name);
+            assert_eq!(
+                m.reference(),
+                runs[0].variant,
+                "{}: the reference comes first",
+                m.name
+            );
+            for run in &runs {
+                // Each variant changes only what its name says (SPEC §3.9, §3.10).
+                let preset = TrainConfig::preset(&run.env).unwrap();
+                let mut expected = preset.clone();
+                expected.seed = run.seed;
+                let c = &run.config;
+                match run.variant.as_str() {
+                    "seads" | "size-5" => {}
+                    "no-second-best-norm" => {
+                        expected.reward.normalisation = seads_skillmodel::Normalisation::LogK;
+                    }
+                    "no-novelty-bonus" => expected.reward.novelty_bonus = false,
+                    "no-relabelling" => {
+                        expected.relabel.skill_model_p = 0.0;
+                        expected.relabel.sac_p = 0.0;
+                    }
+                    "no-forward-model-relabelling" => expected.relabel.skill_model_p = 0.0,
+                    "no-sac-relabelling" => expected.relabel.sac_p = 0.0,
+                    "more-skills" => {
+                        expected.num_skills = Some(if run.env.starts_with("lightsout") {
+                            30
+                        } else {
+                            15
+                        });
+                    }
+                    v if v.starts_with("vic") => {
+                        expected.skill_model.kind = seads_skillmodel::SkillModelKind::Vic;
+                        expected.reward.novelty_bonus = false;
+                        if v != "vic-sbn" {
+                            expected.reward.normalisation = seads_skillmodel::Normalisation::LogK;
+                        }
+                        if v != "vic-relabelling" {
+                            expected.relabel.skill_model_p = 0.0;
+                            expected.relabel.sac_p = 0.0;
+                        }
+                    }
+                    v if v.starts_with("size-") => expected.env_config = c.env_config.clone(),
+                    other => panic!("unexpected variant {other}"),
+                }
+                if m.name == "board-size" {
+                    expected.env_steps = 1_500_000;
+                }
+                assert_eq!(c, &expected, "{} / {} / {}", m.name, run.env, run.variant);
+            }
+        }
+    }
 }
