@@ -15,6 +15,17 @@ pub fn build_env(name: &str, config: &EnvConfig) -> Result<Box<dyn Environment>>
     make_env(name, config).map_err(|e| BadInput(e.into()).into())
 }
 
+/// The number of skills K of a run: its `num_skills`, else the moves of its environment's game
+/// (for a robot run, whose environment is not in the registry, the tablet's LightsOut 5×5).
+pub fn run_skills(config: &seads_rl::TrainConfig) -> usize {
+    config
+        .num_skills
+        .unwrap_or_else(|| match make_env(&config.env, &config.env_config) {
+            Ok(env) => env.spec().num_skills,
+            Err(_) => seads_uarm::BOARD_SIZE * seads_uarm::BOARD_SIZE,
+        })
+}
+
 /// `seads envs`: every registered environment with its dimensions.
 pub fn envs(json: bool) -> Result<()> {
     let envs = list_envs();

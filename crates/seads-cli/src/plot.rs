@@ -78,9 +78,7 @@ pub fn write_figures(
     if !seads_embodiment::env_names().contains(&config.env.as_str()) {
         // A robot run: its environment is the hardware (or its twin), so only what the run
         // directory holds is drawn; `seads uarm train` evaluates and draws the rest itself.
-        let k = config
-            .num_skills
-            .unwrap_or(seads_uarm::BOARD_SIZE * seads_uarm::BOARD_SIZE);
+        let k = crate::envs::run_skills(&config);
         both("coverage", &|p| coverage_figure(p, &metrics, k, &title))?;
         if !quiet {
             eprintln!(

@@ -659,6 +659,46 @@ fn uarm_twin_calibrates_and_trains() {
             .unwrap()
             .contains("uarm-lightsout-absolute")
     );
+    // A robot run has figures and a report too: what its directory holds.
+    let figures = dir.path().join("figures");
+    seads_ok(&["plot", "--run", s(&run), "--out", s(&figures)]);
+    assert!(figures.join("coverage.png").is_file());
+    let report = dir.path().join("report");
+    seads_ok(&["report", s(&run), "--out", s(&report)]);
+    let md = std::fs::read_to_string(report.join("report.md")).unwrap();
+    assert!(md.contains("uarm-lightsout-absolute (of 25)"), "{md}");
+}
+
+fn s(p: &std::path::Path) -> &str {
+    p.to_str().unwrap()
+}
+
+#[test]
+fn a_vic_run_is_plotted_and_reported_without_planning() {
+    let dir = tempfile::tempdir().unwrap();
+    let config = tiny_config(dir.path());
+    let text = std::fs::read_to_string(&config).unwrap().replace(
+        "[skill_model]\nkind = \"forward\"",
+        "[skill_model]\nkind = \"vic\"",
+    );
+    assert!(text.contains("kind = \"vic\""));
+    std::fs::write(&config, text).unwrap();
+    let run = dir.path().join("vic");
+    seads_ok(&["train", "--config", s(&config), "--out", s(&run), "--quiet"]);
+    let figures = dir.path().join("figures");
+    let out = seads_ok(&["plot", "--run", s(&run), "--out", s(&figures)]);
+    assert!(String::from_utf8_lossy(&out.stderr).contains("cannot plan"));
+    for f in ["coverage.png", "trajectories.png", "pushes.svg"] {
+        assert!(figures.join(f).is_file(), "{f}");
+    }
+    assert!(!figures.join("success.png").exists());
+    let report = dir.path().join("report");
+    seads_ok(&["report", s(&run), "--out", s(&report)]);
+    assert!(
+        std::fs::read_to_string(report.join("report.md"))
+            .unwrap()
+            .contains("| vic |")
+    );
 }
 
 #[test]

@@ -25,10 +25,7 @@ pub struct CoverageCell {
 
 /// Skills of a run: the configured K, or the game's moves.
 pub fn skills(run: &RunData) -> usize {
-    run.config.num_skills.unwrap_or_else(|| {
-        seads_embodiment::make_env(&run.config.env, &run.config.env_config)
-            .map_or(0, |e| e.spec().num_skills)
-    })
+    crate::envs::run_skills(&run.config)
 }
 
 /// The cells of Table 1, in group order.
