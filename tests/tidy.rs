@@ -155,6 +155,73 @@ fn crate_dependencies_point_one_way_and_only_three_crates_link_libtorch() {
     assert_eq!(linking, ["seads-skillmodel", "seads-rl", "seads-cli"]);
 }
 
+/// The packages `cargo tree` lists for `args` (normal dependencies only), one name per entry.
+fn tree(args: &[&str]) -> Vec<String> {
+    let cargo = std::env::var("CARGO").unwrap_or_else(|_| "cargo".into());
+    let out = std::process::Command::new(cargo)
+        .args([
+            "tree",
+            "--offline",
+            "-e",
+            "normal",
+            "--prefix",
+            "none",
+            "--format",
+            "{p}",
+        ])
+        .args(args)
+        .current_dir(root())
+        .output()
+        .expect("run cargo tree");
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    String::from_utf8_lossy(&out.stdout)
+        .lines()
+        .filter_map(|l| l.split_whitespace().next().map(str::to_owned))
+        .collect()
+}
+
+/// A user of the games, the planner, the robot, Cursor or Reacher downloads neither PyTorch nor
+/// a physics engine: libtorch only behind `seads-skillmodel`, rapier3d only behind
+/// `seads-embodiment`'s default feature `jaco` (docs/ARCHITECTURE.md).
+#[test]
+fn light_crates_pull_in_neither_libtorch_nor_rapier() {
+    for (args, heavy) in [
+        (
+            &["-p", "seads-games"][..],
+            &["tch", "torch-sys", "rapier3d"][..],
+        ),
+        (&["-p", "seads-planner"], &["tch", "torch-sys", "rapier3d"]),
+        (&["-p", "seads-uarm"], &["tch", "torch-sys", "rapier3d"]),
+        (
+            &["-p", "seads-embodiment", "--no-default-features"],
+            &["tch", "torch-sys", "rapier3d"],
+        ),
+        (&["-p", "seads-embodiment"], &["tch", "torch-sys"]),
+    ] {
+        let packages = tree(args);
+        assert!(
+            packages.len() > 3,
+            "cargo tree {args:?} listed {packages:?}"
+        );
+        for h in heavy {
+            assert!(
+                !packages.iter().any(|p| p == h),
+                "cargo tree {args:?} includes {h}"
+            );
+        }
+    }
+    // The feature is what brings rapier: the check above would pass vacuously otherwise.
+    assert!(
+        tree(&["-p", "seads-embodiment"])
+            .iter()
+            .any(|p| p == "rapier3d")
+    );
+}
+
 /// Every `.rs` file under `crates/`, with its text.
 fn sources() -> Vec<(std::path::PathBuf, String)> {
     let mut out = Vec::new();
@@ -207,7 +274,9 @@ fn nothing_uses_libtorchs_global_generator() {
 #[test]
 fn every_environment_has_a_preset() {
     let embedded = read("crates/seads-rl/src/config.rs");
-    for env in seads_embodiment::env_names() {
+    let envs = seads_embodiment::env_names();
+    assert!(envs.contains(&"lightsout-jaco"), "the Jaco environments are registered");
+    for env in envs {
         let file = format!("configs/{env}.toml");
         let text = read(&file);
         assert!(
@@ -215,7 +284,7 @@ fn every_environment_has_a_preset() {
             "{file} trains {env}"
         );
         assert!(
-            embedded.contains(&format!("\"../../../{file}\"")),
+            embedded.contains(&format!("\"../{file}\"")),
             "crates/seads-rl/src/config.rs embeds {file}"
         );
     }

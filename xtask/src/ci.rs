@@ -5,7 +5,7 @@ use std::process::{Command, Stdio};
 
 use anyhow::{Context, Result, bail};
 
-use crate::{root, setup, step};
+use crate::{root, setup, step, step_with_env};
 
 /// Set-up, formatting, lints (warnings are errors), then every test of every crate, the
 /// integration tests under `tests/` and the benches in test mode (each bench runs once). Ends
@@ -24,6 +24,28 @@ pub fn run() -> Result<()> {
             "warnings",
         ],
     )?;
+    // The API docs build without a warning (broken intra-doc links included).
+    step_with_env(
+        "cargo",
+        &["doc", "--workspace", "--no-deps"],
+        &[("RUSTDOCFLAGS", "-D warnings")],
+    )?;
+    // Every library crate packages (manifest metadata, README, only files inside the crate).
+    // Without verification: building each package again from scratch would double CI's time;
+    // `cargo xtask package` verifies them.
+    step(
+        "cargo",
+        &[
+            "package",
+            "--workspace",
+            "--exclude",
+            "xtask",
+            "--exclude",
+            "seads-tests",
+            "--no-verify",
+            "--allow-dirty",
+        ],
+    )?;
     let mut totals = Totals::default();
     test(&["test", "--workspace", "--doc"], &mut totals)?;
     test(&["test", "--workspace", "--all-targets"], &mut totals)?;
@@ -40,8 +62,20 @@ struct Totals {
 /// Runs `cargo <args>`, echoing its output and adding up its `test result:` lines.
 fn test(args: &[&str], totals: &mut Totals) -> Result<()> {
     eprintln!("xtask: $ cargo {}", args.join(" "));
+    // Doc-tests run from temporary folders, where the binaries' rpath cannot reach libtorch.
+    let libtorch = root().join(".libtorch/lib");
+    let library_path = match std::env::var_os("LD_LIBRARY_PATH") {
+        Some(old) if !old.is_empty() => {
+            let mut path = libtorch.into_os_string();
+            path.push(":");
+            path.push(old);
+            path
+        }
+        _ => libtorch.into_os_string(),
+    };
     let mut child = Command::new("cargo")
         .args(args)
+        .env("LD_LIBRARY_PATH", library_path)
         .current_dir(root())
         .stdout(Stdio::piped())
         .spawn()

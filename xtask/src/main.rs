@@ -14,8 +14,9 @@ cargo xtask <command>
 
 Commands:
   run          set up libtorch if needed, build in release mode and run `seads run` (the main job)
-  ci           set up, then cargo fmt --check, clippy -D warnings, and every test (what CI runs)
+  ci           set up, then fmt --check, clippy -D warnings, doc -D warnings, package, every test (CI)
   setup        install libtorch for tch into .venv / .libtorch (idempotent; scripts/setup.sh)
+  package      cargo package every library crate in dependency order, building each package (slow)
   gen-splits   write data/depth_counts.csv and data/split_counts.csv from a fresh enumeration
 ";
 
@@ -25,6 +26,20 @@ fn main() -> ExitCode {
         Some("run") => run_main_job(&args[1..]),
         Some("ci") => ci::run(),
         Some("setup") => setup(),
+        Some("package") => setup().and_then(|()| {
+            step(
+                "cargo",
+                &[
+                    "package",
+                    "--workspace",
+                    "--exclude",
+                    "xtask",
+                    "--exclude",
+                    "seads-tests",
+                    "--allow-dirty",
+                ],
+            )
+        }),
         Some("gen-splits") => gen_splits::run(&root()),
         Some("help" | "--help" | "-h") | None => {
             print!("{HELP}");
@@ -54,9 +69,15 @@ fn root() -> PathBuf {
 
 /// Runs a command in the repository root and fails if it fails.
 fn step(program: &str, args: &[&str]) -> Result<()> {
+    step_with_env(program, args, &[])
+}
+
+/// Runs `program args` in the repository root with extra environment variables.
+fn step_with_env(program: &str, args: &[&str], env: &[(&str, &str)]) -> Result<()> {
     eprintln!("xtask: $ {program} {}", args.join(" "));
     let status = Command::new(program)
         .args(args)
+        .envs(env.iter().copied())
         .current_dir(root())
         .status()
         .with_context(|| format!("could not start {program}"))?;

@@ -4,10 +4,9 @@ use seads_games::GameKind;
 use serde::Serialize;
 
 use crate::board::BoardState;
-use crate::{
-    Cursor, Embodied, EnvConfig, EnvError, Environment, Jaco, JacoBoard, Layout, Manipulator,
-    Reacher,
-};
+use crate::{Cursor, Embodied, EnvConfig, EnvError, Environment, Layout, Manipulator, Reacher};
+#[cfg(feature = "jaco")]
+use crate::{Jaco, JacoBoard};
 
 /// One registered environment.
 struct Entry {
@@ -21,6 +20,7 @@ struct Entry {
 enum Embodiment {
     Cursor,
     Reacher,
+    #[cfg(feature = "jaco")]
     Jaco(JacoBoard),
 }
 
@@ -49,18 +49,21 @@ const REGISTRY: &[Entry] = &[
         game: GameKind::TileSwap,
         embodiment: Embodiment::Reacher,
     },
+    #[cfg(feature = "jaco")]
     Entry {
         name: "lightsout-jaco",
         description: "LightsOut 5×5 pressed by a Kinova Jaco arm with 3-finger hand (rapier3d)",
         game: GameKind::LightsOut,
         embodiment: Embodiment::Jaco(JacoBoard::LightsOut { stairs: false }),
     },
+    #[cfg(feature = "jaco")]
     Entry {
         name: "tileswap-jaco",
         description: "TileSwap 3×3 pressed by a Kinova Jaco arm with 3-finger hand (rapier3d)",
         game: GameKind::TileSwap,
         embodiment: Embodiment::Jaco(JacoBoard::TileSwap),
     },
+    #[cfg(feature = "jaco")]
     Entry {
         name: "lightsout3d-jaco",
         description: "LightsOut 5×5 with fields raised by distance from the centre, pressed by a Jaco arm",
@@ -85,7 +88,11 @@ pub fn make_env(name: &str, config: &EnvConfig) -> Result<Box<dyn Environment>, 
         })?;
     config.validate()?;
     let layout = layout(entry, config)?;
-    if config.physics_substeps.is_some() && !matches!(entry.embodiment, Embodiment::Jaco(_)) {
+    #[cfg(feature = "jaco")]
+    let jaco = matches!(entry.embodiment, Embodiment::Jaco(_));
+    #[cfg(not(feature = "jaco"))]
+    let jaco = false;
+    if config.physics_substeps.is_some() && !jaco {
         return Err(EnvError::InvalidConfig(format!(
             "physics_substeps applies to the Jaco environments, not {}",
             entry.name
@@ -99,6 +106,7 @@ pub fn make_env(name: &str, config: &EnvConfig) -> Result<Box<dyn Environment>, 
     Ok(match entry.embodiment {
         Embodiment::Cursor => build(entry.name, Cursor::default(), board, layout, config),
         Embodiment::Reacher => build(entry.name, Reacher::default(), board, layout, config),
+        #[cfg(feature = "jaco")]
         Embodiment::Jaco(jaco) => {
             let substeps = config
                 .physics_substeps

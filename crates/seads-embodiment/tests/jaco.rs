@@ -3,6 +3,7 @@
 //! pivot, points the hand down and descends until the press registers.
 #![allow(clippy::approx_constant)] // the MJCF's rounded quaternion literals
 #![allow(clippy::print_stderr)] // the full sweep reports its measured success
+#![cfg(feature = "jaco")]
 
 use rapier3d::math::{Rotation, Vector};
 use rapier3d::na::{DMatrix, DVector};

@@ -9,6 +9,32 @@
 //!
 //! Architecture invariant: this crate knows nothing of physics, tensors or IO; its functions are
 //! pure and only parsing user input returns `Result`.
+//!
+//! # Example: parse a board and solve it
+//!
+//! ```
+//! use seads_games::{BoardGame, DepthTable, Gf2Solver, LightsOut, TileSwap};
+//!
+//! // LightsOut 5×5: a board is 25 values, row-major; pressing field 0 toggles it and its
+//! // right and lower neighbours.
+//! let game = LightsOut::new(5)?;
+//! let board = game.parse("1,1,0,0,0, 1,0,0,0,0, 0,0,0,0,0, 0,0,0,0,0, 0,0,0,0,0")?;
+//! let moves = Gf2Solver::new(&game).solve(board)?; // an optimal move sequence
+//! assert_eq!(moves, vec![0]);
+//! assert!(game.is_goal(game.apply_all(board, &moves)));
+//!
+//! // TileSwap 3×3: a permutation of the tiles; 12 swap moves; solved by the depth table.
+//! let tileswap = TileSwap::new();
+//! let board = tileswap.parse("1,0,2,3,4,5,6,7,8")?;
+//! let table = DepthTable::build(&tileswap)?;
+//! assert_eq!(table.depth(&tileswap, board), Some(1));
+//! let moves = table.solve(&tileswap, board)?;
+//! assert!(tileswap.is_goal(tileswap.apply_all(board, &moves)));
+//! # Ok::<(), seads_games::GameError>(())
+//! ```
+//!
+//! The examples (`cargo run -p seads-games --example depths`, `--example solve`) print the
+//! boards per solution depth and solve a board given on the command line.
 
 mod bits;
 mod dataset;

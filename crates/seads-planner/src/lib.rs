@@ -6,6 +6,26 @@
 //! through `Successor` (implemented in `seads-skillmodel`), the skill policy only through
 //! `SkillPolicy` (implemented in `seads-rl`); the ground-truth game implements `Successor` too,
 //! so the same search runs on the real rules for comparison.
+//!
+//! # Example: plan with the true game's successor
+//!
+//! ```
+//! use seads_games::{BoardGame, GameSuccessor, LightsOut};
+//! use seads_planner::{PlannerConfig, bfs_plan};
+//!
+//! let game = LightsOut::new(5)?;
+//! // A board three moves from the goal.
+//! let start = game.apply_all(game.goal(), &[3, 12, 20]);
+//! // Skill k performs move k; a learned forward model plugs in the same way.
+//! let plan = bfs_plan(&mut GameSuccessor::new(&game), start, game.goal(), &PlannerConfig::default())?;
+//! assert_eq!(plan.skills.len(), 3); // breadth-first: a shortest plan
+//! assert_eq!(game.apply_all(start, &plan.skills), game.goal());
+//! assert_eq!(plan.predicted.last(), Some(&game.goal()));
+//! # Ok::<(), Box<dyn std::error::Error>>(())
+//! ```
+//!
+//! `cargo run -p seads-planner --example plan` plans on a LightsOut board and executes the plan
+//! in `lightsout-cursor` with a scripted skill policy, with and without re-planning.
 
 mod bfs;
 mod evaluate;

@@ -108,31 +108,31 @@ impl Default for TrainConfig {
 const PRESETS: &[(&str, &str)] = &[
     (
         "lightsout-cursor",
-        include_str!("../../../configs/lightsout-cursor.toml"),
+        include_str!("../configs/lightsout-cursor.toml"),
     ),
     (
         "tileswap-cursor",
-        include_str!("../../../configs/tileswap-cursor.toml"),
+        include_str!("../configs/tileswap-cursor.toml"),
     ),
     (
         "lightsout-reacher",
-        include_str!("../../../configs/lightsout-reacher.toml"),
+        include_str!("../configs/lightsout-reacher.toml"),
     ),
     (
         "tileswap-reacher",
-        include_str!("../../../configs/tileswap-reacher.toml"),
+        include_str!("../configs/tileswap-reacher.toml"),
     ),
     (
         "lightsout-jaco",
-        include_str!("../../../configs/lightsout-jaco.toml"),
+        include_str!("../configs/lightsout-jaco.toml"),
     ),
     (
         "tileswap-jaco",
-        include_str!("../../../configs/tileswap-jaco.toml"),
+        include_str!("../configs/tileswap-jaco.toml"),
     ),
     (
         "lightsout3d-jaco",
-        include_str!("../../../configs/lightsout3d-jaco.toml"),
+        include_str!("../configs/lightsout3d-jaco.toml"),
     ),
 ];
 

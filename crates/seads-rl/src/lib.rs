@@ -7,6 +7,30 @@
 //! printing; the binary shows progress from the values [`Run::step`] returns. Every random
 //! choice comes from streams seeded by the run's seed (network initialisation included), never
 //! from libtorch's global generator.
+//!
+//! # Example: a few training epochs from code
+//!
+//! ```
+//! use seads_rl::{TrainConfig, Trainer};
+//!
+//! // The paper's LightsOutCursor settings, shrunk so that the example runs in seconds.
+//! let mut config = TrainConfig::preset("lightsout-cursor")?;
+//! config.sac.hidden = vec![32, 32];
+//! config.skill_model.hidden = vec![32, 32];
+//! (config.sampled_episodes, config.recent_episodes, config.eval_seeds) = (32, 16, 2);
+//! let mut trainer = Trainer::new(config)?;
+//! for _ in 0..3 {
+//!     let stats = trainer.run_epoch()?; // collect 32 episodes, relabel, update the model and SAC
+//!     assert!(stats.mean_reward.is_finite());
+//! }
+//! assert_eq!(trainer.epoch(), 3);
+//! let coverage = trainer.skill_coverage()?; // distinct moves of the K skills, 0..=25
+//! assert!((0.0..=25.0).contains(&coverage));
+//! # Ok::<(), seads_rl::RlError>(())
+//! ```
+//!
+//! [`Run`] does the same into a run directory (metrics, checkpoints, exact resume); see
+//! `cargo run --release -p seads-rl --example train`.
 
 mod agent;
 mod buffers;

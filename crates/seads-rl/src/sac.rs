@@ -331,7 +331,7 @@ impl Sac {
         }
     }
 
-    /// Writes networks and optimiser states into `dir` ([`ACTOR_FILE`] and [`RESUME_FILES`]).
+    /// Writes networks and optimiser states into `dir` (the actor file and the resume files).
     pub fn save(&self, dir: &Path) -> Result<(), RlError> {
         for (file, vs) in self.stores() {
             let path = dir.join(file);

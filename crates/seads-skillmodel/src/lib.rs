@@ -5,6 +5,27 @@
 //!
 //! Architecture invariant: with `seads-rl`, the only crate that links libtorch. Rewards and
 //! relabelling are plain functions on slices, testable without a network.
+//!
+//! # Example: the reward of an episode, and relabelling
+//!
+//! ```
+//! use seads_skillmodel::{RewardConfig, episode_rewards, relabel_assignment};
+//!
+//! // log q(z_T | z_0, k) for K = 3 skills: the effect is best explained by skill 1.
+//! let scores = [-9.0, -0.1, -4.0];
+//! let (clipped, rewards) = episode_rewards(&scores, true, &RewardConfig::default());
+//! // The label that explains the effect earns most, and at least its margin over the runner-up.
+//! assert!(rewards[1] > rewards[0] && rewards[1] > rewards[2]);
+//! assert!(rewards[1] >= clipped[1] - clipped[2]);
+//!
+//! // Two episodes labelled 0 and 1, each better explained by the other's label: relabelling
+//! // swaps them and keeps the multiset of labels.
+//! let clipped = [-5.0, -0.1, /* episode 2: */ -0.2, -6.0];
+//! assert_eq!(relabel_assignment(&clipped, 2, &[0, 1]), vec![1, 0]);
+//! ```
+//!
+//! `cargo run -p seads-skillmodel --example fit` fits a forward model to the LightsOut move table
+//! and measures how often its mode is the true successor.
 
 mod groundtruth;
 mod model;

@@ -10,12 +10,12 @@ use serde::{Deserialize, Serialize};
 pub enum RelabelKind {
     /// One linear assignment over all chosen episodes (SEADS).
     Assignment,
-    /// Each episode independently gets argmax_k C_e[k] (not used in the paper).
+    /// Each episode independently gets `argmax_k C_e[k]` (not used in the paper).
     Max,
 }
 
 /// New labels by assignment (SPEC §3.6): slot i carries label `labels[i]`, column j is episode j,
-/// the cost of giving episode j label `labels[i]` is −C_j[labels[i]]; a minimum-cost assignment
+/// the cost of giving episode j label `labels[i]` is `−C_j[labels[i]]`; a minimum-cost assignment
 /// says which episode receives which label. `clipped` holds the K clipped log-posteriors of each
 /// episode, row-major. The multiset of labels is preserved.
 ///
@@ -134,7 +134,7 @@ fn capacitated_assignment(cost: &[Vec<f64>], capacity: &[usize]) -> Vec<usize> {
     group_of
 }
 
-/// New labels by independent maximisation: argmax_k C_e[k] (first maximum on ties).
+/// New labels by independent maximisation: `argmax_k C_e[k]` (first maximum on ties).
 pub fn relabel_max(clipped: &[f32], k: usize) -> Vec<usize> {
     clipped
         .chunks(k)

@@ -128,7 +128,7 @@ impl Calibration {
         [self.normal.x, self.normal.y, self.normal.z]
     }
 
-    /// Arm coordinates (mm) of normalised screen point (x, y) at height z (clamped to [0,1]³).
+    /// Arm coordinates (mm) of normalised screen point (x, y) at height z (clamped to `[0, 1]³`).
     pub fn to_arm(&self, x: f64, y: f64, z: f64) -> [f64; 3] {
         let (x, y, z) = (x.clamp(0.0, 1.0), y.clamp(0.0, 1.0), z.clamp(0.0, 1.0));
         let h = self.homography * Vector3::new(x, y, 1.0);

@@ -21,7 +21,7 @@ use crate::tablet::Tablet;
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "lowercase")]
 pub enum ActionSpace {
-    /// a = (x, y) ∈ [0,1]²: hover at z = 0.2, press, hover (SPEC §7.3, seed S.5.1).
+    /// `a = (x, y) ∈ [0, 1]²`: hover at z = 0.2, press, hover (SPEC §7.3, seed S.5.1).
     Absolute,
     /// a = (Δx, Δy, p): move at z = 0.3 by at most 0.2 per axis, press when p > 0.6 (the
     /// Cursor in hardware, seed S.5.2).

@@ -11,6 +11,47 @@
 //!   including timeouts, disconnects and malformed replies.
 //!
 //! Architecture invariant: the only crate that opens a serial port.
+//!
+//! # Example: calibrate against the twin and press a field
+//!
+//! ```
+//! use seads_embodiment::Environment;
+//! use seads_uarm::{
+//!     ActionSpace, Calibration, CalibrationFile, DriverConfig, Swift, Twin, UarmConfig, UarmEnv,
+//!     twin_screen_corners,
+//! };
+//!
+//! let twin = Twin::new(3); // an arm and a tablet in this process, seeded
+//! let mut arm = Swift::new(twin.transport(), DriverConfig::default());
+//! // Calibration: the pen is put on the four screen corners by hand and each is read back.
+//! arm.detach()?;
+//! let mut corners = [[0.0; 3]; 4];
+//! for (corner, at) in corners.iter_mut().zip(twin_screen_corners()) {
+//!     twin.move_by_hand(at);
+//!     *corner = arm.position()?;
+//! }
+//! arm.attach()?;
+//! let calibration = Calibration::fit(CalibrationFile { corners, d_max_mm: 100.0 })?;
+//! // The environment: an absolute push at (x, y) on the screen, one step per skill.
+//! let config = UarmConfig {
+//!     action_space: ActionSpace::Absolute,
+//!     step_limit: 1,
+//!     tap_timeout_s: 0.0,
+//!     reset_board: true,
+//! };
+//! let mut env = UarmEnv::new(arm, twin.tablet(), calibration, config)?;
+//! env.seed(1);
+//! env.reset()?;
+//! let before = env.board();
+//! let outcome = env.step(&[0.5, 0.5])?; // the centre of the screen: field 12
+//! assert!(outcome.moved());
+//! assert_ne!(env.board(), before);
+//! assert_eq!(twin.board(), env.board()); // the tablet agrees
+//! # Ok::<(), Box<dyn std::error::Error>>(())
+//! ```
+//!
+//! `cargo run -p seads-uarm --example twin` drives the twin through a calibration and a few
+//! presses, with a fault injected on the wire.
 
 mod calibration;
 mod driver;
