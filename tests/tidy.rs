@@ -275,7 +275,10 @@ fn nothing_uses_libtorchs_global_generator() {
 fn every_environment_has_a_preset() {
     let embedded = read("crates/seads-rl/src/config.rs");
     let envs = seads_embodiment::env_names();
-    assert!(envs.contains(&"lightsout-jaco"), "the Jaco environments are registered");
+    assert!(
+        envs.contains(&"lightsout-jaco"),
+        "the Jaco environments are registered"
+    );
     for env in envs {
         let file = format!("configs/{env}.toml");
         let text = read(&file);
