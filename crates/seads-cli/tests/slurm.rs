@@ -239,12 +239,22 @@ fn a_sweep_runs_as_a_slurm_job_array_and_its_tasks_resume() {
     // Re-queued, task 0 is killed, starts again and resumes its run from the checkpoint.
     let task0 = format!("{array}_0");
     cluster.run("scontrol", &["requeue", &task0]);
-    // Slurm holds a re-queued job for two minutes (its begin time); a test need not wait.
-    until("task 0 is pending again", || {
+    // Slurm holds a re-queued job for two minutes (its begin time), so that the node has
+    // finished cleaning up the killed one; the test waits for that clean-up (no job completing,
+    // the node idle or mixed again) and then lets the job start at once.
+    until("task 0 is pending and its old run cleaned up", || {
         cluster
             .run("scontrol", &["show", "job", &task0])
             .contains("JobState=PENDING")
+            && cluster
+                .run("squeue", &["-h", "-t", "completing"])
+                .trim()
+                .is_empty()
+            && !cluster
+                .run("sinfo", &["-h", "-N", "-o", "%T"])
+                .contains("completing")
     });
+    std::thread::sleep(Duration::from_secs(3));
     cluster.run(
         "scontrol",
         &["update", &format!("JobId={task0}"), "StartTime=now"],

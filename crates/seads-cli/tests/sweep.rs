@@ -225,6 +225,31 @@ fn a_sweep_is_planned_once_run_to_the_end_and_reported() {
     ] {
         assert!(report.join(f).is_file(), "report has {f}");
     }
+    // With --copy-runs the report folder holds the data it rests on (no checkpoints), and the
+    // copy reports to the same table.
+    let copied = tmp.path().join("copied");
+    seads_ok(&["report", s(&sweep), "--out", s(&copied), "--copy-runs"]);
+    let data = copied.join("runs/tiny");
+    assert!(data.join("sweep.json").is_file());
+    assert!(
+        data.join("runs/lightsout-cursor/seads/seed-1/metrics.jsonl")
+            .is_file()
+    );
+    assert!(
+        data.join("runs/lightsout-cursor/seads/seed-1/evaluation-replan.json")
+            .is_file()
+    );
+    assert!(
+        !data
+            .join("runs/lightsout-cursor/seads/seed-1/checkpoints")
+            .exists()
+    );
+    let again = tmp.path().join("again");
+    seads_ok(&["report", s(&data), "--out", s(&again)]);
+    assert_eq!(
+        std::fs::read_to_string(again.join("table1.csv")).unwrap(),
+        std::fs::read_to_string(report.join("table1.csv")).unwrap()
+    );
     // A run outside a sweep can join the report as its own variant.
     seads_ok(&["report", s(&sweep), s(&run), "--out", s(&report)]);
     let md = std::fs::read_to_string(report.join("report.md")).unwrap();

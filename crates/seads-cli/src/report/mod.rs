@@ -28,6 +28,11 @@ pub struct ReportArgs {
     /// The variant the others are tested against (default: the first sweep's reference).
     #[arg(long)]
     reference: Option<String>,
+    /// Also copy what the report rests on into REPORT_DIR/runs/: each run's config.toml,
+    /// metrics.jsonl and evaluation files (never checkpoints), so that the folder can be
+    /// committed as data and reported again from itself.
+    #[arg(long)]
+    copy_runs: bool,
 }
 
 /// Runs `seads report`.
@@ -102,6 +107,35 @@ pub fn report(args: ReportArgs) -> Result<()> {
             .file_name()
             .map_or(String::new(), |n| n.to_string_lossy().into_owned());
         let _ = writeln!(md, "![{name}]({name})\n");
+    }
+    if args.copy_runs {
+        // A sweep's index and manifest come along, so that the copy is a sweep again.
+        for (name, dir) in collection.sweeps.iter().zip(&collection.sweep_dirs) {
+            let dest = args.out.join("runs").join(name);
+            std::fs::create_dir_all(&dest)
+                .with_context(|| format!("creating {}", dest.display()))?;
+            for file in [crate::sweep::INDEX, crate::sweep::MANIFEST] {
+                let bytes = std::fs::read(dir.join(file))
+                    .with_context(|| format!("reading {}", dir.join(file).display()))?;
+                seads_rl::write_atomic(&dest.join(file), &bytes)?;
+            }
+        }
+        for run in &collection.runs {
+            let dest = args.out.join("runs").join(&run.copy_to);
+            std::fs::create_dir_all(&dest)
+                .with_context(|| format!("creating {}", dest.display()))?;
+            for file in runs::data_files(&run.dir)? {
+                let bytes =
+                    std::fs::read(&file).with_context(|| format!("reading {}", file.display()))?;
+                let name = file.file_name().expect("a file has a name");
+                seads_rl::write_atomic(&dest.join(name), &bytes)?;
+            }
+        }
+        let _ = writeln!(
+            md,
+            "The data of every run (configuration, metrics, evaluations; no checkpoints) is in \
+             `runs/`, sweeps with their index: `seads report runs/<sweep> --out …` reports it again.\n"
+        );
     }
     write("report.md", &md)?;
     println!(

@@ -15,6 +15,9 @@ use crate::sweep::Sweep;
 pub struct RunData {
     /// Run directory.
     pub dir: PathBuf,
+    /// Where a copy of its data goes in a report: `<sweep>/<run dir in the sweep>` or, for a
+    /// single run, its directory's name.
+    pub copy_to: PathBuf,
     /// Variant (from the sweep; a single run is named by its directory).
     pub variant: String,
     /// Configuration.
@@ -42,7 +45,7 @@ impl RunData {
         self.metrics.last().map(|m| m.skill_coverage)
     }
 
-    fn load(dir: &Path, variant: String) -> Result<Self> {
+    fn load(dir: &Path, variant: String, copy_to: PathBuf) -> Result<Self> {
         let config = seads_rl::load_config(dir)?;
         let metrics = seads_rl::read_metrics(dir).unwrap_or_default();
         let evaluation = |name: &str| -> Result<Option<Vec<DepthResult>>> {
@@ -57,6 +60,7 @@ impl RunData {
         };
         Ok(Self {
             dir: dir.to_path_buf(),
+            copy_to,
             variant,
             replan: evaluation("evaluation-replan.json")?,
             plan_once: evaluation("evaluation-plan-once.json")?,
@@ -75,6 +79,8 @@ pub struct Collection {
     pub reference: Option<String>,
     /// Names of the sweeps read.
     pub sweeps: Vec<String>,
+    /// Their directories.
+    pub sweep_dirs: Vec<PathBuf>,
 }
 
 /// Reads the sweeps and runs in `inputs`.
@@ -83,23 +89,29 @@ pub fn collect(inputs: &[PathBuf]) -> Result<Collection> {
         runs: Vec::new(),
         reference: None,
         sweeps: Vec::new(),
+        sweep_dirs: Vec::new(),
     };
     for input in inputs {
         if input.join(crate::sweep::INDEX).is_file() {
             let sweep = Sweep::load(input)?;
             for run in &sweep.runs {
-                collection
-                    .runs
-                    .push(RunData::load(&input.join(&run.dir), run.variant.clone())?);
+                collection.runs.push(RunData::load(
+                    &input.join(&run.dir),
+                    run.variant.clone(),
+                    Path::new(&sweep.name).join(&run.dir),
+                )?);
             }
             collection.reference.get_or_insert(sweep.reference.clone());
             collection.sweeps.push(sweep.name);
+            collection.sweep_dirs.push(input.clone());
         } else if input.join("config.toml").is_file() {
             let name = input.file_name().map_or_else(
                 || input.display().to_string(),
                 |n| n.to_string_lossy().into_owned(),
             );
-            collection.runs.push(RunData::load(input, name)?);
+            collection
+                .runs
+                .push(RunData::load(input, name.clone(), PathBuf::from(name))?);
         } else if input.is_dir() {
             bail!(
                 "{} is neither a sweep (sweep.json) nor a run directory (config.toml)",
@@ -167,4 +179,25 @@ pub fn group(runs: &[RunData]) -> Result<(Vec<Group<'_>>, Vec<&RunData>)> {
         }
     }
     Ok((groups, unfinished))
+}
+
+/// The files of a run that results rest on (small; never checkpoints): its configuration,
+/// metrics and evaluations.
+pub fn data_files(run: &Path) -> Result<Vec<PathBuf>> {
+    let mut files = Vec::new();
+    for entry in std::fs::read_dir(run).with_context(|| format!("reading {}", run.display()))? {
+        let path = entry?.path();
+        let name = path
+            .file_name()
+            .map_or(String::new(), |n| n.to_string_lossy().into_owned());
+        let wanted = name == "config.toml"
+            || name == "metrics.jsonl"
+            || (name.starts_with("evaluation")
+                && (name.ends_with(".json") || name.ends_with(".jsonl")));
+        if wanted && path.is_file() {
+            files.push(path);
+        }
+    }
+    files.sort();
+    Ok(files)
 }

@@ -14,7 +14,7 @@ use anyhow::{Context, Result, anyhow};
 use clap::{Args, Subcommand};
 use serde::Serialize;
 
-pub use index::{INDEX, Sweep};
+pub use index::{INDEX, MANIFEST, Sweep};
 pub use manifest::Manifest;
 pub use state::Status;
 
