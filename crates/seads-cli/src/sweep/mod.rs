@@ -51,6 +51,14 @@ pub struct PlanArgs {
     out: PathBuf,
 }
 
+/// A count that must be at least 1 (workers, cores): 0 is a one-line usage error.
+fn at_least_one(option: &str, value: u64) -> Result<usize> {
+    if value == 0 {
+        return Err(BadInput(anyhow!("{option} must be at least 1")).into());
+    }
+    Ok(value as usize)
+}
+
 fn cores() -> usize {
     std::thread::available_parallelism().map_or(1, |n| n.get())
 }
@@ -62,10 +70,10 @@ pub struct RunArgs {
     dir: PathBuf,
     /// Runs trained at once. Each gets an equal share of the cores (a run trains on two threads,
     /// so the default gives each two cores; --workers 2 on two cores gives each one).
-    #[arg(long, value_parser = clap::value_parser!(u64).range(1..))]
+    #[arg(long)]
     workers: Option<u64>,
     /// Cores to share among the workers (default: all of this machine's).
-    #[arg(long, value_parser = clap::value_parser!(u64).range(1..))]
+    #[arg(long)]
     cores: Option<u64>,
     /// No progress bar.
     #[arg(long)]
@@ -81,7 +89,7 @@ pub struct TaskArgs {
     #[arg(long)]
     index: usize,
     /// Cores of this task; its libtorch threads follow them (Slurm: $SLURM_CPUS_PER_TASK).
-    #[arg(long, default_value_t = 2, value_parser = clap::value_parser!(u64).range(1..))]
+    #[arg(long, default_value_t = 2)]
     cores: u64,
     /// Started by `seads sweep run`: die with the parent.
     #[arg(long, hide = true)]
@@ -100,10 +108,10 @@ pub struct SlurmArgs {
     #[arg(long, default_value = "04:00:00")]
     time: String,
     /// Cores per task; the task's libtorch threads follow them.
-    #[arg(long, default_value_t = 2, value_parser = clap::value_parser!(u64).range(1..))]
+    #[arg(long, default_value_t = 2)]
     cpus_per_task: u64,
     /// At most this many tasks at once (the array's %M throttle).
-    #[arg(long, value_parser = clap::value_parser!(u64).range(1..))]
+    #[arg(long)]
     max_parallel: Option<u64>,
     /// The seads binary the tasks run (default: this one; it must be reachable from the nodes).
     #[arg(long)]
@@ -128,15 +136,21 @@ pub fn run(command: SweepCommand) -> Result<()> {
     match command {
         SweepCommand::Plan(args) => plan(args),
         SweepCommand::Run(args) => {
-            let cores = args.cores.map_or_else(cores, |c| c as usize);
-            let workers = args.workers.map_or((cores / 2).max(1), |w| w as usize);
+            let cores = match args.cores {
+                Some(c) => at_least_one("--cores", c)?,
+                None => cores(),
+            };
+            let workers = match args.workers {
+                Some(w) => at_least_one("--workers", w)?,
+                None => (cores / 2).max(1),
+            };
             pool::run_sweep(&args.dir, workers, cores, args.quiet)
         }
         SweepCommand::Task(args) => {
             if args.child {
                 die_with_parent();
             }
-            task::run_task(&args.dir, args.index, args.cores as usize)
+            task::run_task(&args.dir, args.index, at_least_one("--cores", args.cores)?)
         }
         SweepCommand::Slurm(args) => slurm(args),
         SweepCommand::Status(args) => status(args),
@@ -189,8 +203,11 @@ fn slurm(args: SlurmArgs) -> Result<()> {
     let options = slurm::SlurmOptions {
         partition: args.partition,
         time: args.time,
-        cpus_per_task: args.cpus_per_task as usize,
-        max_parallel: args.max_parallel.map(|m| m as usize),
+        cpus_per_task: at_least_one("--cpus-per-task", args.cpus_per_task)?,
+        max_parallel: args
+            .max_parallel
+            .map(|m| at_least_one("--max-parallel", m))
+            .transpose()?,
         seads,
     };
     let (array, report) = slurm::write_scripts(&dir, &sweep, &options)?;

@@ -46,6 +46,7 @@ pub fn run_sweep(dir: &Path, workers: usize, cores: usize, quiet: bool) -> Resul
             Status::Failed | Status::Pending => todo.push(i),
         }
     }
+    let workers = workers.max(1);
     let per_task = (cores / workers).max(1);
     println!(
         "sweep {:?}: {} runs, {} to train or resume, {skipped_running} running elsewhere; {workers} worker(s) × {per_task} core(s)",
