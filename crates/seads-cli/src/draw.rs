@@ -7,7 +7,7 @@ use anyhow::Result;
 use plotters::coord::Shift;
 use plotters::coord::types::RangedCoordf64;
 use plotters::prelude::*;
-use seads_embodiment::{Scene, Shape, SkillRun};
+use seads_embodiment::{FieldView, Scene, Shape, SkillRun};
 
 /// A chart in board coordinates.
 pub type BoardChart<'a, DB> = ChartContext<'a, DB, Cartesian2d<RangedCoordf64, RangedCoordf64>>;
@@ -183,10 +183,67 @@ where
 
 /// Renders a scene to a PNG or SVG file (by extension).
 pub fn render_scene(scene: &Scene, title: &str, out: &std::path::Path) -> Result<()> {
-    render_to!(out, (600, 640), |area: &DrawingArea<_, Shift>| draw_scene(
-        area, scene, title, 18, true
-    )
-    .map(|_| ()))
+    let flat = scene
+        .fields
+        .iter()
+        .all(|f| (f.height - scene.fields[0].height).abs() < 1e-9);
+    if flat {
+        return render_to!(out, (600, 640), |area: &DrawingArea<_, Shift>| draw_scene(
+            area, scene, title, 18, true
+        )
+        .map(|_| ()));
+    }
+    // Fields of different heights (LightsOut3DJaco): the top view and, below it, a side view
+    // of the cross-section through the middle row, so that raised and recessed fields show.
+    render_to!(out, (600, 880), |area: &DrawingArea<_, Shift>| {
+        let (top, side) = area.split_vertically(640);
+        draw_scene(&top, scene, title, 18, true)?;
+        draw_section(&side, scene)
+    })
+}
+
+/// The side view of the fields whose centre lies in the middle row, heights in centimetres.
+fn draw_section<DB: DrawingBackend>(area: &DrawingArea<DB, Shift>, scene: &Scene) -> Result<()> {
+    let centre_v = |f: &FieldView| (f.rect[1] + f.rect[3]) / 2.0;
+    let middle = scene
+        .fields
+        .iter()
+        .map(centre_v)
+        .min_by(|a, b| (a - 0.5).abs().total_cmp(&(b - 0.5).abs()))
+        .unwrap_or(0.5);
+    let row: Vec<&FieldView> = scene
+        .fields
+        .iter()
+        .filter(|f| (centre_v(f) - middle).abs() < 1e-6)
+        .collect();
+    let top = row.iter().map(|f| f.height * 100.0).fold(0.0, f64::max) * 1.25 + 0.5;
+    let mut chart = ChartBuilder::on(area)
+        .caption("side view: the middle row's fields", ("sans-serif", 15))
+        .margin(10)
+        .x_label_area_size(30)
+        .y_label_area_size(50)
+        .build_cartesian_2d(0.0..1.0, 0.0..top)
+        .map_err(plot_err)?;
+    chart
+        .configure_mesh()
+        .disable_x_mesh()
+        .x_desc("position across the board")
+        .y_desc("height (cm)")
+        .draw()
+        .map_err(plot_err)?;
+    chart
+        .draw_series(row.iter().map(|f| {
+            let colour = if f.lit == Some(true) { LIT } else { UNLIT };
+            Rectangle::new(
+                [
+                    (f.rect[0] + 0.005, 0.0),
+                    (f.rect[2] - 0.005, f.height * 100.0),
+                ],
+                colour.filled(),
+            )
+        }))
+        .map_err(plot_err)?;
+    Ok(())
 }
 
 /// The board before solving with the paths of the executed skills (`seads solve --render`).

@@ -218,6 +218,18 @@ fn render_writes_png_and_svg() {
             assert!(text.contains("<svg") && text.contains("lightsout-reacher"));
         }
     }
+    // LightsOut3DJaco's raised and recessed fields get a side view under the top view.
+    let png_height = |path: &std::path::Path| {
+        let bytes = std::fs::read(path).unwrap();
+        u32::from_be_bytes(bytes[20..24].try_into().unwrap())
+    };
+    let (flat, stairs) = (dir.path().join("flat.png"), dir.path().join("stairs.png"));
+    seads_ok(&["render", "--env", "lightsout-jaco", "--out", s(&flat)]);
+    seads_ok(&["render", "--env", "lightsout3d-jaco", "--out", s(&stairs)]);
+    assert_eq!((png_height(&flat), png_height(&stairs)), (640, 880));
+    let svg = dir.path().join("stairs.svg");
+    seads_ok(&["render", "--env", "lightsout3d-jaco", "--out", s(&svg)]);
+    assert!(std::fs::read_to_string(&svg).unwrap().contains("side view"));
     check_bad_input(
         &["render", "--env", "lightsout-robot", "--out", "x.png"],
         "valid environments: lightsout-cursor",

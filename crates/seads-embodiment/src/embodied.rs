@@ -104,6 +104,10 @@ pub trait Manipulator: Clone + Send + Sync + 'static {
     fn end_effector(&self) -> [f64; 2];
     /// Draws the manipulator and widens `extent` to what it can reach.
     fn draw(&self, shapes: &mut Vec<Shape>, extent: &mut [f64; 4]);
+    /// Heights of the fields' top surfaces above the table, row-major, metres (empty: flat).
+    fn field_heights(&self) -> Vec<f64> {
+        Vec::new()
+    }
 }
 
 /// A manipulator `M` in front of a board: implements [`Environment`] for every embodiment.
@@ -278,22 +282,29 @@ impl<M: Manipulator> Environment for Embodied<M> {
         let game = self.board.game();
         let board = self.board.board();
         let values = game.values(board);
+        let heights = self.manipulator.field_heights();
         let fields = self
             .layout
             .fields()
             .into_iter()
             .zip(values)
-            .map(|(rect, v)| match self.spec.game {
-                seads_games::GameKind::LightsOut => FieldView {
-                    rect,
-                    lit: Some(v == 1),
-                    label: None,
-                },
-                seads_games::GameKind::TileSwap => FieldView {
-                    rect,
-                    lit: None,
-                    label: Some(v.to_string()),
-                },
+            .enumerate()
+            .map(|(i, (rect, v))| {
+                let height = heights.get(i).copied().unwrap_or(0.0);
+                match self.spec.game {
+                    seads_games::GameKind::LightsOut => FieldView {
+                        rect,
+                        lit: Some(v == 1),
+                        label: None,
+                        height,
+                    },
+                    seads_games::GameKind::TileSwap => FieldView {
+                        rect,
+                        lit: None,
+                        label: Some(v.to_string()),
+                        height,
+                    },
+                }
             })
             .collect();
         let mut scene = Scene {

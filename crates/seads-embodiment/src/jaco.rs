@@ -748,6 +748,10 @@ impl Manipulator for Jaco {
         [((x + w / 2.0) / w) as f64, (1.0 - (y + w / 2.0) / w) as f64]
     }
 
+    fn field_heights(&self) -> Vec<f64> {
+        self.fields.iter().map(|&(_, top)| f64::from(top)).collect()
+    }
+
     fn draw(&self, shapes: &mut Vec<Shape>, extent: &mut [f64; 4]) {
         // Top view: links projected on the board plane, board coordinates with the y flip.
         let w = 2.0 * self.board.half_width();

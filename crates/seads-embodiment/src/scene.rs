@@ -14,6 +14,9 @@ pub struct FieldView {
     pub lit: Option<bool>,
     /// TileSwap: the tile number shown on the field.
     pub label: Option<String>,
+    /// Height of the field's top surface above the table, metres (0 where the board is flat;
+    /// LightsOut3DJaco raises the fields by their distance from the centre).
+    pub height: f64,
 }
 
 /// A primitive of the manipulator drawing.

@@ -94,6 +94,31 @@ fn press(env: &mut dyn Environment, seed: u64, target: [f32; 2], top: f32) -> Op
     None
 }
 
+/// The scene reports the fields' heights: LightsOut3DJaco's rise from the centre (2, 6 and
+/// 10 cm tops: half-heights 1, 3 and 5 cm by Chebyshev distance), the flat board's are equal.
+#[test]
+fn scenes_carry_the_fields_heights() {
+    let heights = |name: &str| -> Vec<f64> {
+        let env = make_env(name, &EnvConfig::default()).unwrap();
+        env.scene().fields.iter().map(|f| f.height).collect()
+    };
+    let stairs = heights("lightsout3d-jaco");
+    assert_eq!(stairs.len(), 25);
+    for (i, h) in stairs.iter().enumerate() {
+        let ring = (i / 5).abs_diff(2).max((i % 5).abs_diff(2));
+        let expected = [0.02, 0.06, 0.10][ring];
+        assert!(
+            (h - expected).abs() < 1e-6,
+            "field {i}: {h} m, expected {expected}"
+        );
+    }
+    assert!(
+        heights("lightsout-jaco")
+            .iter()
+            .all(|&h| (h - 0.02).abs() < 1e-6)
+    );
+}
+
 #[test]
 fn forward_kinematics_matches_the_observed_pinch_site() {
     let mut env = make_env("lightsout-jaco", &EnvConfig::default()).unwrap();

@@ -340,6 +340,7 @@ impl Environment for UarmEnv {
                 rect,
                 lit: Some(hw.board.get(d)),
                 label: None,
+                height: 0.0,
             })
             .collect();
         Scene {
