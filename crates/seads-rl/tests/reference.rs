@@ -115,3 +115,61 @@ fn one_update_matches_pytorch() {
     }
     assert_eq!(compared, 8 + 12 + 12);
 }
+
+/// RelaxedBernoulli (HAC's subgoal policy) against torch.distributions.RelaxedBernoulli:
+/// reparameterised samples from the same uniforms, their gradient in the logits, and
+/// log-densities (data/reference/relaxed_bernoulli.safetensors, written by
+/// scripts/reference/relaxed_bernoulli.py).
+#[test]
+fn relaxed_bernoulli_matches_pytorch() {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../../data/reference/relaxed_bernoulli.safetensors");
+    let data = Tensor::read_safetensors(path).unwrap();
+    let close = |ours: &Tensor, theirs: &Tensor, what: &str, tol: f32| {
+        let (a, b) = (floats(ours), floats(theirs));
+        assert_eq!(a.len(), b.len(), "{what}");
+        for (i, (x, y)) in a.iter().zip(&b).enumerate() {
+            assert!(
+                (x - y).abs() <= tol * (1.0 + y.abs()),
+                "{what}[{i}]: {x} against PyTorch's {y}"
+            );
+        }
+    };
+    for (name, temperature) in [("t01", 0.1), ("t05", 0.5)] {
+        let logits = get(&data, "logits").copy().set_requires_grad(true);
+        let dist = seads_rl::RelaxedBernoulli::new(temperature, logits.shallow_clone());
+        let sample = dist.rsample_with(get(&data, &format!("{name}.uniforms")));
+        close(
+            &sample,
+            get(&data, &format!("{name}.sample")),
+            &format!("{name} sample"),
+            1e-5,
+        );
+        sample.sum(tch::Kind::Float).backward();
+        close(
+            &logits.grad(),
+            get(&data, &format!("{name}.sample_grad")),
+            &format!("{name} d sample / d logits"),
+            1e-4,
+        );
+        let at_sample = dist.log_prob(&get(&data, &format!("{name}.sample")).detach());
+        close(
+            &at_sample.detach(),
+            get(&data, &format!("{name}.log_prob_sample")),
+            &format!("{name} log-density at the samples"),
+            1e-4,
+        );
+        let at_values = dist.log_prob(get(&data, "values"));
+        close(
+            &at_values.detach(),
+            get(&data, &format!("{name}.log_prob_values")),
+            &format!("{name} log-density at fixed values"),
+            1e-5,
+        );
+        // The deterministic action thresholds the probability at 0.5.
+        assert_eq!(
+            floats(&dist.mode()),
+            floats(&get(&data, "logits").gt(0.0).to_kind(tch::Kind::Float))
+        );
+    }
+}
