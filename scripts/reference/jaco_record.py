@@ -60,6 +60,8 @@ for e in range(40):
     env.seed(e) if hasattr(env, 'seed') else None
     rng = np.random.default_rng(1000 + e)
     env.reset()
+    # Seeding rebuilds the dm_control environment: take the live one.
+    dm = env._gym_env._env
     physics = dm.physics
     ep = {
         'kind': 'random' if e < 20 else 'constant',

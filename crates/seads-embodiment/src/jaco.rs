@@ -429,6 +429,12 @@ impl Jaco {
     }
 
     /// Puts the joints at `q` (in `LINKS` order) at rest and updates every body pose.
+    /// Puts the arm at rest at joint positions `q` (6 arm joints, 3 fingers, radians), e.g. a
+    /// state recorded from the reference simulation; the servo commands stay as they are.
+    pub fn set_joint_positions(&mut self, q: &[f32; 9]) {
+        self.set_joints(q);
+    }
+
     fn set_joints(&mut self, q: &[f32; 9]) {
         let (current, _) = self.joints();
         let dofs: Vec<usize> = (0..LINKS.len()).map(|i| self.dof(i)).collect();
