@@ -1,16 +1,18 @@
-"""Records reference trajectories of LightsOutJaco from the authors' environment
-(EmbodiedVision/seads-environments, run unmodified except for one shim: the board's contact
-cache, which read mujoco-py's structured contact array, copies the same fields from the
-`mujoco` bindings' contact list).
+"""Records reference trajectories of the Jaco environments from the authors' code
+(EmbodiedVision/seads-environments: LightsOutJaco, LightsOutJaco with stairs = LightsOut3D,
+TileSwapJaco), run unmodified except for one shim: the boards' contact cache, which read
+mujoco-py's structured contact array, copies the same fields from the `mujoco` bindings'
+contact list.
 
-Per episode: the reset joint positions and board; per step: the action (9 servo commands in
-[-1, 1]), the joint positions after the step (6 arm joints, 3 fingers), the pinch site's world
-position (and the grip site's, the tool centre point), and the pressed field (row-major index, -1 for none). Also the world positions of the
-25 field sites, so that a test can align frames.
+Per episode: the reset joint positions; per step: the action (9 servo commands in [-1, 1]), the
+joint positions after the step (6 arm joints, 3 fingers), the pinch and grip sites' world
+positions, and the press (LightsOut: the field, row-major; TileSwap: the swapped cells a < b as
+a·9 + b; -1 for none) with its normalised board position. Also the world positions of the
+board's sites (LightsOut: the 25 field centres; TileSwap: the board centre).
 
-Episodes: 20 under uniformly random actions, 20 of joint-space reaching (one random servo
-command held for the whole episode, which the servos reach), 50 steps each, or until a press
-ends the episode; actions drawn from NumPy generators seeded 1000 + episode.
+Episodes: 20 under uniformly random actions, 20 holding one random servo command (which the
+servos reach), 50 steps each or until a press ends the episode; actions drawn from NumPy
+generators seeded 1000 + episode; environment seeds 0..39.
 
 The scratch environment it ran in (2026-11-24; nothing of it is a dependency of the project):
     python3 -m venv /tmp/mjenv
@@ -20,8 +22,10 @@ The scratch environment it ran in (2026-11-24; nothing of it is a dependency of 
     # /tmp/seadsenv; their board files are Git LFS objects, so they were regenerated with that
     # repository's own seads_envs/board_games/bfs_reverse.py (store_boards; LightsOut to depth
     # 6, TileSwap complete).
-    MUJOCO_GL=disable /tmp/mjenv/bin/python scripts/reference/jaco_record.py \
-        data/reference/jaco/lightsout_jaco.json
+    for board in lightsout lightsout3d tileswap; do
+        MUJOCO_GL=disable /tmp/mjenv/bin/python scripts/reference/jaco_record.py \
+            data/reference/jaco/${board}_jaco.json $board
+    done
 """
 import json
 import sys
@@ -50,9 +54,19 @@ def before_substep(self, physics, random_state):
 
 
 lightsout_board.LightsOutBoard.before_substep = before_substep
-from seads_envs.hybrid.jaco.lightsout import LightsOutJacoEnv  # noqa: E402
+from seads_envs.hybrid.jaco import tileswap_board  # noqa: E402
 
-env = LightsOutJacoEnv(reset_split='train', max_solution_depth=5, random_solution_depth=True)
+tileswap_board.TileSwapBoard.before_substep = before_substep
+from seads_envs.hybrid.jaco.lightsout import LightsOutJacoEnv  # noqa: E402
+from seads_envs.hybrid.jaco.tileswap import TileSwapJacoEnv  # noqa: E402
+
+board = sys.argv[2] if len(sys.argv) > 2 else 'lightsout'
+if board == 'tileswap':
+    env = TileSwapJacoEnv(reset_split='train', max_solution_depth=5, random_solution_depth=True)
+else:
+    env = LightsOutJacoEnv(reset_split='train', max_solution_depth=5, random_solution_depth=True,
+                           stairs=(board == 'lightsout3d'))
+side = 3 if board == 'tileswap' else 5
 dm = env._gym_env._env
 r6 = lambda a: [round(float(x), 6) for x in a]
 episodes = []
@@ -76,8 +90,12 @@ for e in range(40):
         _, _, done, info = env.step(action.astype(np.float32))
         c = info.get('contact_info')
         pressed = -1
-        if c is not None:
+        if c is not None and board != 'tileswap':
             pressed = int(c.row) * 5 + int(c.col)
+        elif c is not None:
+            # TileSwap: the swapped pair of cells (row-major), as one number a * 9 + b, a < b.
+            a, b = sorted(int(i[0]) * 3 + int(i[1]) for i in c.swap_indices)
+            pressed = a * 9 + b
         ep['steps'].append({
             'action': r6(action),
             'qpos': r6(physics.data.qpos[:9]),
@@ -92,11 +110,13 @@ for e in range(40):
     episodes.append(ep)
     print(e, ep['kind'], len(ep['steps']), 'pressed', [s['pressed'] for s in ep['steps'] if s['pressed'] >= 0], flush=True)
 
-fields = [r6(dm.physics.named.data.site_xpos[f'checkerboard/{r}_{c}']) for r in range(5) for c in range(5)]
+site_names = [dm.physics.model.id2name(i, 'site') for i in range(dm.physics.model.nsite)]
+fields = [r6(dm.physics.named.data.site_xpos[n]) for n in site_names if not n.startswith('jaco_arm')]
 import mujoco, dm_control
 out = {
     'made_with': {'mujoco': mujoco.__version__, 'dm_control': dm_control.__version__ if hasattr(dm_control, '__version__') else '1.0.50',
                   'physics_timestep': dm.physics.timestep(), 'control_timestep': dm.control_timestep()},
+    'board': board,
     'field_sites': fields,
     'episodes': episodes,
 }
