@@ -77,14 +77,22 @@ pub fn report(args: ReportArgs) -> Result<()> {
         collection.runs.len() - unfinished.len(),
         unfinished.len()
     );
+    let mut not_started = 0;
     for run in &unfinished {
         let steps = run.metrics.last().map_or(0, |m| m.env_steps);
+        if steps == 0 {
+            not_started += 1;
+            continue;
+        }
         let _ = writeln!(
             md,
             "- unfinished: `{}` ({steps} of {} steps)",
             run.dir.display(),
             run.config.env_steps
         );
+    }
+    if not_started > 0 {
+        let _ = writeln!(md, "- not started: {not_started} run(s)");
     }
     if !unfinished.is_empty() {
         md.push('\n');
