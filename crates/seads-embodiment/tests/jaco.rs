@@ -256,7 +256,7 @@ fn joint_trajectories_follow_the_reference_simulation() {
 
 /// Presses under the reference's actions on the LightsOut boards: on how many steps our Jaco
 /// presses the same field as MuJoCo's (or, like it, none), and which of the reference's presses
-/// it reproduces. (TileSwap's presses are pivot positions, not compared yet.)
+/// it reproduces. (TileSwap: `tileswap_touches_agree_with_the_reference_simulation`.)
 #[test]
 fn presses_agree_with_the_reference_simulation() {
     let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(0);
@@ -308,6 +308,63 @@ fn presses_agree_with_the_reference_simulation() {
             assert!(fraction > 0.97, "{name}: {fraction}");
         }
     }
+}
+
+/// TileSwap's presses under the reference's actions: the touch (a position on the board, which
+/// the layout turns into a swap) on the same steps, at the same place.
+#[test]
+fn tileswap_touches_agree_with_the_reference_simulation() {
+    let (_, board, data) = references()
+        .into_iter()
+        .find(|(name, _, _)| *name == "tileswap")
+        .unwrap();
+    let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(0);
+    let (mut steps, mut agree) = (0usize, 0usize);
+    let mut touches = Vec::new();
+    for episode in data["episodes"].as_array().unwrap() {
+        let q0 = floats(&episode["qpos0"]);
+        let mut jaco = Jaco::new(board, 50);
+        jaco.set_joint_positions(&q0.clone().try_into().unwrap());
+        for step in episode["steps"].as_array().unwrap() {
+            let mut ours: Option<[f64; 2]> = None;
+            let mut touch = |touch: Touch| {
+                if let (Touch::At { u, v }, None) = (touch, ours) {
+                    ours = Some([u, v]);
+                }
+                Push::None
+            };
+            assert!(jaco.step(&floats(&step["action"]), &mut rng, &mut touch));
+            let theirs = step["contact"]
+                .as_array()
+                .map(|c| [c[0].as_f64().unwrap(), c[1].as_f64().unwrap()]);
+            steps += 1;
+            let same = match (ours, theirs) {
+                (None, None) => true,
+                (Some(a), Some(b)) => (a[0] - b[0]).hypot(a[1] - b[1]) < 0.05,
+                _ => false,
+            };
+            agree += usize::from(same);
+            if theirs.is_some() {
+                touches.push((episode["seed"].as_u64().unwrap(), theirs, ours));
+            }
+        }
+    }
+    let fraction = agree as f64 / steps as f64;
+    eprintln!(
+        "tileswap-jaco vs reference: the same touch (within 5 % of the board) or none on {agree} of {steps} steps ({:.1} %); the reference's touches (episode, theirs, ours): {touches:?}",
+        100.0 * fraction
+    );
+    assert!(!touches.is_empty());
+    // Measured: 99.2 %; both reference touches reproduced. The reference reports only touches
+    // inside a swap region, ours every touch of the board, which accounts for the rest.
+    assert!(fraction > 0.99, "{fraction}");
+    assert!(
+        touches.iter().all(|(_, t, o)| o.is_some_and(|o| {
+            let t = t.expect("a reference touch");
+            (o[0] - t[0]).hypot(o[1] - t[1]) < 0.05
+        })),
+        "{touches:?}"
+    );
 }
 
 #[test]
