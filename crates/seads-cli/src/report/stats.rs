@@ -3,7 +3,7 @@
 //! at p < 0.01), as SciPy's `mannwhitneyu(variant, reference, alternative="less")` computes
 //! it with `method="auto"`: the exact null distribution when a sample holds at most 8 values
 //! and there are no ties, else the normal approximation with tie and continuity correction.
-//! (statrs 0.19's `mannwhitneyu` returns 1 − p for the exact one-sided test, so only its
+//! (statrs 0.19's `mannwhitneyu` gives 1 − SciPy's p for the exact one-sided test, so only its
 //! `erfc` is used here.) Checked against SciPy's values in `data/reference/mannwhitneyu.json`.
 
 use statrs::function::erf::erfc;
