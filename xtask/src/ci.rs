@@ -5,7 +5,7 @@ use std::process::{Command, Stdio};
 
 use anyhow::{Context, Result, bail};
 
-use crate::{root, setup, step, step_with_env};
+use crate::{PACKAGE, root, setup, step, step_with_env};
 
 /// Set-up, formatting, lints (warnings are errors), then every test of every crate, the
 /// integration tests under `tests/` and the benches in test mode (each bench runs once). Ends
@@ -35,16 +35,7 @@ pub fn run() -> Result<()> {
     // `cargo xtask package` verifies them.
     step(
         "cargo",
-        &[
-            "package",
-            "--workspace",
-            "--exclude",
-            "xtask",
-            "--exclude",
-            "seads-tests",
-            "--no-verify",
-            "--allow-dirty",
-        ],
+        &[&PACKAGE[..], &["--no-verify", "--allow-dirty"]].concat(),
     )?;
     let mut totals = Totals::default();
     test(&["test", "--workspace", "--doc"], &mut totals)?;

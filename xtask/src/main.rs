@@ -26,20 +26,9 @@ fn main() -> ExitCode {
         Some("run") => run_main_job(&args[1..]),
         Some("ci") => ci::run(),
         Some("setup") => setup(),
-        Some("package") => setup().and_then(|()| {
-            step(
-                "cargo",
-                &[
-                    "package",
-                    "--workspace",
-                    "--exclude",
-                    "xtask",
-                    "--exclude",
-                    "seads-tests",
-                    "--allow-dirty",
-                ],
-            )
-        }),
+        Some("package") => {
+            setup().and_then(|()| step("cargo", &[&PACKAGE[..], &["--allow-dirty"]].concat()))
+        }
         Some("gen-splits") => gen_splits::run(&root()),
         Some("help" | "--help" | "-h") | None => {
             print!("{HELP}");
@@ -68,6 +57,16 @@ fn root() -> PathBuf {
 }
 
 /// Runs a command in the repository root and fails if it fails.
+/// `cargo package` of every library crate (the workspace without xtask and the tests crate).
+const PACKAGE: [&str; 6] = [
+    "package",
+    "--workspace",
+    "--exclude",
+    "xtask",
+    "--exclude",
+    "seads-tests",
+];
+
 fn step(program: &str, args: &[&str]) -> Result<()> {
     step_with_env(program, args, &[])
 }
