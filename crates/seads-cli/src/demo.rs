@@ -76,7 +76,10 @@ pub fn run(args: RunArgs) -> Result<()> {
         seeds: seeds.clone(),
         split: Split::Test,
         replan,
-        timeout: args.timeout,
+        limits: crate::plan::SearchLimits {
+            timeout: args.timeout,
+            max_expanded: None,
+        },
     };
     let replan = run_evaluation(&mut agent, &args.out, tasks(true), false)?;
     let once = run_evaluation(&mut agent, &args.out, tasks(false), false)?;

@@ -14,7 +14,7 @@ use seads_rl::Agent;
 use serde::{Deserialize, Serialize};
 
 use crate::BadInput;
-use crate::plan::{Tasks, evaluate_agent};
+use crate::plan::{SearchLimits, Tasks, evaluate_agent};
 
 /// The file, in the run directory.
 pub const FILE: &str = "evaluation-over-training.jsonl";
@@ -32,6 +32,9 @@ pub struct CheckpointEvaluation {
     pub boards: usize,
     /// Seconds per search.
     pub timeout_s: f64,
+    /// States expanded per search, if bounded.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub max_expanded: Option<usize>,
     /// Per depth.
     pub results: Vec<DepthResult>,
 }
@@ -108,7 +111,7 @@ pub fn evaluate_checkpoints(
     selection: Selection,
     depths: &[usize],
     boards: usize,
-    timeout: f64,
+    limits: SearchLimits,
     quiet: bool,
 ) -> Result<usize> {
     let config =
@@ -161,7 +164,7 @@ pub fn evaluate_checkpoints(
             seeds: seeds.clone(),
             split: seads_games::Split::Test,
             replan: *replan,
-            timeout,
+            limits,
         };
         let results = evaluate_agent(agent, &tasks, &bar)?;
         let line = CheckpointEvaluation {
@@ -169,7 +172,8 @@ pub fn evaluate_checkpoints(
             env_steps: env_steps_at(run, &metrics, *epoch, dir)?,
             replan: *replan,
             boards,
-            timeout_s: timeout,
+            timeout_s: limits.timeout,
+            max_expanded: limits.max_expanded,
             results,
         };
         append_line(&path, &serde_json::to_string(&line)?)?;

@@ -189,6 +189,10 @@ pub struct EvaluateArgs {
     /// Time limit per search, seconds (the authors' evaluation used 60).
     #[arg(long, default_value_t = 60.0, value_parser = crate::positive_finite)]
     timeout: f64,
+    /// Also stop each search after expanding this many states: a limit that, unlike the clock,
+    /// gives the same results on every machine.
+    #[arg(long, value_parser = clap::value_parser!(u64).range(1..))]
+    max_expanded: Option<u64>,
     /// Print JSON.
     #[arg(long)]
     json: bool,
@@ -207,6 +211,15 @@ pub fn task_seeds(boards: usize, seed: Option<u64>) -> Vec<u64> {
     }
 }
 
+/// Limits of each search of an evaluation.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct SearchLimits {
+    /// Seconds per search.
+    pub timeout: f64,
+    /// States expanded per search (`None`: no bound).
+    pub max_expanded: Option<usize>,
+}
+
 /// The tasks of an evaluation.
 pub struct Tasks {
     /// Solution depths.
@@ -217,8 +230,8 @@ pub struct Tasks {
     pub split: Split,
     /// Re-plan on deviations.
     pub replan: bool,
-    /// Seconds per search.
-    pub timeout: f64,
+    /// Limits of each search.
+    pub limits: SearchLimits,
 }
 
 /// Evaluates the agent on `tasks`, advancing `bar` by one per task.
@@ -236,7 +249,8 @@ pub fn evaluate_agent(
         solve: SolveConfig {
             replan: tasks.replan,
             planner: PlannerConfig {
-                timeout_s: Some(tasks.timeout),
+                timeout_s: Some(tasks.limits.timeout),
+                max_expanded: tasks.limits.max_expanded,
                 ..PlannerConfig::default()
             },
             ..SolveConfig::default()
@@ -283,6 +297,12 @@ pub fn run_evaluation(
 /// `seads evaluate`.
 pub fn evaluate_run(args: EvaluateArgs) -> Result<()> {
     let depths = parse_depths(&args.depths)?;
+    let limits = SearchLimits {
+        timeout: args.timeout,
+        max_expanded: args
+            .max_expanded
+            .map(|m| m.try_into().unwrap_or(usize::MAX)),
+    };
     if args.boards == 0 {
         bail!(BadInput(anyhow::anyhow!("--boards must be at least 1")));
     }
@@ -292,7 +312,7 @@ pub fn evaluate_run(args: EvaluateArgs) -> Result<()> {
             selection,
             &depths,
             args.boards,
-            args.timeout,
+            limits,
             args.json,
         )?;
         let lines = crate::overtraining::read(&args.run)?;
@@ -329,7 +349,7 @@ pub fn evaluate_run(args: EvaluateArgs) -> Result<()> {
         seeds,
         split: args.split,
         replan: args.replan,
-        timeout: args.timeout,
+        limits,
     };
     let results = run_evaluation(&mut agent, &args.run, tasks, args.json)?;
     let summary = summarise(&results);

@@ -154,7 +154,10 @@ fn evaluations(
             seeds: task_seeds(boards, None),
             split: Split::Test,
             replan,
-            timeout,
+            limits: crate::plan::SearchLimits {
+                timeout,
+                max_expanded: None,
+            },
         };
         run_evaluation(agent, run, tasks, quiet)
     };

@@ -28,7 +28,8 @@ skill_model = { hidden = [32, 32] }
 
 [evaluation]
 boards = 1
-timeout = 0.2
+timeout = 600
+max_expanded = 2000
 
 [[variant]]
 name = "seads"

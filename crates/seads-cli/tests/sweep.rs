@@ -56,7 +56,9 @@ skill_model = { hidden = [32, 32] }
 [evaluation]
 every = 2
 boards = 1
-timeout = 0.2
+# A state budget, not the clock, bounds each search: results must not depend on the load.
+timeout = 600
+max_expanded = 2000
 
 [[variant]]
 name = "seads"
@@ -177,7 +179,9 @@ fn a_sweep_is_planned_once_run_to_the_end_and_reported() {
         "--boards",
         "1",
         "--timeout",
-        "0.2",
+        "600",
+        "--max-expanded",
+        "2000",
     ]);
     assert!(String::from_utf8_lossy(&out.stdout).starts_with("0 new evaluation(s)"));
     let before = lines.lines().count();
@@ -190,7 +194,9 @@ fn a_sweep_is_planned_once_run_to_the_end_and_reported() {
         "--boards",
         "1",
         "--timeout",
-        "0.2",
+        "600",
+        "--max-expanded",
+        "2000",
     ]);
     assert!(
         String::from_utf8_lossy(&out.stdout)
@@ -250,6 +256,21 @@ fn a_sweep_is_planned_once_run_to_the_end_and_reported() {
         std::fs::read_to_string(again.join("table1.csv")).unwrap(),
         std::fs::read_to_string(report.join("table1.csv")).unwrap()
     );
+    let md = std::fs::read_to_string(again.join("report.md")).unwrap();
+    assert!(!md.contains("search time limit"), "{md}");
+    // Tasks that ended at the clock are named in the report.
+    let evaluation = data.join("runs/lightsout-cursor/seads/seed-1/evaluation-replan.json");
+    let mut v: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&evaluation).unwrap()).unwrap();
+    v[2]["timeouts"] = 1.into();
+    v[4]["timeouts"] = 1.into();
+    std::fs::write(&evaluation, v.to_string()).unwrap();
+    seads_ok(&["report", s(&data), "--out", s(&again)]);
+    let md = std::fs::read_to_string(again.join("report.md")).unwrap();
+    assert!(
+        md.contains("2 task(s) ended at the search time limit"),
+        "{md}"
+    );
     // A run outside a sweep can join the report as its own variant.
     seads_ok(&["report", s(&sweep), s(&run), "--out", s(&report)]);
     let md = std::fs::read_to_string(report.join("report.md")).unwrap();
@@ -295,6 +316,10 @@ fn sweep_commands_reject_bad_input_and_write_nothing() {
         (
             MANIFEST.replace("name = \"tiny\"", "nam = \"tiny\""),
             "unknown field `nam`",
+        ),
+        (
+            MANIFEST.replace("max_expanded = 2000", "max_expanded = 0"),
+            "max_expanded must be at least 1",
         ),
     ];
     for (text, needle) in cases {
@@ -419,6 +444,10 @@ fn results(run: &Path) -> (Vec<serde_json::Value>, Vec<serde_json::Value>) {
         let mut v: serde_json::Value =
             serde_json::from_str(&std::fs::read_to_string(run.join(file)).unwrap()).unwrap();
         for depth in v.as_array_mut().unwrap() {
+            assert_eq!(
+                depth["timeouts"], 0,
+                "no search stopped at the clock: {depth}"
+            );
             depth.as_object_mut().unwrap().remove("planning_s");
         }
         evaluations.push(v);

@@ -19,6 +19,9 @@ pub struct PlannerConfig {
     /// Wall-clock limit per search, seconds (`None`, or a value too large for the clock:
     /// unlimited; NaN or negative: none, the search stops at once).
     pub timeout_s: Option<f64>,
+    /// Most states expanded per search (`None`: no bound). Unlike the clock, this limit stops
+    /// every machine at the same state, so results under it are reproducible anywhere.
+    pub max_expanded: Option<usize>,
     /// States expanded per call of the successor function.
     pub batch_size: usize,
 }
@@ -29,6 +32,7 @@ impl Default for PlannerConfig {
             max_layers: 20,
             memory_limit_mib: 4096,
             timeout_s: None,
+            max_expanded: None,
             batch_size: 1024,
         }
     }
@@ -73,6 +77,12 @@ pub enum PlanError {
     Timeout {
         /// Seconds spent.
         seconds: f64,
+    },
+    /// The search expanded as many states as it may.
+    #[error("planning stopped after expanding {expanded} states (state budget)")]
+    Budget {
+        /// States expanded.
+        expanded: usize,
     },
 }
 
@@ -152,8 +162,17 @@ fn search<K: Key>(
     let mut expanded = 0;
     for _layer in 0..config.max_layers {
         let next_start = nodes.len();
-        for chunk_start in fringe.clone().step_by(config.batch_size.max(1)) {
-            let chunk = chunk_start..(chunk_start + config.batch_size.max(1)).min(fringe.end);
+        let mut chunk_start = fringe.start;
+        while chunk_start < fringe.end {
+            let budget = config
+                .max_expanded
+                .map_or(usize::MAX, |m| m.saturating_sub(expanded));
+            if budget == 0 {
+                return Err(PlanError::Budget { expanded });
+            }
+            let len = config.batch_size.max(1).min(budget);
+            let chunk = chunk_start..(chunk_start + len).min(fringe.end);
+            chunk_start = chunk.end;
             states.clear();
             states.extend(nodes[chunk.clone()].iter().map(|n| n.state));
             out.clear();

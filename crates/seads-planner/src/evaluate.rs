@@ -31,6 +31,9 @@ pub struct DepthResult {
     pub plan_found: usize,
     /// Seconds of search per task.
     pub planning_s: Vec<f64>,
+    /// Tasks where a search stopped at the time limit: their outcome depends on the machine.
+    #[serde(default)]
+    pub timeouts: usize,
     /// Manipulator steps of each solved task.
     pub solution_steps: Vec<usize>,
     /// Manipulator steps of every skill executed in solved tasks.
@@ -80,6 +83,7 @@ pub fn evaluate(
             solved: 0,
             plan_found: 0,
             planning_s: Vec::new(),
+            timeouts: 0,
             solution_steps: Vec::new(),
             skill_steps: Vec::new(),
         };
@@ -90,6 +94,7 @@ pub fn evaluate(
             result.tasks += 1;
             result.plan_found += outcome.plan_found as usize;
             result.planning_s.push(outcome.planning_s);
+            result.timeouts += outcome.timed_out as usize;
             if outcome.solved {
                 result.solved += 1;
                 result.solution_steps.push(outcome.manipulator_steps);

@@ -50,6 +50,8 @@ pub struct SolveOutcome {
     pub manipulator_steps: usize,
     /// Seconds spent searching.
     pub planning_s: f64,
+    /// A search stopped at the time limit (the outcome may differ on a faster machine).
+    pub timed_out: bool,
     /// Why the task failed, if it did.
     pub failure: Option<String>,
     /// What each executed skill did (manipulator path and pushes), for figures.
@@ -75,6 +77,7 @@ pub fn solve(
         skill_steps: Vec::new(),
         manipulator_steps: 0,
         planning_s: 0.0,
+        timed_out: false,
         failure: None,
         runs: Vec::new(),
     };
@@ -136,6 +139,7 @@ fn search(
     outcome.plans += 1;
     let plan = bfs_plan(successor, start, goal, &config.planner);
     outcome.planning_s += began.elapsed().as_secs_f64();
+    outcome.timed_out |= matches!(plan, Err(PlanError::Timeout { .. }));
     plan
 }
 

@@ -114,6 +114,39 @@ fn limits_end_the_search_with_a_reason() {
 }
 
 #[test]
+fn the_state_budget_stops_the_search_at_an_exact_count() {
+    let lo = &*LIGHTSOUT;
+    let deep = lo.apply_all(lo.goal(), &[0, 3, 7, 12, 18, 21, 24]);
+    // Layers 0, 1 and 2 of LightsOut hold 1, 25 and C(25, 2) = 300 states; batches of 64 do not
+    // divide the budget, which still holds exactly.
+    for (budget, batch_size) in [(326, 1024), (326, 64), (100, 64), (1, 1)] {
+        let config = PlannerConfig {
+            max_expanded: Some(budget),
+            batch_size,
+            ..PlannerConfig::default()
+        };
+        assert_eq!(
+            bfs_plan(&mut GameSuccessor::new(lo), deep, lo.goal(), &config),
+            Err(PlanError::Budget { expanded: budget }),
+            "budget {budget}, batches of {batch_size}"
+        );
+    }
+    // A depth-3 board is found while layer 2 is expanded: inside a budget of 326, not of 26.
+    let three = lo.apply_all(lo.goal(), &[2, 11, 20]);
+    let config = |budget| PlannerConfig {
+        max_expanded: Some(budget),
+        ..PlannerConfig::default()
+    };
+    let plan = bfs_plan(&mut GameSuccessor::new(lo), three, lo.goal(), &config(326)).unwrap();
+    assert_eq!(plan.skills.len(), 3);
+    assert!(plan.expanded <= 326, "{}", plan.expanded);
+    assert_eq!(
+        bfs_plan(&mut GameSuccessor::new(lo), three, lo.goal(), &config(26)),
+        Err(PlanError::Budget { expanded: 26 })
+    );
+}
+
+#[test]
 fn goal_test_at_generation_prefers_the_first_skill() {
     // Board = move 3: skill 3 solves it in one step, found before any other candidate.
     let lo = &*LIGHTSOUT;
@@ -307,6 +340,7 @@ fn summaries_order_depths_numerically() {
         solved: 1,
         plan_found: 1,
         planning_s: vec![0.0],
+        timeouts: 0,
         solution_steps: vec![depth],
         skill_steps: vec![1],
     };

@@ -208,6 +208,19 @@ pub fn success_tables(groups: &[Group<'_>]) -> (String, String) {
     }
     md += "\nShare of test boards solved at the end of training, per solution depth, mean over the runs \
            (20 boards per depth and run unless the sweep says otherwise).\n";
+    let timeouts: usize = groups
+        .iter()
+        .flat_map(|g| g.runs.iter())
+        .flat_map(|r| r.replan.iter().chain(r.plan_once.iter()))
+        .flat_map(|e| e.iter().map(|d| d.timeouts))
+        .sum();
+    if timeouts > 0 {
+        let _ = writeln!(
+            md,
+            "{timeouts} task(s) ended at the search time limit: their outcome depends on the \
+             machine's speed."
+        );
+    }
     (md, csv)
 }
 

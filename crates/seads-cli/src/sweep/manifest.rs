@@ -63,6 +63,10 @@ pub struct EvaluationPlan {
     pub boards: usize,
     /// Seconds per search (the authors used 60; an agent that lacks a skill searches until then).
     pub timeout: f64,
+    /// Also stop each search after expanding this many states: unlike the clock, the same on
+    /// every machine.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub max_expanded: Option<usize>,
 }
 
 impl Default for EvaluationPlan {
@@ -72,6 +76,17 @@ impl Default for EvaluationPlan {
             every: 0,
             boards: 20,
             timeout: 10.0,
+            max_expanded: None,
+        }
+    }
+}
+
+impl EvaluationPlan {
+    /// The limits of each search.
+    pub fn limits(&self) -> crate::plan::SearchLimits {
+        crate::plan::SearchLimits {
+            timeout: self.timeout,
+            max_expanded: self.max_expanded,
         }
     }
 }
@@ -171,8 +186,12 @@ impl Manifest {
             );
         }
         let e = &self.evaluation;
-        if e.boards == 0 || !(e.timeout.is_finite() && e.timeout > 0.0) {
-            bail!("evaluation.boards must be at least 1 and evaluation.timeout above 0");
+        if e.boards == 0 || !(e.timeout.is_finite() && e.timeout > 0.0) || e.max_expanded == Some(0)
+        {
+            bail!(
+                "evaluation.boards and evaluation.max_expanded must be at least 1 and \
+                 evaluation.timeout above 0"
+            );
         }
         // Expanding checks every override against the configuration's keys and values.
         self.expand()?;

@@ -82,7 +82,7 @@ fn train_and_evaluate(sweep: &Sweep, run: &Path, cores: usize) -> Result<()> {
             Selection::Every(plan.every),
             &[1, 2, 3, 4, 5],
             plan.boards,
-            plan.timeout,
+            plan.limits(),
             true,
         )?;
         println!(
@@ -98,7 +98,7 @@ fn train_and_evaluate(sweep: &Sweep, run: &Path, cores: usize) -> Result<()> {
                 seeds: task_seeds(plan.boards, None),
                 split: seads_games::Split::Test,
                 replan,
-                timeout: plan.timeout,
+                limits: plan.limits(),
             };
             let results = run_evaluation(&mut agent, run, tasks, true)?;
             let solved: usize = results.iter().map(|r| r.solved).sum();
