@@ -3,7 +3,7 @@
 
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
-use seads_games::{MoveId, SymbolicState};
+use seads_games::SymbolicState;
 
 use crate::board::BoardState;
 use crate::{EnvError, EnvSpec, FieldView, Layout, Push, Scene, Shape, StepOutcome};
@@ -67,8 +67,9 @@ pub enum Touch {
         /// Row direction, 0..1.
         v: f64,
     },
-    /// A press detected on a given LightsOut field (Jaco's per-field touch sensors).
-    Field(MoveId),
+    /// A press detected on the LightsOut field in this row-major position (Jaco's per-field
+    /// touch sensors), resolved to a move by the board's [`Layout`].
+    Field(usize),
 }
 
 /// The embodiment-specific part of an environment: state, dynamics, observation.
@@ -204,7 +205,7 @@ impl<M: Manipulator> Environment for Embodied<M> {
             }
             let result = match touch {
                 Touch::At { u, v } => layout.locate(u, v).map_or(Push::Miss, Push::Move),
-                Touch::Field(mv) => Push::Move(mv),
+                Touch::Field(index) => layout.field_move(index).map_or(Push::Miss, Push::Move),
             };
             match result {
                 Push::Move(mv) => {
@@ -289,8 +290,11 @@ impl<M: Manipulator> Environment for Embodied<M> {
             .into_iter()
             .zip(values)
             .enumerate()
-            .map(|(i, (rect, v))| {
-                let height = heights.get(i).copied().unwrap_or(0.0);
+            .map(|(mv, (rect, v))| {
+                // Heights are per row-major position; the move of that position is `mv`.
+                let height = (0..heights.len())
+                    .find(|&i| self.layout.field_move(i) == Some(mv))
+                    .map_or(0.0, |i| heights[i]);
                 match self.spec.game {
                     seads_games::GameKind::LightsOut => FieldView {
                         rect,

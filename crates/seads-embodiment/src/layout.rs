@@ -56,6 +56,14 @@ pub enum Layout {
         /// fields to the border.
         spacing: f64,
     },
+    /// LightsOut N×N whose fields tile the unit square but are numbered column by column: the
+    /// field in row r, column c is move c·N + r. The reference builds LightsOut3DJaco's board
+    /// this way; LightsOut is symmetric under transposition, so the game is the same and only
+    /// which physical field carries which bit of the board differs.
+    ColumnMajor {
+        /// Board side N.
+        n: usize,
+    },
     /// TileSwap 3×3: a push within L1 distance 1/6 of one of 12 pivots swaps its two tiles.
     Pivots,
 }
@@ -73,6 +81,7 @@ impl Layout {
     pub fn locate(&self, u: f64, v: f64) -> Option<MoveId> {
         match *self {
             Layout::Grid { n } => Some(grid_bin(v, n) * n + grid_bin(u, n)),
+            Layout::ColumnMajor { n } => Some(grid_bin(u, n) * n + grid_bin(v, n)),
             Layout::Spaced { n, spacing } => {
                 let centres = spaced_centres(n, spacing);
                 let hit = |x: f64| {
@@ -95,9 +104,32 @@ impl Layout {
         }
     }
 
-    /// The fields as rectangles `[u0, v0, u1, v1]`, row-major.
+    /// The move of the field in row-major position `index` (row `index / N`, column
+    /// `index % N`); `None` past the last field.
+    pub fn field_move(&self, index: usize) -> Option<MoveId> {
+        let n = match *self {
+            Layout::Grid { n } | Layout::Spaced { n, .. } | Layout::ColumnMajor { n } => n,
+            Layout::Pivots => 3,
+        };
+        if index >= n * n {
+            return None;
+        }
+        Some(match self {
+            Layout::ColumnMajor { .. } => (index % n) * n + index / n,
+            _ => index,
+        })
+    }
+
+    /// The fields as rectangles `[u0, v0, u1, v1]`, in the order of their moves (row-major but
+    /// for [`Layout::ColumnMajor`]).
     pub fn fields(&self) -> Vec<[f64; 4]> {
         match *self {
+            Layout::ColumnMajor { n } => {
+                let row_major = Layout::Grid { n }.fields();
+                (0..n * n)
+                    .map(|mv| row_major[(mv % n) * n + mv / n])
+                    .collect()
+            }
             Layout::Grid { n } => square_fields(
                 &(0..n)
                     .map(|i| (i as f64 + 0.5) / n as f64)
@@ -166,6 +198,29 @@ mod tests {
         );
         assert_eq!(g.locate(1.0, 1.0), Some(24));
         assert_eq!(g.locate(0.5, 0.9), Some(22));
+    }
+
+    /// Column-major numbering: the field in row r, column c is move c·N + r, whether found by a
+    /// push (`locate`), by a sensor's row-major position (`field_move`) or drawn (`fields`).
+    #[test]
+    fn column_major_grids_number_fields_column_by_column() {
+        for n in 1..=7 {
+            let (grid, columns) = (Layout::Grid { n }, Layout::ColumnMajor { n });
+            let drawn = columns.fields();
+            for (row, col) in (0..n).flat_map(|r| (0..n).map(move |c| (r, c))) {
+                let (u, v) = ((col as f64 + 0.5) / n as f64, (row as f64 + 0.5) / n as f64);
+                assert_eq!(grid.locate(u, v), Some(row * n + col));
+                assert_eq!(columns.locate(u, v), Some(col * n + row));
+                assert_eq!(grid.field_move(row * n + col), Some(row * n + col));
+                assert_eq!(columns.field_move(row * n + col), Some(col * n + row));
+                let [u0, v0, u1, v1] = drawn[col * n + row];
+                assert!(
+                    u0 < u && u < u1 && v0 < v && v < v1,
+                    "n {n}: ({row}, {col})"
+                );
+            }
+            assert_eq!(columns.field_move(n * n), None);
+        }
     }
 
     #[test]

@@ -99,7 +99,7 @@ pub fn make_env(name: &str, config: &EnvConfig) -> Result<Box<dyn Environment>, 
         )));
     }
     let size = match layout {
-        Layout::Grid { n } | Layout::Spaced { n, .. } => n,
+        Layout::Grid { n } | Layout::Spaced { n, .. } | Layout::ColumnMajor { n } => n,
         Layout::Pivots => 3,
     };
     let board = BoardState::new(entry.game, size, config)?;
@@ -138,6 +138,14 @@ fn layout(entry: &Entry, config: &EnvConfig) -> Result<Layout, EnvError> {
     let size = config.board_size.unwrap_or(default);
     let variant = size != default || config.spacing.is_some();
     if !variant {
+        // The reference numbers LightsOut3DJaco's fields column by column.
+        #[cfg(feature = "jaco")]
+        if matches!(
+            entry.embodiment,
+            Embodiment::Jaco(JacoBoard::LightsOut { stairs: true })
+        ) {
+            return Ok(Layout::ColumnMajor { n: size });
+        }
         return Ok(Layout::standard(entry.game, size));
     }
     if entry.name != "lightsout-cursor" {

@@ -160,7 +160,8 @@ fn forward_kinematics_matches_the_reference_simulation() {
     let mut checked = 0;
     for (name, _, data) in references() {
         // The fields' centres (a site each; TileSwap's board has one site, at its centre) lie on
-        // our grid: 10 cm apart around the origin. (LightsOut3D lists them column by column.)
+        // our grid: 10 cm apart around the origin. (LightsOut3D lists them column by column, and
+        // numbers its fields so: `Layout::ColumnMajor`.)
         let sites: Vec<Vec<f32>> = data["field_sites"]
             .as_array()
             .unwrap()
@@ -266,6 +267,12 @@ fn presses_agree_with_the_reference_simulation() {
         }
         let (mut steps, mut agree) = (0usize, 0usize);
         let mut reference_presses = Vec::new();
+        // The board's own numbering of the fields, as the environment resolves touches.
+        let layout = if name == "lightsout3d" {
+            Layout::ColumnMajor { n: 5 }
+        } else {
+            Layout::Grid { n: 5 }
+        };
         for episode in data["episodes"].as_array().unwrap() {
             let q0 = floats(&episode["qpos0"]);
             let mut jaco = Jaco::new(board, 50);
@@ -273,8 +280,8 @@ fn presses_agree_with_the_reference_simulation() {
             for (t, step) in episode["steps"].as_array().unwrap().iter().enumerate() {
                 let mut ours: i64 = -1;
                 let mut touch = |touch: Touch| {
-                    if let (Touch::Field(m), -1) = (touch, ours) {
-                        ours = m as i64;
+                    if let (Touch::Field(index), -1) = (touch, ours) {
+                        ours = layout.field_move(index).unwrap() as i64;
                     }
                     Push::None
                 };
@@ -303,9 +310,11 @@ fn presses_agree_with_the_reference_simulation() {
                 "{name}: {reference_presses:?}"
             );
         } else {
-            // LightsOut3D does not agree yet (docs/RESULTS.md): 97.5 % of steps, none of its 10
-            // presses; where both press, ours is the transposed field. Guarded, not the goal.
+            // Measured: 97.7 % of steps, 3 of 10 presses (none before the reference's column-by-
+            // column numbering was followed). The misses come where our hand makes no contact in
+            // the press step, most after the joints have drifted by 0.02–0.09 rad (docs/RESULTS.md).
             assert!(fraction > 0.97, "{name}: {fraction}");
+            assert!(reproduced >= 3, "{name}: {reference_presses:?}");
         }
     }
 }
@@ -399,9 +408,15 @@ fn sweep(name: &str, seeds: &[u64], moves: &[MoveId]) -> Vec<String> {
         for &mv in moves {
             let (target, top) = match n {
                 5 => {
-                    let (row, col) = (mv / 5, mv % 5);
+                    // LightsOut3D numbers its fields column by column (`Layout::ColumnMajor`).
+                    let stairs = name.starts_with("lightsout3d");
+                    let (row, col) = if stairs {
+                        (mv % 5, mv / 5)
+                    } else {
+                        (mv / 5, mv % 5)
+                    };
                     let ring = row.abs_diff(2).max(col.abs_diff(2));
-                    let top = if name.starts_with("lightsout3d") {
+                    let top = if stairs {
                         [0.02, 0.06, 0.10][ring]
                     } else {
                         0.02
