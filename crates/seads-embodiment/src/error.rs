@@ -41,6 +41,12 @@ pub enum EnvError {
         /// Steps since the last reset.
         steps: usize,
     },
+    /// A task episode was stepped after it ended (solved or out of time) without a reset.
+    #[error("{env}: the task episode is over (solved or out of time); reset it first")]
+    EpisodeOver {
+        /// Environment name.
+        env: String,
+    },
     /// `step` was called after the skill's step limit without a reset.
     #[error(
         "{env}: the step limit of {limit} steps is reached; reset the environment or its step counter first"

@@ -59,6 +59,7 @@ mod registry;
 mod runner;
 mod scene;
 mod spec;
+mod task;
 
 pub use config::EnvConfig;
 pub use cursor::Cursor;
@@ -76,3 +77,4 @@ pub use registry::{EnvInfo, env_names, list_envs, make_env};
 pub use runner::{VecEnv, random_rollout};
 pub use scene::{FieldView, Scene, Shape};
 pub use spec::{EnvSpec, Push, StepOutcome};
+pub use task::{TaskEnv, TaskStep};
