@@ -7,7 +7,7 @@ use anyhow::Result;
 use clap::Args;
 use seads_games::Split;
 use seads_planner::summarise;
-use seads_rl::{Run, TrainConfig};
+use seads_rl::{Run, TrainConfig, Trainer};
 
 use crate::BadInput;
 use crate::plan::{Tasks, run_evaluation};
@@ -45,7 +45,7 @@ pub fn run(args: RunArgs) -> Result<()> {
         println!("resuming the run in {}", args.out.display());
         let config = seads_rl::load_config(&args.out)?;
         crate::kernels::use_kernels(config.portable_numerics)?;
-        crate::train::resume(&args.out, Run::resume(&args.out))?
+        crate::train::resume(&args.out, Run::<Trainer>::resume(&args.out))?
     } else {
         let mut config = TrainConfig::preset(&args.env).map_err(|e| BadInput(e.into()))?;
         config.env_steps = args.env_steps;

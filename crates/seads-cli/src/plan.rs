@@ -25,6 +25,14 @@ pub fn load_agent(run: &Path, checkpoint: Option<u64>) -> Result<Agent> {
     let config = seads_rl::load_config(run)
         .with_context(|| format!("loading the agent of run {}", run.display()))?;
     crate::kernels::use_kernels(config.portable_numerics)?;
+    if config.algorithm != seads_rl::Algorithm::Seads {
+        bail!(BadInput(anyhow::anyhow!(
+            "{} is a {} baseline run: it has no skills to plan with (`seads evaluate --run` \
+             measures its policy's task success)",
+            run.display(),
+            config.algorithm.name()
+        )));
+    }
     Agent::load(run, checkpoint)
         .with_context(|| format!("loading the agent of run {}", run.display()))
 }
@@ -211,6 +219,11 @@ pub fn task_seeds(boards: usize, seed: Option<u64>) -> Vec<u64> {
     }
 }
 
+/// Where a baseline's final task success is saved in its run directory: its policy acting
+/// alone, no planning (the SEADS runs' counterparts are `evaluation-replan.json` and
+/// `evaluation-plan-once.json`).
+pub const POLICY_EVALUATION: &str = "evaluation-policy.json";
+
 /// Limits of each search of an evaluation.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct SearchLimits {
@@ -306,6 +319,18 @@ pub fn evaluate_run(args: EvaluateArgs) -> Result<()> {
     if args.boards == 0 {
         bail!(BadInput(anyhow::anyhow!("--boards must be at least 1")));
     }
+    let config = seads_rl::load_config(&args.run)
+        .with_context(|| format!("loading run {}", args.run.display()))?;
+    if config.algorithm == seads_rl::Algorithm::Sac {
+        if args.checkpoints.is_some() {
+            bail!(BadInput(anyhow::anyhow!(
+                "{}: a SAC baseline's task success over training is in its metrics.jsonl; \
+                 --checkpoints is for SEADS runs",
+                args.run.display()
+            )));
+        }
+        return evaluate_policy(&args, &config, &depths);
+    }
     if let Some(selection) = args.checkpoints {
         let added = crate::overtraining::evaluate_checkpoints(
             &args.run,
@@ -380,6 +405,55 @@ pub fn evaluate_run(args: EvaluateArgs) -> Result<()> {
                 fmt(summary.solution_steps[&key]),
                 fmt(summary.skill_steps[&key])
             );
+        }
+    }
+    Ok(())
+}
+
+/// `seads evaluate` on a baseline run: its policy alone on the test boards of each depth, saved
+/// as `evaluation-policy.json` (depths 1–5) or `evaluation-policy-depths-A-B.json`.
+fn evaluate_policy(
+    args: &EvaluateArgs,
+    config: &seads_rl::TrainConfig,
+    depths: &[usize],
+) -> Result<()> {
+    crate::kernels::use_kernels(config.portable_numerics)?;
+    let checkpoint = match args.checkpoint {
+        Some(epoch) => args
+            .run
+            .join("checkpoints")
+            .join(seads_rl::checkpoint_name(epoch)),
+        None => seads_rl::latest_checkpoint(&args.run)?.ok_or_else(|| {
+            BadInput(anyhow::anyhow!(
+                "{} has no checkpoint yet",
+                args.run.display()
+            ))
+        })?,
+    };
+    let policy = seads_rl::load_policy(config, &checkpoint)
+        .with_context(|| format!("loading the policy of run {}", args.run.display()))?;
+    let results = seads_rl::task_success(config, &policy, depths, args.boards)?;
+    let name = match (depths.first(), depths.last()) {
+        (Some(1), Some(5)) if depths.len() == 5 => POLICY_EVALUATION.to_owned(),
+        (Some(a), Some(b)) => format!("evaluation-policy-depths-{a}-{b}.json"),
+        _ => POLICY_EVALUATION.to_owned(),
+    };
+    seads_rl::write_atomic(
+        &args.run.join(name),
+        serde_json::to_string_pretty(&results)?.as_bytes(),
+    )?;
+    let summary = summarise(&results);
+    if args.json {
+        println!("{}", serde_json::to_string(&summary)?);
+    } else {
+        println!(
+            "{} ({}), its policy alone, {} boards per depth",
+            args.run.display(),
+            checkpoint.display(),
+            args.boards
+        );
+        for r in &results {
+            println!("depth {}: {}/{} solved", r.depth, r.solved, r.tasks);
         }
     }
     Ok(())

@@ -1,11 +1,12 @@
-//! `seads train`: train a SEADS agent into a run directory, with a progress bar.
+//! `seads train`: train a SEADS agent (or the flat SAC baseline) into a run directory, with a
+//! progress bar.
 
 use std::path::PathBuf;
 
 use anyhow::{Context, Result};
 use clap::Args;
 use indicatif::{ProgressBar, ProgressStyle};
-use seads_rl::{Hook, Moment, Run, TrainConfig};
+use seads_rl::{Algorithm, Hook, Learner, Moment, Run, TaskSac, TrainConfig, Trainer};
 
 use crate::BadInput;
 
@@ -15,6 +16,10 @@ pub struct TrainArgs {
     /// Environment to train on, with its preset (the paper's settings; see `seads envs`).
     #[arg(long, required_unless_present_any = ["resume", "config"])]
     env: Option<String>,
+    /// What to train: `seads`, or the flat SAC baseline with the task reward (`sac`, SPEC §5.1;
+    /// its presets are `configs/sac-*.toml`). Default: the config's, else seads.
+    #[arg(long, value_parser = ["seads", "sac"], conflicts_with = "resume")]
+    algorithm: Option<String>,
     /// Run directory to create (config.toml, metrics.jsonl, checkpoints/).
     #[arg(long, required_unless_present = "resume")]
     out: Option<PathBuf>,
@@ -50,9 +55,13 @@ fn config(args: &TrainArgs) -> Result<TrainConfig> {
             }
             config
         }
-        (None, Some(env)) => TrainConfig::preset(env).map_err(|e| BadInput(e.into()))?,
+        (None, Some(env)) => TrainConfig::preset_for(env, algorithm(args.algorithm.as_deref()))
+            .map_err(|e| BadInput(e.into()))?,
         (None, None) => unreachable!("clap requires --env or --config"),
     };
+    if let Some(name) = &args.algorithm {
+        config.algorithm = algorithm(Some(name));
+    }
     if let Some(seed) = args.seed {
         config.seed = seed;
     }
@@ -63,9 +72,17 @@ fn config(args: &TrainArgs) -> Result<TrainConfig> {
     Ok(config)
 }
 
+/// The algorithm named on the command line (clap checked the name).
+fn algorithm(name: Option<&str>) -> Algorithm {
+    match name {
+        Some("sac") => Algorithm::Sac,
+        _ => Algorithm::Seads,
+    }
+}
+
 /// Runs `seads train`.
 pub fn train(args: TrainArgs) -> Result<()> {
-    let mut run = match &args.resume {
+    match &args.resume {
         Some(dir) => {
             if let Some(steps) = args.env_steps {
                 seads_rl::raise_budget(dir, steps).map_err(|e| match e {
@@ -76,23 +93,38 @@ pub fn train(args: TrainArgs) -> Result<()> {
             let config = seads_rl::load_config(dir)
                 .with_context(|| format!("resuming {}", dir.display()))?;
             crate::kernels::use_kernels(config.portable_numerics)?;
-            resume(dir, Run::resume(dir))?
+            match config.algorithm {
+                Algorithm::Seads => {
+                    drive(&mut resume(dir, Run::<Trainer>::resume(dir))?, args.quiet)
+                }
+                Algorithm::Sac => drive(&mut resume(dir, Run::<TaskSac>::resume(dir))?, args.quiet),
+            }
         }
         None => {
             let config = config(&args)?;
             crate::kernels::use_kernels(config.portable_numerics)?;
             let out = args.out.as_ref().expect("clap requires --out");
-            Run::create(out, config).map_err(|e| match e {
-                seads_rl::RlError::Config(_) => BadInput(e.into()).into(),
-                other => anyhow::Error::from(other),
-            })?
+            match config.algorithm {
+                Algorithm::Seads => drive(&mut create::<Trainer>(out, config)?, args.quiet),
+                Algorithm::Sac => drive(&mut create::<TaskSac>(out, config)?, args.quiet),
+            }
         }
-    };
-    drive(&mut run, args.quiet)
+    }
+}
+
+/// A new run; a configuration error is bad input.
+fn create<L: Learner>(out: &std::path::Path, config: TrainConfig) -> Result<Run<L>> {
+    Run::create(out, config).map_err(|e| match e {
+        seads_rl::RlError::Config(_) => BadInput(e.into()).into(),
+        other => anyhow::Error::from(other),
+    })
 }
 
 /// The resumed run, after telling on stderr what resuming repaired.
-pub fn resume(dir: &std::path::Path, run: Result<Run, seads_rl::RlError>) -> Result<Run> {
+pub fn resume<L: Learner>(
+    dir: &std::path::Path,
+    run: Result<Run<L>, seads_rl::RlError>,
+) -> Result<Run<L>> {
     let run = run.with_context(|| format!("resuming {}", dir.display()))?;
     for repair in run.repairs() {
         eprintln!("seads: {}: {repair}", dir.display());
@@ -132,8 +164,81 @@ fn crash_hook() -> Result<Option<Hook>> {
     })))
 }
 
+/// How `seads train` shows a learner's progress.
+pub trait Shown: Learner {
+    /// Environment steps so far.
+    fn steps(&self) -> u64;
+    /// (epoch, environment steps) after an epoch.
+    fn stats_steps(stats: &Self::Stats) -> (u64, u64);
+    /// (epoch, environment steps, steps per second) of an evaluation.
+    fn metrics_steps(m: &Self::Metrics) -> (u64, u64, f64);
+    /// What an evaluation found, in a few words ("coverage 24.10/25").
+    fn headline(&self, m: &Self::Metrics) -> String;
+    /// The time per phase, one line.
+    fn phases(&self) -> String;
+}
+
+impl Shown for Trainer {
+    fn steps(&self) -> u64 {
+        self.env_steps()
+    }
+    fn stats_steps(stats: &Self::Stats) -> (u64, u64) {
+        (stats.epoch, stats.env_steps)
+    }
+    fn metrics_steps(m: &Self::Metrics) -> (u64, u64, f64) {
+        (m.epoch, m.env_steps, m.steps_per_s)
+    }
+    fn headline(&self, m: &Self::Metrics) -> String {
+        format!(
+            "coverage {:>5.2}/{}  reward {:>6.2}",
+            m.skill_coverage,
+            self.num_skills(),
+            m.mean_reward
+        )
+    }
+    fn phases(&self) -> String {
+        let t = self.timings();
+        format!(
+            "collect {:.1} s, relabel {:.1} s, skill model {:.1} s, SAC {:.1} s, evaluation {:.1} s",
+            t.collect, t.relabel, t.skill_model, t.sac, t.evaluate
+        )
+    }
+}
+
+impl Shown for TaskSac {
+    fn steps(&self) -> u64 {
+        self.env_steps()
+    }
+    fn stats_steps(stats: &Self::Stats) -> (u64, u64) {
+        (stats.epoch, stats.env_steps)
+    }
+    fn metrics_steps(m: &Self::Metrics) -> (u64, u64, f64) {
+        (m.epoch, m.env_steps, m.steps_per_s)
+    }
+    fn headline(&self, m: &Self::Metrics) -> String {
+        let per_depth: Vec<String> = m
+            .success
+            .iter()
+            .map(|s| format!("{:.0}", 100.0 * s))
+            .collect();
+        format!(
+            "task success {:>5.1} % (depths 1-5: {} %)  training episodes solved {:.1} %",
+            100.0 * m.mean_success,
+            per_depth.join("/"),
+            100.0 * m.train_solved
+        )
+    }
+    fn phases(&self) -> String {
+        let t = self.timings();
+        format!(
+            "collect {:.1} s, SAC {:.1} s, evaluation {:.1} s",
+            t.collect, t.sac, t.evaluate
+        )
+    }
+}
+
 /// Trains `run` to its budget, showing progress, and prints a summary.
-pub fn drive(run: &mut Run, quiet: bool) -> Result<()> {
+pub fn drive<L: Shown>(run: &mut Run<L>, quiet: bool) -> Result<()> {
     if let Some(hook) = crash_hook()? {
         run.set_hook(hook);
     }
@@ -148,21 +253,19 @@ pub fn drive(run: &mut Run, quiet: bool) -> Result<()> {
             .expect("valid template")
             .progress_chars("=> "),
     );
-    bar.set_position(run.trainer().env_steps().min(budget));
+    bar.set_position(run.trainer().steps().min(budget));
     // A resumed run shows its last evaluation until the next one.
-    let mut coverage = seads_rl::read_metrics(run.dir())
+    let mut headline = seads_rl::read_metrics_as::<L::Metrics>(run.dir())
         .ok()
-        .and_then(|m| m.last().map(|m| m.skill_coverage))
-        .unwrap_or(f64::NAN);
-    let k = run.trainer().num_skills();
+        .and_then(|m| m.last().map(|m| run.trainer().headline(m)))
+        .unwrap_or_default();
     while !run.finished() {
         let event = run.step().context("training")?;
         if let Some(m) = &event.metrics {
-            coverage = m.skill_coverage;
-            let line = format!(
-                "epoch {:>6}  steps {:>9}  coverage {:>5.2}/{}  reward {:>6.2}  {:>6.0} steps/s",
-                m.epoch, m.env_steps, m.skill_coverage, k, m.mean_reward, m.steps_per_s
-            );
+            headline = run.trainer().headline(m);
+            let (epoch, steps, per_s) = L::metrics_steps(m);
+            let line =
+                format!("epoch {epoch:>6}  steps {steps:>9}  {headline}  {per_s:>6.0} steps/s");
             // A hidden bar (quiet, or output not a terminal) drops `println`: print directly.
             if bar.is_hidden() {
                 println!("{line}");
@@ -170,31 +273,22 @@ pub fn drive(run: &mut Run, quiet: bool) -> Result<()> {
                 bar.println(line);
             }
         }
-        let steps_per_s = event.stats.env_steps as f64 / run.wall_s().max(1e-9);
-        bar.set_position(event.stats.env_steps.min(budget));
+        let (epoch, steps) = L::stats_steps(&event.stats);
+        let steps_per_s = steps as f64 / run.wall_s().max(1e-9);
+        bar.set_position(steps.min(budget));
         bar.set_message(format!(
-            "epoch {} coverage {:.2}/{} reward {:.2} {:.0} steps/s",
-            event.stats.epoch + 1,
-            coverage,
-            k,
-            event.stats.mean_reward,
-            steps_per_s
+            "epoch {} {headline} {steps_per_s:.0} steps/s",
+            epoch + 1
         ));
     }
     bar.finish_and_clear();
-    let t = run.trainer().timings();
     println!(
-        "trained {} epochs, {} steps in {:.0} s: skill coverage {:.2}/{}; run directory {}",
+        "trained {} epochs, {} steps in {:.0} s: {headline}; run directory {}",
         run.trainer().epoch(),
-        run.trainer().env_steps(),
+        run.trainer().steps(),
         run.wall_s(),
-        coverage,
-        k,
         run.dir().display()
     );
-    println!(
-        "time per phase: collect {:.1} s, relabel {:.1} s, skill model {:.1} s, SAC {:.1} s, evaluation {:.1} s",
-        t.collect, t.relabel, t.skill_model, t.sac, t.evaluate
-    );
+    println!("time per phase: {}", run.trainer().phases());
     Ok(())
 }

@@ -1,40 +1,7 @@
 //! End-to-end tests of the `seads` binary.
 
-use std::process::{Command, Output};
-
-fn seads(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_seads"))
-        .args(args)
-        .output()
-        .expect("run seads")
-}
-
-/// Runs seads and asserts that it succeeded.
-fn seads_ok(args: &[&str]) -> Output {
-    let out = seads(args);
-    assert!(
-        out.status.success(),
-        "seads {args:?}: {}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    out
-}
-
-fn json(args: &[&str]) -> serde_json::Value {
-    serde_json::from_slice(&seads_ok(args).stdout).expect("valid JSON")
-}
-
-/// Exit code 2 and a single `error:` line on stderr.
-fn check_bad_input(args: &[&str], needle: &str) {
-    let out = seads(args);
-    let stderr = String::from_utf8_lossy(&out.stderr);
-    assert_eq!(out.status.code(), Some(2), "seads {args:?}: {stderr}");
-    assert_eq!(stderr.lines().count(), 1, "one line: {stderr}");
-    assert!(
-        stderr.starts_with("error: ") && stderr.contains(needle),
-        "{stderr}"
-    );
-}
+mod common;
+use common::*;
 
 #[test]
 fn depths_json() {
@@ -679,10 +646,6 @@ fn uarm_twin_calibrates_and_trains() {
     seads_ok(&["report", s(&run), "--out", s(&report)]);
     let md = std::fs::read_to_string(report.join("report.md")).unwrap();
     assert!(md.contains("uarm-lightsout-absolute (of 25)"), "{md}");
-}
-
-fn s(p: &std::path::Path) -> &str {
-    p.to_str().unwrap()
 }
 
 #[test]

@@ -3,38 +3,11 @@
 //! points, which must lose nothing (the resumed sweep equals the uninterrupted one).
 
 use std::path::{Path, PathBuf};
-use std::process::{Command, Output, Stdio};
+use std::process::{Command, Stdio};
 use std::time::{Duration, Instant};
 
-fn seads(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_seads"))
-        .args(args)
-        .output()
-        .expect("run seads")
-}
-
-fn seads_ok(args: &[&str]) -> Output {
-    let out = seads(args);
-    assert!(
-        out.status.success(),
-        "seads {args:?}: {}{}",
-        String::from_utf8_lossy(&out.stdout),
-        String::from_utf8_lossy(&out.stderr)
-    );
-    out
-}
-
-/// Exit code 2 and a single `error:` line on stderr.
-fn check_bad_input(args: &[&str], needle: &str) {
-    let out = seads(args);
-    let stderr = String::from_utf8_lossy(&out.stderr);
-    assert_eq!(out.status.code(), Some(2), "seads {args:?}: {stderr}");
-    assert_eq!(stderr.lines().count(), 1, "one line: {stderr}");
-    assert!(
-        stderr.starts_with("error: ") && stderr.contains(needle),
-        "seads {args:?}: {stderr:?} should say {needle:?}"
-    );
-}
+mod common;
+use common::*;
 
 /// A study of tiny runs: small networks, 600 steps, checkpoints every 5 epochs.
 const MANIFEST: &str = r#"
@@ -72,10 +45,6 @@ fn write_manifest(dir: &Path, text: &str) -> PathBuf {
     let path = dir.join("manifest.toml");
     std::fs::write(&path, text).unwrap();
     path
-}
-
-fn s(p: &Path) -> &str {
-    p.to_str().unwrap()
 }
 
 fn status_json(sweep: &Path) -> serde_json::Value {

@@ -9,7 +9,7 @@
 
 use std::path::Path;
 
-use seads_rl::{RlError, Run, TrainConfig, read_metrics};
+use seads_rl::{RlError, Run, TrainConfig, Trainer, read_metrics};
 
 /// Trains a small agent for `steps` environment steps into `dir`; returns the final coverage.
 fn run(steps: u64, dir: &Path) -> Result<f64, RlError> {
@@ -22,7 +22,7 @@ fn run(steps: u64, dir: &Path) -> Result<f64, RlError> {
         config.checkpoint_every,
         config.eval_seeds,
     ) = (10, 10, 4);
-    let mut run = Run::create(dir, config)?;
+    let mut run = Run::<Trainer>::create(dir, config)?;
     while !run.finished() {
         let event = run.step()?;
         if let Some(m) = event.metrics {

@@ -28,10 +28,59 @@ impl Default for RelabelConfig {
     }
 }
 
+/// What a run trains.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Algorithm {
+    /// SEADS: reward-free skills and their forward model (SPEC §3).
+    #[default]
+    Seads,
+    /// The flat SAC baseline with the task reward (SPEC §5.1).
+    Sac,
+}
+
+impl Algorithm {
+    /// The name in configs and on the command line.
+    pub fn name(self) -> &'static str {
+        match self {
+            Algorithm::Seads => "seads",
+            Algorithm::Sac => "sac",
+        }
+    }
+}
+
+/// Settings of the task-reward baselines (SPEC §5.1); SEADS ignores them.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct BaselineConfig {
+    /// Transitions kept in the replay buffer (the most recent).
+    pub replay_capacity: usize,
+    /// Environments stepped once per epoch: the new transitions of an epoch.
+    pub samples_per_epoch: usize,
+    /// Gradient steps per epoch N; N < 1 means one step every 1/N epochs.
+    pub updates_per_epoch: f64,
+    /// Test boards per depth 1–5 of each task-success evaluation.
+    pub eval_boards: usize,
+}
+
+impl Default for BaselineConfig {
+    fn default() -> Self {
+        Self {
+            replay_capacity: 1_000_000,
+            samples_per_epoch: 8,
+            updates_per_epoch: 1.0,
+            eval_boards: 20,
+        }
+    }
+}
+
 /// Everything a SEADS training run needs. `Default` is the LightsOutCursor preset of the paper.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields, default)]
 pub struct TrainConfig {
+    /// What to train: SEADS (the default) or a baseline.
+    #[serde(skip_serializing_if = "is_seads")]
+    pub algorithm: Algorithm,
     /// Environment name (see `seads envs`).
     pub env: String,
     /// Environment options; the reset split is always "train" for training.
@@ -76,11 +125,23 @@ pub struct TrainConfig {
     /// `COMPATIBLE` branch), so that the seed alone fixes the run. About 1.8× slower per SAC
     /// update; off in the presets, on for the demo and the tests (see `seads_rl::numerics`).
     pub portable_numerics: bool,
+    /// The task-reward baselines' settings (`algorithm = "sac"`).
+    #[serde(skip_serializing_if = "is_default_baseline")]
+    pub baseline: BaselineConfig,
+}
+
+fn is_seads(algorithm: &Algorithm) -> bool {
+    *algorithm == Algorithm::Seads
+}
+
+fn is_default_baseline(baseline: &BaselineConfig) -> bool {
+    *baseline == BaselineConfig::default()
 }
 
 impl Default for TrainConfig {
     fn default() -> Self {
         Self {
+            algorithm: Algorithm::Seads,
             env: "lightsout-cursor".into(),
             env_config: EnvConfig::default(),
             seed: 1,
@@ -100,6 +161,7 @@ impl Default for TrainConfig {
             threads: 1,
             sac_threads_alone: 2,
             portable_numerics: false,
+            baseline: BaselineConfig::default(),
         }
     }
 }
@@ -136,10 +198,51 @@ const PRESETS: &[(&str, &str)] = &[
     ),
 ];
 
+/// The presets of the flat SAC baseline (`configs/sac-*.toml`).
+const SAC_PRESETS: &[(&str, &str)] = &[
+    (
+        "lightsout-cursor",
+        include_str!("../configs/sac-lightsout-cursor.toml"),
+    ),
+    (
+        "tileswap-cursor",
+        include_str!("../configs/sac-tileswap-cursor.toml"),
+    ),
+    (
+        "lightsout-reacher",
+        include_str!("../configs/sac-lightsout-reacher.toml"),
+    ),
+    (
+        "tileswap-reacher",
+        include_str!("../configs/sac-tileswap-reacher.toml"),
+    ),
+    (
+        "lightsout-jaco",
+        include_str!("../configs/sac-lightsout-jaco.toml"),
+    ),
+    (
+        "tileswap-jaco",
+        include_str!("../configs/sac-tileswap-jaco.toml"),
+    ),
+    (
+        "lightsout3d-jaco",
+        include_str!("../configs/sac-lightsout3d-jaco.toml"),
+    ),
+];
+
 impl TrainConfig {
     /// The preset of environment `env` (the paper's settings).
     pub fn preset(env: &str) -> Result<Self, RlError> {
-        let text = PRESETS
+        Self::preset_for(env, Algorithm::Seads)
+    }
+
+    /// The preset of `algorithm` on environment `env`.
+    pub fn preset_for(env: &str, algorithm: Algorithm) -> Result<Self, RlError> {
+        let presets = match algorithm {
+            Algorithm::Seads => PRESETS,
+            Algorithm::Sac => SAC_PRESETS,
+        };
+        let text = presets
             .iter()
             .find(|(name, _)| *name == env)
             .map(|(_, text)| *text)
@@ -152,9 +255,14 @@ impl TrainConfig {
         Self::from_toml(text)
     }
 
-    /// Every preset, as `(environment, TOML text)`.
+    /// Every SEADS preset, as `(environment, TOML text)`.
     pub fn presets() -> &'static [(&'static str, &'static str)] {
         PRESETS
+    }
+
+    /// Every preset of the SAC baseline, as `(environment, TOML text)`.
+    pub fn sac_presets() -> &'static [(&'static str, &'static str)] {
+        SAC_PRESETS
     }
 
     /// Parses a TOML configuration and validates its values (not the environment: see
@@ -166,9 +274,15 @@ impl TrainConfig {
         Ok(config)
     }
 
-    /// The configuration as TOML.
+    /// The configuration as TOML. A SEADS config leaves out the baselines' section; a
+    /// baseline's always has it, defaults included.
     pub fn to_toml(&self) -> String {
-        toml::to_string(self).expect("a config serialises")
+        let text = toml::to_string(self).expect("a config serialises");
+        if self.algorithm == Algorithm::Seads || !is_default_baseline(&self.baseline) {
+            return text;
+        }
+        let section = toml::to_string(&self.baseline).expect("a config serialises");
+        format!("{text}\n[baseline]\n{section}")
     }
 
     /// Checks every value, and that the environment exists with these options.
@@ -212,6 +326,20 @@ impl TrainConfig {
         }
         if self.eval_every == 0 || self.checkpoint_every == 0 || self.eval_seeds == 0 {
             return bad("eval_every, eval_seeds and checkpoint_every must be at least 1".into());
+        }
+        let b = &self.baseline;
+        if b.replay_capacity == 0 || b.samples_per_epoch == 0 || b.eval_boards == 0 {
+            return bad(
+                "baseline.replay_capacity, baseline.samples_per_epoch and baseline.eval_boards \
+                 must be at least 1"
+                    .into(),
+            );
+        }
+        if !(b.updates_per_epoch.is_finite() && b.updates_per_epoch > 0.0) {
+            return bad(format!(
+                "baseline.updates_per_epoch must be positive, got {}",
+                b.updates_per_epoch
+            ));
         }
         for (name, p) in [
             ("relabel.skill_model_p", self.relabel.skill_model_p),

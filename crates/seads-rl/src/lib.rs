@@ -43,19 +43,26 @@ mod run;
 mod sac;
 mod seeds;
 mod store;
+mod task_sac;
 mod trainer;
 
 use std::path::Path;
 
 pub use agent::{Agent, AgentPolicy};
-pub use config::{RelabelConfig, TrainConfig};
+pub use config::{Algorithm, BaselineConfig, RelabelConfig, TrainConfig};
 pub use episode::{Episode, policy_input, run_episodes, skill_coverage};
 pub use numerics::{FAST_KERNELS, PORTABLE_KERNELS, kernel_environment, portable_kernels_active};
 pub use relaxed::RelaxedBernoulli;
-pub use run::{Hook, Metrics, Moment, Run, RunEvent, load_config, raise_budget};
+pub use run::{Hook, Learner, Metrics, Moment, Run, RunEvent, load_config, raise_budget};
 pub use sac::{Sac, SacConfig, SacLosses, TransitionBatch};
 pub use seeds::{Purpose, derived_seed, stream, train_env_seed};
-pub use store::{checkpoints, latest_checkpoint, read_metrics, write_atomic};
+pub use store::{
+    MetricsLine, checkpoint_name, checkpoints, latest_checkpoint, read_metrics, read_metrics_as,
+    write_atomic,
+};
+pub use task_sac::{
+    TaskEpochStats, TaskMetrics, TaskSac, TaskTimings, load_policy, task_success, updates_due,
+};
 pub use trainer::{COVERAGE_SEED, EpochStats, Timings, Trainer};
 
 /// Sets the number of libtorch intra-op threads of the process.

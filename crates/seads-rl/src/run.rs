@@ -16,11 +16,38 @@ use std::time::Instant;
 use serde::{Deserialize, Serialize};
 
 use crate::store::{
-    CHECKPOINTS, CONFIG, LATEST, METRICS, append_metrics, checkpoint_name, checkpoints,
-    clean_leftovers, commit_dir, hidden_sibling, latest_pointer, read_metrics_text, write_atomic,
-    write_metrics,
+    CHECKPOINTS, CONFIG, LATEST, METRICS, MetricsLine, append_metrics, checkpoint_name,
+    checkpoints, clean_leftovers, commit_dir, hidden_sibling, latest_pointer, read_metrics_text,
+    write_atomic, write_metrics,
 };
 use crate::{EpochStats, RlError, Timings, TrainConfig, Trainer};
+
+/// What a [`Run`] drives: an agent in training whose whole state a checkpoint folder holds.
+/// [`Trainer`] (SEADS) and [`TaskSac`](crate::TaskSac) (the task-reward baseline) are learners.
+pub trait Learner: Sized {
+    /// What one epoch reports.
+    type Stats: Clone;
+    /// One line of `metrics.jsonl`.
+    type Metrics: MetricsLine + Clone;
+    /// A fresh learner for `config` (validated).
+    fn build(config: TrainConfig) -> Result<Self, RlError>;
+    /// The configuration.
+    fn config(&self) -> &TrainConfig;
+    /// Epochs completed.
+    fn epoch(&self) -> u64;
+    /// Whether the step budget is spent.
+    fn finished(&self) -> bool;
+    /// One epoch, calling `hook` at the [`Moment`]s inside it.
+    fn run_epoch_observed(&mut self, hook: &mut dyn FnMut(Moment)) -> Result<Self::Stats, RlError>;
+    /// The evaluation after an epoch, as a metrics line (`wall_s`: the run's seconds so far).
+    fn metrics(&mut self, stats: &Self::Stats, wall_s: f64) -> Result<Self::Metrics, RlError>;
+    /// Writes the complete state into the folder `dir`.
+    fn save(&self, dir: &Path) -> Result<(), RlError>;
+    /// Restores what [`Learner::save`] wrote.
+    fn load(&mut self, dir: &Path) -> Result<(), RlError>;
+    /// The checkpoint files only resuming needs, dropped from all but the two newest.
+    fn resume_only_files() -> Vec<&'static str>;
+}
 
 /// Moments of a run at which a crash leaves a different state on disk. A hook set with
 /// [`Run::set_hook`] is called at each (the crash-point tests stop the process there).
@@ -40,6 +67,15 @@ pub enum Moment {
     CheckpointRenamed,
     /// `latest` names the new checkpoint; older ones still hold their resume files.
     LatestWritten,
+}
+
+impl MetricsLine for Metrics {
+    fn epoch(&self) -> u64 {
+        self.epoch
+    }
+    fn wall_s(&self) -> f64 {
+        self.wall_s
+    }
 }
 
 impl Moment {
@@ -89,30 +125,30 @@ pub struct Metrics {
 
 /// What a call to [`Run::step`] did.
 #[derive(Debug, Clone)]
-pub struct RunEvent {
+pub struct RunEvent<L: Learner = Trainer> {
     /// The epoch's statistics.
-    pub stats: EpochStats,
+    pub stats: L::Stats,
     /// The evaluation written to `metrics.jsonl`, if one was due.
-    pub metrics: Option<Metrics>,
+    pub metrics: Option<L::Metrics>,
     /// The checkpoint written, if one was due.
     pub checkpoint: Option<PathBuf>,
 }
 
 /// A training run writing into a directory.
-pub struct Run {
+pub struct Run<L: Learner = Trainer> {
     dir: PathBuf,
-    trainer: Trainer,
+    trainer: L,
     started: Instant,
     wall_before: f64,
     hook: Hook,
     repairs: Vec<String>,
 }
 
-impl Run {
+impl<L: Learner> Run<L> {
     /// Starts a run in `dir` (created; it must not already hold a run).
     pub fn create(dir: &Path, config: TrainConfig) -> Result<Self, RlError> {
         Self::check_free(dir)?;
-        Self::with_trainer(dir, Trainer::new(config)?)
+        Self::with_trainer(dir, L::build(config)?)
     }
 
     fn check_free(dir: &Path) -> Result<(), RlError> {
@@ -126,16 +162,16 @@ impl Run {
     }
 
     /// Starts a run in `dir` with a trainer built elsewhere (e.g. on the robot's environment).
-    pub fn with_trainer(dir: &Path, trainer: Trainer) -> Result<Self, RlError> {
+    pub fn with_trainer(dir: &Path, trainer: L) -> Result<Self, RlError> {
         Self::check_free(dir)?;
         fs::create_dir_all(dir.join(CHECKPOINTS)).map_err(|e| RlError::io(dir, e))?;
-        write_metrics(dir, &[])?;
+        write_metrics::<L::Metrics>(dir, &[])?;
         // The config last: a folder with a config is a run.
         write_atomic(&dir.join(CONFIG), trainer.config().to_toml().as_bytes())?;
         Ok(Self::new(dir, trainer, 0.0, Vec::new()))
     }
 
-    fn new(dir: &Path, trainer: Trainer, wall_before: f64, repairs: Vec<String>) -> Self {
+    fn new(dir: &Path, trainer: L, wall_before: f64, repairs: Vec<String>) -> Self {
         Self {
             dir: dir.to_path_buf(),
             trainer,
@@ -148,7 +184,7 @@ impl Run {
 
     /// Continues the run in `dir` from its latest checkpoint (from scratch if it has none).
     pub fn resume(dir: &Path) -> Result<Self, RlError> {
-        Self::resume_with(dir, Trainer::new)
+        Self::resume_with(dir, L::build)
     }
 
     /// Continues the run in `dir`, building its trainer with `build` from the saved config.
@@ -160,13 +196,13 @@ impl Run {
     /// be loaded although the run has written one.
     pub fn resume_with(
         dir: &Path,
-        mut build: impl FnMut(TrainConfig) -> Result<Trainer, RlError>,
+        mut build: impl FnMut(TrainConfig) -> Result<L, RlError>,
     ) -> Result<Self, RlError> {
         let config = load_config(dir)?;
         // A directory planned by a sweep holds only its config: the run starts here.
         if !dir.join(METRICS).exists() {
             fs::create_dir_all(dir.join(CHECKPOINTS)).map_err(|e| RlError::io(dir, e))?;
-            write_metrics(dir, &[])?;
+            write_metrics::<L::Metrics>(dir, &[])?;
         }
         let mut repairs: Vec<String> = clean_leftovers(&dir.join(CHECKPOINTS))?
             .into_iter()
@@ -206,7 +242,7 @@ impl Run {
                 }
             }
         }
-        let (mut metrics, torn) = read_metrics_text(dir)?;
+        let (mut metrics, torn) = read_metrics_text::<L::Metrics>(dir)?;
         if torn {
             repairs.push(format!("dropped a torn last line of {METRICS}"));
         }
@@ -227,7 +263,7 @@ impl Run {
         // Evaluations after the checkpoint are redone; a run with no checkpoint starts afresh.
         let epoch = trainer.epoch();
         let before = metrics.len();
-        metrics.retain(|m| resumed.is_some() && m.epoch <= epoch);
+        metrics.retain(|m| resumed.is_some() && m.epoch() <= epoch);
         if metrics.len() < before {
             repairs.push(format!(
                 "dropped {} evaluation line(s) after epoch {epoch}, to be redone",
@@ -237,7 +273,7 @@ impl Run {
         if metrics.len() < before || torn {
             write_metrics(dir, &metrics)?;
         }
-        let wall_before = metrics.last().map_or(0.0, |m| m.wall_s);
+        let wall_before = metrics.last().map_or(0.0, |m| m.wall_s());
         Ok(Self::new(dir, trainer, wall_before, repairs))
     }
 
@@ -252,7 +288,7 @@ impl Run {
     }
 
     /// The trainer.
-    pub fn trainer(&self) -> &Trainer {
+    pub fn trainer(&self) -> &L {
         &self.trainer
     }
 
@@ -271,23 +307,10 @@ impl Run {
         self.wall_before + self.started.elapsed().as_secs_f64()
     }
 
-    /// Evaluates skill coverage and appends a metrics line.
-    pub fn evaluate(&mut self, stats: &EpochStats) -> Result<Metrics, RlError> {
-        let skill_coverage = self.trainer.skill_coverage()?;
+    /// Evaluates the agent (SEADS: skill coverage) and appends a metrics line.
+    pub fn evaluate(&mut self, stats: &L::Stats) -> Result<L::Metrics, RlError> {
         let wall_s = self.wall_s();
-        let metrics = Metrics {
-            epoch: self.trainer.epoch(),
-            env_steps: self.trainer.env_steps(),
-            skill_coverage,
-            wall_s,
-            mean_reward: stats.mean_reward,
-            changed: stats.changed,
-            skill_model_loss: stats.skill_model_loss,
-            critic_loss: stats.sac.critic,
-            actor_loss: stats.sac.actor,
-            steps_per_s: self.trainer.env_steps() as f64 / wall_s.max(1e-9),
-            timings: self.trainer.timings(),
-        };
+        let metrics = self.trainer.metrics(stats, wall_s)?;
         append_metrics(&self.dir, &metrics)?;
         (self.hook)(Moment::MetricsAppended);
         Ok(metrics)
@@ -315,7 +338,7 @@ impl Run {
             .map(|(_, p)| p)
             .collect();
         for old in older.iter().rev().skip(2) {
-            for file in crate::checkpoint::resume_only_files() {
+            for file in L::resume_only_files() {
                 match fs::remove_file(old.join(file)) {
                     Err(e) if e.kind() != std::io::ErrorKind::NotFound => {
                         return Err(RlError::io(&old.join(file), e));
@@ -329,7 +352,7 @@ impl Run {
 
     /// One epoch, plus the evaluation and checkpoint that are due after it (both also before
     /// the first epoch's updates, i.e. at epoch 1, and when the budget is spent).
-    pub fn step(&mut self) -> Result<RunEvent, RlError> {
+    pub fn step(&mut self) -> Result<RunEvent<L>, RlError> {
         let first = self.trainer.epoch() == 0;
         let stats = self.trainer.run_epoch_observed(&mut self.hook)?;
         (self.hook)(Moment::EpochDone);
@@ -379,4 +402,50 @@ pub fn load_config(dir: &Path) -> Result<TrainConfig, RlError> {
     let path = dir.join(CONFIG);
     let text = fs::read_to_string(&path).map_err(|e| RlError::io(&path, e))?;
     TrainConfig::from_toml(&text).map_err(|e| RlError::Config(format!("{}: {e}", path.display())))
+}
+
+impl Learner for Trainer {
+    type Stats = EpochStats;
+    type Metrics = Metrics;
+
+    fn build(config: TrainConfig) -> Result<Self, RlError> {
+        Trainer::new(config)
+    }
+    fn config(&self) -> &TrainConfig {
+        Trainer::config(self)
+    }
+    fn epoch(&self) -> u64 {
+        Trainer::epoch(self)
+    }
+    fn finished(&self) -> bool {
+        Trainer::finished(self)
+    }
+    fn run_epoch_observed(&mut self, hook: &mut dyn FnMut(Moment)) -> Result<EpochStats, RlError> {
+        Trainer::run_epoch_observed(self, hook)
+    }
+    fn metrics(&mut self, stats: &EpochStats, wall_s: f64) -> Result<Metrics, RlError> {
+        let skill_coverage = self.skill_coverage()?;
+        Ok(Metrics {
+            epoch: self.epoch(),
+            env_steps: self.env_steps(),
+            skill_coverage,
+            wall_s,
+            mean_reward: stats.mean_reward,
+            changed: stats.changed,
+            skill_model_loss: stats.skill_model_loss,
+            critic_loss: stats.sac.critic,
+            actor_loss: stats.sac.actor,
+            steps_per_s: self.env_steps() as f64 / wall_s.max(1e-9),
+            timings: self.timings(),
+        })
+    }
+    fn save(&self, dir: &Path) -> Result<(), RlError> {
+        Trainer::save(self, dir)
+    }
+    fn load(&mut self, dir: &Path) -> Result<(), RlError> {
+        Trainer::load(self, dir)
+    }
+    fn resume_only_files() -> Vec<&'static str> {
+        crate::checkpoint::resume_only_files()
+    }
 }

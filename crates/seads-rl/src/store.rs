@@ -13,7 +13,18 @@ use std::fs;
 use std::io::Write as _;
 use std::path::{Path, PathBuf};
 
+use serde::Serialize;
+use serde::de::DeserializeOwned;
+
 use crate::{Metrics, RlError};
+
+/// A line of `metrics.jsonl`: what resuming needs to know of it.
+pub trait MetricsLine: Serialize + DeserializeOwned {
+    /// Epochs completed when it was written.
+    fn epoch(&self) -> u64;
+    /// Wall-clock seconds of the run when it was written.
+    fn wall_s(&self) -> f64;
+}
 
 /// The folder of checkpoints in a run directory.
 pub const CHECKPOINTS: &str = "checkpoints";
@@ -157,11 +168,16 @@ pub fn latest_checkpoint(dir: &Path) -> Result<Option<PathBuf>, RlError> {
 /// The lines of `dir/metrics.jsonl`. A last line without its newline is the trace of a crash
 /// during the append and is left out; any other line that does not parse is an error.
 pub fn read_metrics(dir: &Path) -> Result<Vec<Metrics>, RlError> {
+    read_metrics_as(dir)
+}
+
+/// [`read_metrics`] for any kind of line (a baseline's [`TaskMetrics`](crate::TaskMetrics)).
+pub fn read_metrics_as<M: MetricsLine>(dir: &Path) -> Result<Vec<M>, RlError> {
     Ok(read_metrics_text(dir)?.0)
 }
 
 /// The whole lines of `dir/metrics.jsonl`, and whether a torn last line was left out.
-pub(crate) fn read_metrics_text(dir: &Path) -> Result<(Vec<Metrics>, bool), RlError> {
+pub(crate) fn read_metrics_text<M: MetricsLine>(dir: &Path) -> Result<(Vec<M>, bool), RlError> {
     let path = dir.join(METRICS);
     let text = fs::read_to_string(&path).map_err(|e| RlError::io(&path, e))?;
     let (whole, torn) = match text.rfind('\n') {
@@ -183,7 +199,7 @@ pub(crate) fn read_metrics_text(dir: &Path) -> Result<(Vec<Metrics>, bool), RlEr
 }
 
 /// Appends one line to `dir/metrics.jsonl` and fsyncs it.
-pub fn append_metrics(dir: &Path, metrics: &Metrics) -> Result<(), RlError> {
+pub fn append_metrics<M: MetricsLine>(dir: &Path, metrics: &M) -> Result<(), RlError> {
     let path = dir.join(METRICS);
     let mut line = serde_json::to_string(metrics).map_err(|e| RlError::io(&path, e))?;
     line.push('\n');
@@ -197,7 +213,7 @@ pub fn append_metrics(dir: &Path, metrics: &Metrics) -> Result<(), RlError> {
 }
 
 /// Rewrites `dir/metrics.jsonl` with exactly `metrics`.
-pub fn write_metrics(dir: &Path, metrics: &[Metrics]) -> Result<(), RlError> {
+pub fn write_metrics<M: MetricsLine>(dir: &Path, metrics: &[M]) -> Result<(), RlError> {
     let path = dir.join(METRICS);
     let mut text = String::new();
     for m in metrics {

@@ -169,7 +169,7 @@ fn same_seed_same_run() {
 fn resume_continues_from_the_last_checkpoint() {
     let dir = tempfile::tempdir().unwrap();
     let path = dir.path().join("run");
-    let mut run = Run::create(&path, small(11, 2500)).unwrap();
+    let mut run = Run::<Trainer>::create(&path, small(11, 2500)).unwrap();
     let mut at_checkpoint = None;
     for _ in 0..25 {
         let event = run.step().unwrap();
@@ -187,10 +187,10 @@ fn resume_continues_from_the_last_checkpoint() {
     drop(run);
     // Creating again in the same directory is refused.
     assert!(matches!(
-        Run::create(&path, small(11, 2500)),
+        Run::<Trainer>::create(&path, small(11, 2500)),
         Err(RlError::Config(m)) if m.contains("already holds a run")
     ));
-    let mut resumed = Run::resume(&path).unwrap();
+    let mut resumed = Run::<Trainer>::resume(&path).unwrap();
     assert_eq!(
         (resumed.trainer().epoch(), resumed.trainer().env_steps()),
         (epoch, steps)
@@ -253,7 +253,7 @@ fn chain(err: impl std::error::Error + Send + Sync + 'static) -> String {
 fn corrupt_checkpoints_are_errors_not_panics() {
     let dir = tempfile::tempdir().unwrap();
     let path = dir.path().join("run");
-    let mut run = Run::create(&path, small(2, 4000)).unwrap();
+    let mut run = Run::<Trainer>::create(&path, small(2, 4000)).unwrap();
     while !run.finished() {
         run.step().unwrap();
     }
@@ -263,7 +263,7 @@ fn corrupt_checkpoints_are_errors_not_panics() {
     let episodes = latest.join("episodes.safetensors");
     let intact = std::fs::read(&episodes).unwrap();
     std::fs::write(&episodes, b"garbage").unwrap();
-    let resumed = Run::resume(&path).unwrap();
+    let resumed = Run::<Trainer>::resume(&path).unwrap();
     assert!(
         resumed.repairs()[0].contains("episodes.safetensors"),
         "{:?}",
@@ -276,7 +276,7 @@ fn corrupt_checkpoints_are_errors_not_panics() {
     );
     drop(resumed);
     std::fs::write(before.join("episodes.safetensors"), b"garbage").unwrap();
-    let err = Run::resume(&path)
+    let err = Run::<Trainer>::resume(&path)
         .err()
         .expect("no loadable checkpoint is an error");
     let text = chain(err);
@@ -287,7 +287,7 @@ fn corrupt_checkpoints_are_errors_not_panics() {
     let lengths = &mut tensors.iter_mut().find(|(n, _)| n == "lengths").unwrap().1;
     let _ = lengths.get(1).fill_(-1);
     tch::Tensor::write_safetensors(&tensors, &episodes).unwrap();
-    let err = Run::resume(&path)
+    let err = Run::<Trainer>::resume(&path)
         .err()
         .expect("a negative episode length is an error");
     let text = chain(err);
@@ -296,12 +296,17 @@ fn corrupt_checkpoints_are_errors_not_panics() {
     std::fs::write(&episodes, &intact).unwrap();
     std::fs::remove_file(latest.join("sac_critic_adam.safetensors")).unwrap();
     std::fs::remove_dir_all(before).unwrap();
-    let err = Run::resume(&path).err().expect("a missing optimiser state");
+    let err = Run::<Trainer>::resume(&path)
+        .err()
+        .expect("a missing optimiser state");
     let text = chain(err);
     assert!(text.contains("sac_critic_adam"), "{text}");
     std::fs::remove_dir_all(latest).unwrap();
     assert!(
-        matches!(Run::resume(&path), Err(RlError::NoCheckpoint { .. })),
+        matches!(
+            Run::<Trainer>::resume(&path),
+            Err(RlError::NoCheckpoint { .. })
+        ),
         "checkpoints were written, none that resuming can load is left"
     );
 }
@@ -335,17 +340,17 @@ fn a_resumed_run_equals_the_uninterrupted_run() {
             .collect()
     };
     let whole = dir.path().join("whole");
-    let mut run = Run::create(&whole, config.clone()).unwrap();
+    let mut run = Run::<Trainer>::create(&whole, config.clone()).unwrap();
     while !run.finished() {
         run.step().unwrap();
     }
     let killed = dir.path().join("killed");
-    let mut run = Run::create(&killed, config).unwrap();
+    let mut run = Run::<Trainer>::create(&killed, config).unwrap();
     for _ in 0..13 {
         run.step().unwrap();
     }
     drop(run); // killed at epoch 13, after its epoch-10 checkpoint
-    let mut run = Run::resume(&killed).unwrap();
+    let mut run = Run::<Trainer>::resume(&killed).unwrap();
     assert_eq!(run.trainer().epoch(), 10);
     while !run.finished() {
         run.step().unwrap();

@@ -132,10 +132,14 @@ pub fn coverage_figures(
                         .collect()
                 })
                 .collect();
-            curves.push((
-                format!("{} (n = {})", g.variant, g.runs.len()),
-                band(&series),
-            ));
+            // A baseline has no skills: no curve.
+            let band = band(&series);
+            if !band.is_empty() {
+                curves.push((format!("{} (n = {})", g.variant, g.runs.len()), band));
+            }
+        }
+        if curves.is_empty() {
+            continue;
         }
         let title = format!("Skill coverage: {env} (mean, min–max band)");
         written.extend(both(out, &format!("coverage-{env}"), &|p| {
@@ -151,8 +155,9 @@ pub fn coverage_figures(
     Ok(written)
 }
 
-/// Task success over training (with re-planning, mean over the depths) per environment, for
-/// the groups whose runs were evaluated over training; returns the files written.
+/// Task success over training (SEADS with re-planning, a baseline's policy; mean over the depths)
+/// per environment, for the groups whose runs were evaluated over training; returns the files
+/// written.
 pub fn success_figures(out: &Path, groups: &[Group<'_>]) -> Result<Vec<PathBuf>> {
     let mut written = Vec::new();
     for env in envs(groups) {
@@ -162,6 +167,14 @@ pub fn success_figures(out: &Path, groups: &[Group<'_>]) -> Result<Vec<PathBuf>>
                 .runs
                 .iter()
                 .map(|r| {
+                    // A baseline evaluates its policy as it trains (metrics.jsonl).
+                    if !r.task_metrics.is_empty() {
+                        return r
+                            .task_metrics
+                            .iter()
+                            .map(|m| (m.epoch, m.env_steps as f64, 100.0 * m.mean_success))
+                            .collect();
+                    }
                     r.over_training
                         .iter()
                         .filter(|l| l.replan)
@@ -187,7 +200,9 @@ pub fn success_figures(out: &Path, groups: &[Group<'_>]) -> Result<Vec<PathBuf>>
         if curves.is_empty() {
             continue;
         }
-        let title = format!("Task success over training: {env} (re-planning, depths pooled)");
+        let title = format!(
+            "Task success over training: {env} (SEADS re-planning, baselines' policies; depths pooled)"
+        );
         written.extend(both(out, &format!("success-{env}"), &|p| {
             band_figure(p, &title, "test tasks solved (%)", 105.0, &curves)
         })?);

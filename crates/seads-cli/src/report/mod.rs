@@ -79,7 +79,7 @@ pub fn report(args: ReportArgs) -> Result<()> {
     );
     let mut not_started = 0;
     for run in &unfinished {
-        let steps = run.metrics.last().map_or(0, |m| m.env_steps);
+        let steps = run.env_steps();
         if steps == 0 {
             not_started += 1;
             continue;

@@ -6,7 +6,7 @@ use std::path::{Path, PathBuf};
 
 use anyhow::{Context, Result, anyhow, bail};
 use seads_planner::DepthResult;
-use seads_rl::{Metrics, TrainConfig};
+use seads_rl::{Algorithm, Metrics, TaskMetrics, TrainConfig};
 
 use crate::overtraining::CheckpointEvaluation;
 use crate::sweep::Sweep;
@@ -22,8 +22,12 @@ pub struct RunData {
     pub variant: String,
     /// Configuration.
     pub config: TrainConfig,
-    /// Skill-coverage evaluations.
+    /// Skill-coverage evaluations (SEADS).
     pub metrics: Vec<Metrics>,
+    /// Task-success evaluations over training (the SAC baseline).
+    pub task_metrics: Vec<TaskMetrics>,
+    /// Final task success of a baseline's policy acting alone, if any.
+    pub policy: Option<Vec<DepthResult>>,
     /// Final task evaluation with re-planning, if any.
     pub replan: Option<Vec<DepthResult>>,
     /// Final task evaluation without re-planning, if any.
@@ -35,9 +39,15 @@ pub struct RunData {
 impl RunData {
     /// Whether training spent its budget.
     pub fn finished(&self) -> bool {
-        self.metrics
-            .last()
-            .is_some_and(|m| m.env_steps >= self.config.env_steps)
+        self.env_steps() >= self.config.env_steps
+    }
+
+    /// Environment steps at the last evaluation (0 before the first).
+    pub fn env_steps(&self) -> u64 {
+        match self.config.algorithm {
+            Algorithm::Seads => self.metrics.last().map_or(0, |m| m.env_steps),
+            Algorithm::Sac => self.task_metrics.last().map_or(0, |m| m.env_steps),
+        }
     }
 
     /// Skill coverage at the end of training.
@@ -47,7 +57,13 @@ impl RunData {
 
     fn load(dir: &Path, variant: String, copy_to: PathBuf) -> Result<Self> {
         let config = seads_rl::load_config(dir)?;
-        let metrics = seads_rl::read_metrics(dir).unwrap_or_default();
+        let (metrics, task_metrics) = match config.algorithm {
+            Algorithm::Seads => (seads_rl::read_metrics(dir).unwrap_or_default(), Vec::new()),
+            Algorithm::Sac => (
+                Vec::new(),
+                seads_rl::read_metrics_as::<TaskMetrics>(dir).unwrap_or_default(),
+            ),
+        };
         let evaluation = |name: &str| -> Result<Option<Vec<DepthResult>>> {
             let path = dir.join(name);
             match std::fs::read_to_string(&path) {
@@ -64,9 +80,11 @@ impl RunData {
             variant,
             replan: evaluation("evaluation-replan.json")?,
             plan_once: evaluation("evaluation-plan-once.json")?,
+            policy: evaluation(crate::plan::POLICY_EVALUATION)?,
             over_training: crate::overtraining::read(dir)?,
             config,
             metrics,
+            task_metrics,
         })
     }
 }

@@ -134,12 +134,33 @@ pub fn coverage_csv(cells: &[CoverageCell]) -> String {
     csv
 }
 
+/// How a final evaluation solved its tasks.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Mode {
+    /// SEADS, planning again on a deviation (Algorithm 2).
+    Replan,
+    /// SEADS, one plan (Algorithm 1).
+    PlanOnce,
+    /// A baseline's policy acting alone.
+    Policy,
+}
+
+impl Mode {
+    fn label(self) -> &'static str {
+        match self {
+            Mode::Replan => "re-planning",
+            Mode::PlanOnce => "plan once",
+            Mode::Policy => "policy",
+        }
+    }
+}
+
 /// The final evaluation of a run in one mode.
-fn evaluation(run: &RunData, replan: bool) -> Option<&Vec<DepthResult>> {
-    if replan {
-        run.replan.as_ref()
-    } else {
-        run.plan_once.as_ref()
+fn evaluation(run: &RunData, mode: Mode) -> Option<&Vec<DepthResult>> {
+    match mode {
+        Mode::Replan => run.replan.as_ref(),
+        Mode::PlanOnce => run.plan_once.as_ref(),
+        Mode::Policy => run.policy.as_ref(),
     }
 }
 
@@ -148,7 +169,7 @@ fn depths(groups: &[Group<'_>]) -> Vec<usize> {
     let mut depths: Vec<usize> = groups
         .iter()
         .flat_map(|g| g.runs.iter())
-        .flat_map(|r| r.replan.iter().chain(r.plan_once.iter()))
+        .flat_map(|r| r.replan.iter().chain(&r.plan_once).chain(&r.policy))
         .flat_map(|e| e.iter().map(|d| d.depth))
         .collect();
     depths.sort_unstable();
@@ -168,16 +189,13 @@ pub fn success_tables(groups: &[Group<'_>]) -> (String, String) {
     md.push('\n');
     let mut csv = String::from("env,variant,mode,runs,depth,mean_success,std_success\n");
     for g in groups {
-        for replan in [true, false] {
-            let evaluated: Vec<&Vec<DepthResult>> = g
-                .runs
-                .iter()
-                .filter_map(|r| evaluation(r, replan))
-                .collect();
+        for mode in [Mode::Replan, Mode::PlanOnce, Mode::Policy] {
+            let evaluated: Vec<&Vec<DepthResult>> =
+                g.runs.iter().filter_map(|r| evaluation(r, mode)).collect();
             if evaluated.is_empty() {
                 continue;
             }
-            let mode = if replan { "re-planning" } else { "plan once" };
+            let mode = mode.label();
             let _ = write!(
                 md,
                 "| {} | {} | {mode} | {} |",
@@ -211,7 +229,7 @@ pub fn success_tables(groups: &[Group<'_>]) -> (String, String) {
     let timeouts: usize = groups
         .iter()
         .flat_map(|g| g.runs.iter())
-        .flat_map(|r| r.replan.iter().chain(r.plan_once.iter()))
+        .flat_map(|r| r.replan.iter().chain(&r.plan_once).chain(&r.policy))
         .flat_map(|e| e.iter().map(|d| d.timeouts))
         .sum();
     if timeouts > 0 {

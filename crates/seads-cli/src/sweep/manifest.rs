@@ -219,8 +219,19 @@ impl Manifest {
     }
 
     /// The preset of `env` with the study's, the variant's and the environment's overrides.
+    /// A layer that sets `algorithm = "sac"` starts from the baseline's preset.
     fn config(&self, env: &str, variant: &Variant, seed: u64) -> Result<TrainConfig> {
-        let preset = TrainConfig::presets()
+        let env_layer = variant.env_overrides.get(env);
+        let named = [Some(&self.overrides), Some(&variant.overrides), env_layer]
+            .into_iter()
+            .flatten()
+            .filter_map(|layer| layer.get("algorithm").and_then(|v| v.as_str()))
+            .next_back();
+        let presets = match named {
+            Some("sac") => TrainConfig::sac_presets(),
+            _ => TrainConfig::presets(),
+        };
+        let preset = presets
             .iter()
             .find(|(name, _)| *name == env)
             .map(|(_, text)| *text)
@@ -230,7 +241,6 @@ impl Manifest {
             ("overrides", &self.overrides),
             ("variant overrides", &variant.overrides),
         ];
-        let env_layer = variant.env_overrides.get(env);
         for (what, layer) in layers
             .into_iter()
             .chain(env_layer.map(|l| ("environment overrides", l)))
@@ -407,6 +417,14 @@ env_overrides = { "lightsout-cursor" = { num_skills = 30 }, "tileswap-cursor" = 
                 include_str!("../../../../experiments/board-size.toml"),
                 5 * 5,
             ),
+            (
+                include_str!("../../../../experiments/baselines.toml"),
+                2 * 2 * 5,
+            ),
+            (
+                include_str!("../../../../experiments/sac-grid.toml"),
+                6 * 9 * 5,
+            ),
         ];
         for (text, count) in shipped {
             let m = Manifest::parse(text, "experiments").unwrap();
@@ -419,13 +437,25 @@ env_overrides = { "lightsout-cursor" = { num_skills = 30 }, "tileswap-cursor" = 
                 m.name
             );
             for run in &runs {
-                // Each variant changes only what its name says (SPEC §3.9, §3.10).
-                let preset = TrainConfig::preset(&run.env).unwrap();
+                // Each variant changes only what its name says (SPEC §3.9, §3.10, §5.1).
+                let baseline = m.name == "sac-grid" || run.variant == "sac";
+                let algorithm = if baseline {
+                    seads_rl::Algorithm::Sac
+                } else {
+                    seads_rl::Algorithm::Seads
+                };
+                let preset = TrainConfig::preset_for(&run.env, algorithm).unwrap();
                 let mut expected = preset.clone();
                 expected.seed = run.seed;
                 let c = &run.config;
                 match run.variant.as_str() {
-                    "seads" | "size-5" => {}
+                    "seads" | "size-5" | "sac" => {}
+                    v if m.name == "sac-grid" => {
+                        // n<N>-a<alpha>, N with "_" for ".".
+                        let (n, a) = v[1..].split_once("-a").unwrap();
+                        expected.baseline.updates_per_epoch = n.replace('_', ".").parse().unwrap();
+                        expected.sac.alpha = a.parse().unwrap();
+                    }
                     "no-second-best-norm" => {
                         expected.reward.normalisation = seads_skillmodel::Normalisation::LogK;
                     }

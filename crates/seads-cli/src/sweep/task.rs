@@ -5,7 +5,7 @@
 use std::path::Path;
 
 use anyhow::{Context, Result};
-use seads_rl::{Run, Trainer};
+use seads_rl::{Algorithm, Run, TaskSac, Trainer};
 use seads_skillmodel::SkillModelKind;
 
 use super::index::Sweep;
@@ -50,6 +50,9 @@ fn train_and_evaluate(sweep: &Sweep, run: &Path, cores: usize) -> Result<()> {
         seads_rl::load_config(run).with_context(|| format!("loading {}", run.display()))?;
     crate::kernels::use_kernels(config.portable_numerics)?;
     let (threads, alone) = thread_split(cores);
+    if config.algorithm == Algorithm::Sac {
+        return train_and_evaluate_baseline(sweep, run, cores);
+    }
     let mut training = crate::train::resume(
         run,
         Run::resume_with(run, |mut c| {
@@ -113,6 +116,45 @@ fn train_and_evaluate(sweep: &Sweep, run: &Path, cores: usize) -> Result<()> {
                 }
             );
         }
+    }
+    Ok(())
+}
+
+/// A baseline run: training on all of the task's cores (one training thread), then task success
+/// of the final policy on the study's boards per depth (`evaluation-policy.json`).
+fn train_and_evaluate_baseline(sweep: &Sweep, run: &Path, cores: usize) -> Result<()> {
+    let mut training = crate::train::resume(
+        run,
+        Run::resume_with(run, |mut c| {
+            c.threads = cores.max(1);
+            c.sac_threads_alone = 0;
+            TaskSac::new(c)
+        }),
+    )?;
+    if !training.finished() {
+        println!(
+            "{}: training the SAC baseline from epoch {} with {} libtorch thread(s)",
+            run.display(),
+            training.trainer().epoch(),
+            cores.max(1)
+        );
+        crate::train::drive(&mut training, true)?;
+    }
+    if sweep.evaluation.last {
+        let config = training.trainer().config().clone();
+        let results = seads_rl::task_success(
+            &config,
+            training.trainer().policy(),
+            &[1, 2, 3, 4, 5],
+            sweep.evaluation.boards,
+        )?;
+        seads_rl::write_atomic(
+            &run.join(crate::plan::POLICY_EVALUATION),
+            serde_json::to_string_pretty(&results)?.as_bytes(),
+        )?;
+        let solved: usize = results.iter().map(|r| r.solved).sum();
+        let tasks: usize = results.iter().map(|r| r.tasks).sum();
+        println!("{}: policy {solved}/{tasks} solved", run.display());
     }
     Ok(())
 }

@@ -1,0 +1,178 @@
+//! The flat SAC baseline through the binary: `seads train --algorithm sac` with its preset, a
+//! tiny run trained, extended by `--resume`, evaluated on the SEADS protocol and reported beside
+//! SEADS's modes; the planning commands refuse it in one line.
+
+use std::io::{BufRead, BufReader};
+use std::path::{Path, PathBuf};
+use std::process::{Command, Stdio};
+
+mod common;
+use common::*;
+
+/// A tiny baseline run: 30 epochs of 8 steps, evaluations and checkpoints every 10 epochs.
+fn tiny_config(dir: &Path) -> PathBuf {
+    let path = dir.join("sac.toml");
+    std::fs::write(
+        &path,
+        r#"
+algorithm = "sac"
+env = "lightsout-cursor"
+seed = 3
+env_steps = 240
+eval_every = 10
+checkpoint_every = 10
+portable_numerics = true
+
+[sac]
+hidden = [16, 16]
+batch_size = 16
+alpha = 0.1
+
+[baseline]
+replay_capacity = 100
+eval_boards = 1
+"#,
+    )
+    .unwrap();
+    path
+}
+
+fn metrics(run: &Path) -> Vec<serde_json::Value> {
+    std::fs::read_to_string(run.join("metrics.jsonl"))
+        .unwrap()
+        .lines()
+        .map(|l| serde_json::from_str(l).unwrap())
+        .collect()
+}
+
+/// The metrics without the wall-clock fields.
+fn numbers(run: &Path) -> Vec<serde_json::Value> {
+    metrics(run)
+        .into_iter()
+        .map(|mut m| {
+            for key in ["wall_s", "steps_per_s", "timings"] {
+                m.as_object_mut().unwrap().remove(key);
+            }
+            m
+        })
+        .collect()
+}
+
+#[test]
+fn the_preset_is_the_papers_baseline() {
+    let dir = tempfile::tempdir().unwrap();
+    let run = dir.path().join("run");
+    let args = [
+        "train",
+        "--env",
+        "tileswap-cursor",
+        "--algorithm",
+        "sac",
+        "--env-steps",
+        "8",
+        "--out",
+        s(&run),
+        "--quiet",
+    ];
+    let out = seads_ok(&args);
+    assert!(String::from_utf8_lossy(&out.stdout).contains("task success"));
+    let config = std::fs::read_to_string(run.join("config.toml")).unwrap();
+    for line in [
+        "algorithm = \"sac\"",
+        "hidden = [512, 512, 512]",
+        "updates_per_epoch = 1.0",
+    ] {
+        assert!(config.contains(line), "{config}");
+    }
+    assert_eq!(metrics(&run)[0]["success"].as_array().unwrap().len(), 5);
+}
+
+#[test]
+fn a_baseline_run_trains_resumes_evaluates_and_is_reported() {
+    let dir = tempfile::tempdir().unwrap();
+    let config = tiny_config(dir.path());
+    let run = dir.path().join("run");
+    seads_ok(&["train", "--config", s(&config), "--out", s(&run), "--quiet"]);
+    let epochs: Vec<u64> = metrics(&run)
+        .iter()
+        .map(|m| m["epoch"].as_u64().unwrap())
+        .collect();
+    assert_eq!(epochs, [1, 10, 20, 30]);
+    // More budget: the run continues from its last checkpoint.
+    seads_ok(&[
+        "train",
+        "--resume",
+        s(&run),
+        "--env-steps",
+        "320",
+        "--quiet",
+    ]);
+    let m = metrics(&run);
+    assert_eq!(m.last().unwrap()["epoch"], 40);
+    assert_eq!(m.last().unwrap()["env_steps"], 320);
+
+    let v = json(&["evaluate", "--run", s(&run), "--boards", "2", "--json"]);
+    assert_eq!(v["success_rate"].as_object().unwrap().len(), 5, "{v}");
+    let saved: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(run.join("evaluation-policy.json")).unwrap())
+            .unwrap();
+    assert!(saved.as_array().unwrap().iter().all(|d| d["tasks"] == 2));
+
+    check_bad_input(
+        &[
+            "solve",
+            "--run",
+            s(&run),
+            "--board",
+            "1,1,0,0,0,1,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0",
+        ],
+        "baseline run",
+    );
+    check_bad_input(
+        &["evaluate", "--run", s(&run), "--checkpoints", "all"],
+        "metrics.jsonl",
+    );
+
+    let report = dir.path().join("report");
+    seads_ok(&["report", s(&run), "--out", s(&report)]);
+    let md = std::fs::read_to_string(report.join("report.md")).unwrap();
+    assert!(md.contains("| run | policy | 1 |"), "{md}");
+    assert!(report.join("success-lightsout-cursor.png").is_file());
+}
+
+/// Killed with SIGKILL at moments spread over its life (collection, metrics appends, checkpoint
+/// writes; `SEADS_CRASH_POINT` counts them) and resumed, a baseline run ends as the uninterrupted
+/// one: the replay buffer, the streams and the open episodes come back exactly.
+#[test]
+fn a_killed_baseline_run_resumes_to_the_same_run() {
+    let dir = tempfile::tempdir().unwrap();
+    let config = tiny_config(dir.path());
+    let whole = dir.path().join("whole");
+    seads_ok(&[
+        "train",
+        "--config",
+        s(&config),
+        "--out",
+        s(&whole),
+        "--quiet",
+    ]);
+    for point in [3, 24, 29, 47, 66] {
+        let out = dir.path().join(format!("killed-{point}"));
+        let mut child = Command::new(env!("CARGO_BIN_EXE_seads"))
+            .args(["train", "--config", s(&config), "--out", s(&out), "--quiet"])
+            .env("SEADS_CRASH_POINT", point.to_string())
+            .stdout(Stdio::null())
+            .stderr(Stdio::piped())
+            .spawn()
+            .unwrap();
+        let stderr = BufReader::new(child.stderr.take().unwrap());
+        let stopped = stderr
+            .lines()
+            .any(|l| l.unwrap().starts_with("seads: stopped at moment"));
+        assert!(stopped, "the run never reached moment {point}");
+        child.kill().unwrap();
+        child.wait().unwrap();
+        seads_ok(&["train", "--resume", s(&out), "--quiet"]);
+        assert_eq!(numbers(&out), numbers(&whole), "killed at moment {point}");
+    }
+}

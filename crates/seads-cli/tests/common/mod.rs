@@ -1,0 +1,48 @@
+//! Helpers shared by the binary's end-to-end tests: running `seads` and checking its exit.
+
+#![allow(dead_code)] // each test file uses some of them
+
+use std::path::Path;
+use std::process::{Command, Output};
+
+/// Runs the `seads` binary of this build.
+pub fn seads(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_seads"))
+        .args(args)
+        .output()
+        .expect("run seads")
+}
+
+/// Runs seads and asserts that it succeeded.
+pub fn seads_ok(args: &[&str]) -> Output {
+    let out = seads(args);
+    assert!(
+        out.status.success(),
+        "seads {args:?}: {}{}",
+        String::from_utf8_lossy(&out.stdout),
+        String::from_utf8_lossy(&out.stderr)
+    );
+    out
+}
+
+/// The JSON a successful call prints.
+pub fn json(args: &[&str]) -> serde_json::Value {
+    serde_json::from_slice(&seads_ok(args).stdout).expect("valid JSON")
+}
+
+/// Exit code 2 and a single `error:` line on stderr that says `needle`.
+pub fn check_bad_input(args: &[&str], needle: &str) {
+    let out = seads(args);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "seads {args:?}: {stderr}");
+    assert_eq!(stderr.lines().count(), 1, "one line: {stderr}");
+    assert!(
+        stderr.starts_with("error: ") && stderr.contains(needle),
+        "seads {args:?}: {stderr:?} should say {needle:?}"
+    );
+}
+
+/// A path as the `&str` an argument list wants.
+pub fn s(p: &Path) -> &str {
+    p.to_str().expect("UTF-8 path")
+}

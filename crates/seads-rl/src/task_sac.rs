@@ -1,0 +1,658 @@
+//! The flat SAC baseline with the task reward (SPEC §5.1): SAC on the environment's own
+//! observation in task mode ([`TaskEnv`]), a replay buffer of the most recent transitions, and
+//! task success on the SEADS protocol's test boards as its evaluation.
+//!
+//! One epoch steps each of `samples_per_epoch` environments once (an episode continues across
+//! epochs), stores the transitions, and takes N gradient steps, N < 1 meaning one every 1/N
+//! epochs. An episode ends when the board is solved or after T_lim steps; both end the return
+//! (the observation carries the time left, so the limit is part of the state).
+//!
+//! Resuming is exact: a checkpoint holds the networks, the optimisers, the replay buffer, the
+//! random streams, and for each environment the seed and actions of its open episode, which
+//! resuming replays (the simulations are deterministic given a seed).
+
+use std::path::Path;
+use std::time::Instant;
+
+use rand::RngExt;
+use rand_chacha::ChaCha8Rng;
+use seads_embodiment::{EnvConfig, EnvSpec, TaskEnv, make_env};
+use seads_games::Split;
+use seads_planner::{DepthResult, EVALUATION_SEEDS};
+use serde::{Deserialize, Serialize};
+use tch::{Device, Tensor};
+
+use crate::run::Learner;
+use crate::store::MetricsLine;
+use crate::{Moment, Purpose, RlError, Sac, SacLosses, TrainConfig, TransitionBatch};
+use crate::{derived_seed, stream};
+
+/// The replay buffer of a run's checkpoint.
+pub const REPLAY_FILE: &str = "replay.safetensors";
+/// Epoch, steps, random streams and open episodes of a run's checkpoint.
+pub const TASK_PROGRESS_FILE: &str = "task-progress.json";
+
+/// The most recent transitions, in a ring.
+#[derive(Debug, Clone, PartialEq, Default)]
+struct Replay {
+    capacity: usize,
+    obs_dim: usize,
+    action_dim: usize,
+    obs: Vec<f32>,
+    actions: Vec<f32>,
+    rewards: Vec<f32>,
+    next_obs: Vec<f32>,
+    dones: Vec<f32>,
+    /// Where the next transition goes once the ring is full.
+    next: usize,
+}
+
+impl Replay {
+    fn new(capacity: usize, obs_dim: usize, action_dim: usize) -> Self {
+        Self {
+            capacity,
+            obs_dim,
+            action_dim,
+            ..Self::default()
+        }
+    }
+
+    fn len(&self) -> usize {
+        self.rewards.len()
+    }
+
+    fn push(&mut self, obs: &[f32], action: &[f32], reward: f32, next_obs: &[f32], done: bool) {
+        let done = if done { 1.0 } else { 0.0 };
+        if self.len() < self.capacity {
+            self.obs.extend_from_slice(obs);
+            self.actions.extend_from_slice(action);
+            self.rewards.push(reward);
+            self.next_obs.extend_from_slice(next_obs);
+            self.dones.push(done);
+        } else {
+            let (i, o, a) = (self.next, self.obs_dim, self.action_dim);
+            self.obs[i * o..(i + 1) * o].copy_from_slice(obs);
+            self.actions[i * a..(i + 1) * a].copy_from_slice(action);
+            self.rewards[i] = reward;
+            self.next_obs[i * o..(i + 1) * o].copy_from_slice(next_obs);
+            self.dones[i] = done;
+            self.next = (self.next + 1) % self.capacity;
+        }
+    }
+
+    /// `rows` transitions drawn uniformly with replacement.
+    fn sample(&self, rows: usize, rng: &mut ChaCha8Rng) -> TransitionBatch {
+        let (o, a) = (self.obs_dim, self.action_dim);
+        let mut batch = TransitionBatch::default();
+        for _ in 0..rows {
+            let i = rng.random_range(0..self.len());
+            batch.obs.extend_from_slice(&self.obs[i * o..(i + 1) * o]);
+            batch
+                .actions
+                .extend_from_slice(&self.actions[i * a..(i + 1) * a]);
+            batch.rewards.push(self.rewards[i]);
+            batch
+                .next_obs
+                .extend_from_slice(&self.next_obs[i * o..(i + 1) * o]);
+            batch.dones.push(self.dones[i]);
+        }
+        batch
+    }
+
+    fn save(&self, path: &Path) -> Result<(), RlError> {
+        let (o, a) = (self.obs_dim as i64, self.action_dim as i64);
+        let tensors = [
+            ("obs", Tensor::from_slice(&self.obs).view([-1, o])),
+            ("actions", Tensor::from_slice(&self.actions).view([-1, a])),
+            ("rewards", Tensor::from_slice(&self.rewards)),
+            ("next_obs", Tensor::from_slice(&self.next_obs).view([-1, o])),
+            ("dones", Tensor::from_slice(&self.dones)),
+            ("next", Tensor::from_slice(&[self.next as i64])),
+        ];
+        Tensor::write_safetensors(&tensors, path).map_err(|e| RlError::io(path, e))
+    }
+
+    fn load(&mut self, path: &Path) -> Result<(), RlError> {
+        let bad = |reason: String| RlError::Checkpoint {
+            path: path.display().to_string(),
+            reason,
+        };
+        let named = Tensor::read_safetensors(path).map_err(|e| RlError::unreadable(path, e))?;
+        let get = |name: &str| -> Result<&Tensor, RlError> {
+            named
+                .iter()
+                .find(|(n, _)| n == name)
+                .map(|(_, t)| t)
+                .ok_or_else(|| bad(format!("no tensor {name:?}")))
+        };
+        let floats = |name: &str| -> Result<Vec<f32>, RlError> {
+            Vec::<f32>::try_from(get(name)?.view([-1])).map_err(|e| bad(format!("{name}: {e}")))
+        };
+        let rewards = floats("rewards")?;
+        let n = rewards.len();
+        let (obs, actions, next_obs, dones) = (
+            floats("obs")?,
+            floats("actions")?,
+            floats("next_obs")?,
+            floats("dones")?,
+        );
+        let next =
+            Vec::<i64>::try_from(get("next")?.view([-1])).map_err(|e| bad(format!("next: {e}")))?;
+        let next = match next.as_slice() {
+            [i] if *i >= 0 && (*i as usize) < self.capacity.max(1) => *i as usize,
+            _ => return Err(bad("a bad ring position".into())),
+        };
+        if n > self.capacity
+            || obs.len() != n * self.obs_dim
+            || next_obs.len() != n * self.obs_dim
+            || actions.len() != n * self.action_dim
+            || dones.len() != n
+        {
+            return Err(bad(format!(
+                "a replay buffer of another shape ({n} transitions, capacity {})",
+                self.capacity
+            )));
+        }
+        *self = Self {
+            obs,
+            actions,
+            rewards,
+            next_obs,
+            dones,
+            next,
+            ..self.clone()
+        };
+        Ok(())
+    }
+}
+
+/// The open episode of one environment: enough to rebuild its state by replaying.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+struct OpenEpisode {
+    /// The environment seed it was reset with.
+    seed: u64,
+    /// Its actions so far, row-major.
+    actions: Vec<f32>,
+}
+
+/// Random streams of a baseline run.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+struct Streams {
+    collect: ChaCha8Rng,
+    sample: ChaCha8Rng,
+    sac: ChaCha8Rng,
+}
+
+/// Seconds per phase since the start of the run.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Serialize, Deserialize)]
+pub struct TaskTimings {
+    /// Environment steps and policy calls.
+    pub collect: f64,
+    /// SAC gradient steps.
+    pub sac: f64,
+    /// Task-success evaluations.
+    pub evaluate: f64,
+}
+
+#[derive(Debug, Clone, Serialize, Deserialize)]
+struct Progress {
+    epoch: u64,
+    env_steps: u64,
+    /// Episodes started, over all environments (numbers their seeds).
+    episodes: u64,
+    /// Episodes ended, and how many of them solved their board.
+    ended: u64,
+    solved: u64,
+    timings: TaskTimings,
+    streams: Streams,
+    open: Vec<OpenEpisode>,
+}
+
+/// What one epoch of the baseline did.
+#[derive(Debug, Clone, Copy, Default, Serialize)]
+pub struct TaskEpochStats {
+    /// Epochs completed.
+    pub epoch: u64,
+    /// Environment steps so far.
+    pub env_steps: u64,
+    /// Gradient steps taken this epoch.
+    pub updates: usize,
+    /// Mean SAC losses of this epoch's steps (zero without steps).
+    pub sac: SacLosses,
+}
+
+/// One line of a baseline run's `metrics.jsonl`.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct TaskMetrics {
+    /// Epochs completed.
+    pub epoch: u64,
+    /// Environment steps so far.
+    pub env_steps: u64,
+    /// Wall-clock seconds since the run started (across resumes).
+    pub wall_s: f64,
+    /// Share of the test boards solved per depth 1–5, deterministic policy.
+    pub success: Vec<f64>,
+    /// Mean of `success`.
+    pub mean_success: f64,
+    /// Share of the training episodes ended so far that solved their board.
+    pub train_solved: f64,
+    /// Last critic loss.
+    pub critic_loss: f32,
+    /// Last actor loss.
+    pub actor_loss: f32,
+    /// Environment steps per wall-clock second since the start of the run.
+    pub steps_per_s: f64,
+    /// Seconds per phase since the start of the run.
+    pub timings: TaskTimings,
+}
+
+impl MetricsLine for TaskMetrics {
+    fn epoch(&self) -> u64 {
+        self.epoch
+    }
+    fn wall_s(&self) -> f64 {
+        self.wall_s
+    }
+}
+
+/// A flat SAC agent in training on the task reward.
+pub struct TaskSac {
+    config: TrainConfig,
+    spec: EnvSpec,
+    envs: Vec<TaskEnv>,
+    /// The current observation of each environment.
+    obs: Vec<Vec<f32>>,
+    sac: Sac,
+    replay: Replay,
+    progress: Progress,
+}
+
+/// Gradient steps due after epoch `epoch` (0-based) at N per epoch: ⌊(e+1)·N⌋ − ⌊e·N⌋, so that
+/// N = 0.25 steps once every 4 epochs and N = 2 twice per epoch.
+pub fn updates_due(epoch: u64, per_epoch: f64) -> usize {
+    let at = |e: u64| (e as f64 * per_epoch).floor();
+    (at(epoch + 1) - at(epoch)).max(0.0) as usize
+}
+
+impl TaskSac {
+    /// A fresh agent for `config` (validated; `config.algorithm` is not checked here).
+    pub fn new(config: TrainConfig) -> Result<Self, RlError> {
+        config.validate()?;
+        crate::numerics::check(config.portable_numerics)?;
+        if config.threads > 0 {
+            tch::set_num_threads(config.threads as i32);
+        }
+        let train = EnvConfig {
+            reset_split: Split::Train,
+            ..config.env_config.clone()
+        };
+        let max_depth = train.max_solution_depth;
+        let envs = (0..config.baseline.samples_per_epoch)
+            .map(|_| TaskEnv::new(make_env(&config.env, &train)?, max_depth))
+            .collect::<Result<Vec<_>, _>>()?;
+        let spec = envs[0].spec().clone();
+        let sac = Sac::new(
+            spec.obs_dim,
+            &spec.action_low,
+            &spec.action_high,
+            &config.sac,
+            Device::Cpu,
+            derived_seed(config.seed, Purpose::SacInit, 0),
+        );
+        let replay = Replay::new(
+            config.baseline.replay_capacity,
+            spec.obs_dim,
+            spec.action_dim,
+        );
+        let progress = Progress {
+            epoch: 0,
+            env_steps: 0,
+            episodes: 0,
+            ended: 0,
+            solved: 0,
+            timings: TaskTimings::default(),
+            streams: Streams {
+                collect: stream(config.seed, Purpose::Collect),
+                sample: stream(config.seed, Purpose::Sample),
+                sac: stream(config.seed, Purpose::Sac),
+            },
+            open: Vec::new(),
+        };
+        let mut agent = Self {
+            obs: vec![Vec::new(); envs.len()],
+            config,
+            spec,
+            envs,
+            sac,
+            replay,
+            progress,
+        };
+        for slot in 0..agent.envs.len() {
+            agent.start_episode(slot)?;
+        }
+        Ok(agent)
+    }
+
+    /// Resets environment `slot` for the next episode, seeded by the episode's number.
+    fn start_episode(&mut self, slot: usize) -> Result<(), RlError> {
+        let seed = derived_seed(self.config.seed, Purpose::TrainEnvs, self.progress.episodes);
+        self.progress.episodes += 1;
+        let env = &mut self.envs[slot];
+        env.seed(seed);
+        env.reset()?;
+        let mut obs = vec![0.0; self.spec.obs_dim];
+        env.observe(&mut obs);
+        self.obs[slot] = obs;
+        let open = OpenEpisode {
+            seed,
+            actions: Vec::new(),
+        };
+        match self.progress.open.get_mut(slot) {
+            Some(o) => *o = open,
+            None => self.progress.open.push(open),
+        }
+        Ok(())
+    }
+
+    /// The configuration.
+    pub fn config(&self) -> &TrainConfig {
+        &self.config
+    }
+
+    /// The policy.
+    pub fn policy(&self) -> &Sac {
+        &self.sac
+    }
+
+    /// Epochs run so far.
+    pub fn epoch(&self) -> u64 {
+        self.progress.epoch
+    }
+
+    /// Environment steps so far.
+    pub fn env_steps(&self) -> u64 {
+        self.progress.env_steps
+    }
+
+    /// Whether the step budget is spent.
+    pub fn finished(&self) -> bool {
+        self.progress.env_steps >= self.config.env_steps
+    }
+
+    /// Time spent per phase.
+    pub fn timings(&self) -> TaskTimings {
+        self.progress.timings
+    }
+
+    /// One epoch: a step of every environment, then the gradient steps due.
+    pub fn run_epoch(&mut self) -> Result<TaskEpochStats, RlError> {
+        let start = Instant::now();
+        let inputs: Vec<f32> = self.obs.concat();
+        let actions = self
+            .sac
+            .act(&inputs, Some(&mut self.progress.streams.collect));
+        let a = self.spec.action_dim;
+        for slot in 0..self.envs.len() {
+            let action = &actions[slot * a..(slot + 1) * a];
+            let step = self.envs[slot].step(action)?;
+            let mut next = vec![0.0; self.spec.obs_dim];
+            self.envs[slot].observe(&mut next);
+            self.replay
+                .push(&self.obs[slot], action, step.reward, &next, step.done);
+            self.progress.open[slot].actions.extend_from_slice(action);
+            self.obs[slot] = next;
+            if step.done {
+                self.progress.ended += 1;
+                self.progress.solved += u64::from(step.solved);
+                self.start_episode(slot)?;
+            }
+        }
+        self.progress.env_steps += self.envs.len() as u64;
+        self.progress.timings.collect += start.elapsed().as_secs_f64();
+
+        let start = Instant::now();
+        let mut updates = 0;
+        let mut total = SacLosses::default();
+        if self.replay.len() >= self.config.sac.batch_size {
+            for _ in 0..updates_due(self.progress.epoch, self.config.baseline.updates_per_epoch) {
+                let batch = self.replay.sample(
+                    self.config.sac.batch_size,
+                    &mut self.progress.streams.sample,
+                );
+                let l = self.sac.update(&batch, &mut self.progress.streams.sac);
+                total.critic += l.critic;
+                total.actor += l.actor;
+                total.q += l.q;
+                updates += 1;
+            }
+        }
+        self.progress.timings.sac += start.elapsed().as_secs_f64();
+        self.progress.epoch += 1;
+        let n = updates.max(1) as f32;
+        Ok(TaskEpochStats {
+            epoch: self.progress.epoch,
+            env_steps: self.progress.env_steps,
+            updates,
+            sac: SacLosses {
+                critic: total.critic / n,
+                actor: total.actor / n,
+                q: total.q / n,
+            },
+        })
+    }
+
+    /// Task success of the deterministic policy on `boards` test boards of each depth 1–5
+    /// (the authors' evaluation seeds first), as the SEADS evaluation's per-depth results.
+    pub fn task_success(&mut self, boards: usize) -> Result<Vec<DepthResult>, RlError> {
+        let start = Instant::now();
+        let results = task_success(&self.config, &self.sac, &[1, 2, 3, 4, 5], boards)?;
+        self.progress.timings.evaluate += start.elapsed().as_secs_f64();
+        Ok(results)
+    }
+
+    /// Writes the complete training state into `dir` (which must exist).
+    pub fn save(&self, dir: &Path) -> Result<(), RlError> {
+        self.sac.save(dir)?;
+        self.replay.save(&dir.join(REPLAY_FILE))?;
+        let path = dir.join(TASK_PROGRESS_FILE);
+        let text = serde_json::to_string(&self.progress).map_err(|e| RlError::io(&path, e))?;
+        std::fs::write(&path, text).map_err(|e| RlError::io(&path, e))
+    }
+
+    /// Restores what [`TaskSac::save`] wrote, replaying each environment's open episode.
+    pub fn load(&mut self, dir: &Path) -> Result<(), RlError> {
+        self.sac.load(dir, false)?;
+        self.replay.load(&dir.join(REPLAY_FILE))?;
+        let path = dir.join(TASK_PROGRESS_FILE);
+        let text = std::fs::read_to_string(&path).map_err(|e| RlError::io(&path, e))?;
+        let progress: Progress =
+            serde_json::from_str(&text).map_err(|e| RlError::unreadable(&path, e))?;
+        if progress.open.len() != self.envs.len() {
+            return Err(RlError::Checkpoint {
+                path: path.display().to_string(),
+                reason: format!(
+                    "{} open episodes for {} environments",
+                    progress.open.len(),
+                    self.envs.len()
+                ),
+            });
+        }
+        let a = self.spec.action_dim;
+        for (slot, open) in progress.open.iter().enumerate() {
+            let env = &mut self.envs[slot];
+            env.seed(open.seed);
+            env.reset()?;
+            for action in open.actions.chunks(a) {
+                env.step(action)?;
+            }
+            let mut obs = vec![0.0; self.spec.obs_dim];
+            env.observe(&mut obs);
+            self.obs[slot] = obs;
+        }
+        self.progress = progress;
+        Ok(())
+    }
+}
+
+/// The policy saved in a checkpoint folder of a baseline run with `config` (only the actor is
+/// read: older checkpoints keep nothing else).
+pub fn load_policy(config: &TrainConfig, checkpoint: &Path) -> Result<Sac, RlError> {
+    let spec = make_env(&config.env, &config.env_config)?.spec().clone();
+    let mut sac = Sac::new(
+        spec.obs_dim,
+        &spec.action_low,
+        &spec.action_high,
+        &config.sac,
+        Device::Cpu,
+        0,
+    );
+    sac.load(checkpoint, true)?;
+    Ok(sac)
+}
+
+/// Task success of `policy` (deterministic) on the SEADS protocol: `boards` test boards per
+/// depth (1–5 in the protocol), the authors' evaluation seeds first, each episode until solved
+/// or T_lim.
+pub fn task_success(
+    config: &TrainConfig,
+    policy: &Sac,
+    depths: &[usize],
+    boards: usize,
+) -> Result<Vec<DepthResult>, RlError> {
+    let seeds: Vec<u64> = (0..boards as u64)
+        .map(|i| {
+            EVALUATION_SEEDS
+                .get(i as usize)
+                .copied()
+                .unwrap_or_else(|| derived_seed(4343, Purpose::TrainEnvs, i))
+        })
+        .collect();
+    let mut results = Vec::new();
+    for &depth in depths {
+        let env_config = EnvConfig {
+            reset_split: Split::Test,
+            max_solution_depth: depth,
+            random_solution_depth: false,
+            ..config.env_config.clone()
+        };
+        let mut env = TaskEnv::new(make_env(&config.env, &env_config)?, depth)?;
+        let mut result = DepthResult {
+            depth,
+            tasks: 0,
+            solved: 0,
+            plan_found: 0,
+            planning_s: Vec::new(),
+            timeouts: 0,
+            solution_steps: Vec::new(),
+            skill_steps: Vec::new(),
+        };
+        let mut obs = vec![0.0; env.spec().obs_dim];
+        for &seed in &seeds {
+            env.seed(seed);
+            env.reset()?;
+            result.tasks += 1;
+            loop {
+                env.observe(&mut obs);
+                let action = policy.act(&obs, None);
+                let step = env.step(&action)?;
+                if step.done {
+                    if step.solved {
+                        result.solved += 1;
+                        result.solution_steps.push(env.steps());
+                    }
+                    break;
+                }
+            }
+        }
+        results.push(result);
+    }
+    Ok(results)
+}
+
+impl Learner for TaskSac {
+    type Stats = TaskEpochStats;
+    type Metrics = TaskMetrics;
+
+    fn build(config: TrainConfig) -> Result<Self, RlError> {
+        Self::new(config)
+    }
+    fn config(&self) -> &TrainConfig {
+        &self.config
+    }
+    fn epoch(&self) -> u64 {
+        self.progress.epoch
+    }
+    fn finished(&self) -> bool {
+        TaskSac::finished(self)
+    }
+    fn run_epoch_observed(
+        &mut self,
+        hook: &mut dyn FnMut(Moment),
+    ) -> Result<TaskEpochStats, RlError> {
+        let stats = self.run_epoch()?;
+        hook(Moment::Collected);
+        Ok(stats)
+    }
+    fn metrics(&mut self, stats: &TaskEpochStats, wall_s: f64) -> Result<TaskMetrics, RlError> {
+        let results = self.task_success(self.config.baseline.eval_boards)?;
+        let success: Vec<f64> = results
+            .iter()
+            .map(|r| r.solved as f64 / r.tasks.max(1) as f64)
+            .collect();
+        let p = &self.progress;
+        Ok(TaskMetrics {
+            epoch: p.epoch,
+            env_steps: p.env_steps,
+            wall_s,
+            mean_success: success.iter().sum::<f64>() / success.len().max(1) as f64,
+            success,
+            train_solved: p.solved as f64 / p.ended.max(1) as f64,
+            critic_loss: stats.sac.critic,
+            actor_loss: stats.sac.actor,
+            steps_per_s: p.env_steps as f64 / wall_s.max(1e-9),
+            timings: p.timings,
+        })
+    }
+    fn save(&self, dir: &Path) -> Result<(), RlError> {
+        TaskSac::save(self, dir)
+    }
+    fn load(&mut self, dir: &Path) -> Result<(), RlError> {
+        TaskSac::load(self, dir)
+    }
+    fn resume_only_files() -> Vec<&'static str> {
+        crate::sac::RESUME_FILES
+            .iter()
+            .chain(&[REPLAY_FILE, TASK_PROGRESS_FILE])
+            .copied()
+            .collect()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The ring keeps the most recent `capacity` transitions, and a checkpoint restores it
+    /// exactly; a buffer of another shape is refused.
+    #[test]
+    fn the_replay_ring_keeps_the_newest_and_round_trips() {
+        let mut replay = Replay::new(3, 2, 1);
+        for i in 0..5 {
+            let x = i as f32;
+            replay.push(&[x, x], &[-x], x, &[x + 0.5, x], i == 4);
+        }
+        // Transitions 3 and 4 overwrote 0 and 1; the next goes where 2 is.
+        assert_eq!(replay.rewards, [3.0, 4.0, 2.0]);
+        assert_eq!(replay.obs, [3.0, 3.0, 4.0, 4.0, 2.0, 2.0]);
+        assert_eq!(replay.dones, [0.0, 1.0, 0.0]);
+        assert_eq!(replay.next, 2);
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join(REPLAY_FILE);
+        replay.save(&path).unwrap();
+        let mut back = Replay::new(3, 2, 1);
+        back.load(&path).unwrap();
+        assert_eq!(back, replay);
+        let mut other = Replay::new(3, 3, 1);
+        assert!(matches!(other.load(&path), Err(RlError::Checkpoint { .. })));
+    }
+}
