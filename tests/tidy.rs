@@ -103,7 +103,12 @@ fn crate_dependencies_point_one_way_and_only_three_crates_link_libtorch() {
         ("seads-skillmodel", &["seads-games"]),
         (
             "seads-rl",
-            &["seads-embodiment", "seads-games", "seads-skillmodel"],
+            &[
+                "seads-embodiment",
+                "seads-games",
+                "seads-planner",
+                "seads-skillmodel",
+            ],
         ),
         ("seads-planner", &["seads-embodiment", "seads-games"]),
         ("seads-uarm", &["seads-embodiment", "seads-games"]),

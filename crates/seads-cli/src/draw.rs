@@ -58,6 +58,21 @@ macro_rules! render_to {
 }
 pub(crate) use render_to;
 
+/// Draws the figure `name` twice into `out`, as `name.png` and `name.svg`; returns both paths.
+pub fn png_and_svg(
+    out: &std::path::Path,
+    name: &str,
+    draw: &dyn Fn(&std::path::Path) -> anyhow::Result<()>,
+) -> anyhow::Result<Vec<std::path::PathBuf>> {
+    let mut written = Vec::new();
+    for ext in ["png", "svg"] {
+        let path = out.join(format!("{name}.{ext}"));
+        anyhow::Context::with_context(draw(&path), || format!("drawing {}", path.display()))?;
+        written.push(path);
+    }
+    Ok(written)
+}
+
 /// Lit LightsOut field.
 const LIT: RGBColor = RGBColor(245, 190, 40);
 /// Unlit LightsOut field.

@@ -45,7 +45,8 @@ enum Command {
     Render(envs::RenderArgs),
     /// Measure environment steps per second with random actions.
     EnvBench(envs::BenchArgs),
-    /// Train SEADS skills and their forward model on an environment (no task reward).
+    /// Train SEADS skills and their forward model on an environment (no task reward), or the
+    /// flat SAC baseline on the task reward (`--algorithm sac`).
     Train(train::TrainArgs),
     /// Solve one board with a trained agent: plan with its forward model, execute its skills.
     Solve(plan::SolveArgs),

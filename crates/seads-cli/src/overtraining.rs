@@ -4,7 +4,6 @@
 //! in the file are skipped, so the command resumes where it stopped.
 
 use std::collections::BTreeSet;
-use std::io::Write as _;
 use std::path::Path;
 
 use anyhow::{Context, Result, anyhow};
@@ -66,20 +65,10 @@ impl std::str::FromStr for Selection {
 /// Reads the lines of `run`'s file (none if it does not exist; a torn last line is ignored).
 pub fn read(run: &Path) -> Result<Vec<CheckpointEvaluation>> {
     let path = run.join(FILE);
-    let text = match std::fs::read_to_string(&path) {
-        Ok(text) => text,
-        Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok(Vec::new()),
-        Err(e) => return Err(e).with_context(|| format!("reading {}", path.display())),
-    };
-    let whole = text.rfind('\n').map_or("", |end| &text[..=end]);
-    whole
-        .lines()
-        .enumerate()
-        .map(|(i, line)| {
-            serde_json::from_str(line)
-                .with_context(|| format!("{}:{}: not an evaluation line", path.display(), i + 1))
-        })
-        .collect()
+    if !path.exists() {
+        return Ok(Vec::new());
+    }
+    Ok(seads_rl::read_json_lines(&path)?.0)
 }
 
 /// The environment steps of training at checkpoint `epoch`: from the run's metrics (the presets
@@ -176,28 +165,8 @@ pub fn evaluate_checkpoints(
             max_expanded: limits.max_expanded,
             results,
         };
-        append_line(&path, &serde_json::to_string(&line)?)?;
+        seads_rl::append_json_line(&path, &line)?;
     }
     bar.finish_and_clear();
     Ok(todo.len())
-}
-
-/// Appends a whole line and fsyncs it (a crash leaves at most a torn last line, ignored by
-/// [`read`] and completed by the next append's newline-terminated line).
-fn append_line(path: &Path, line: &str) -> Result<()> {
-    let mut file = std::fs::OpenOptions::new()
-        .create(true)
-        .append(true)
-        .open(path)
-        .with_context(|| format!("opening {}", path.display()))?;
-    // A torn tail from a crash is cut off before the new line.
-    let text = std::fs::read_to_string(path).unwrap_or_default();
-    if !text.is_empty() && !text.ends_with('\n') {
-        let keep = text.rfind('\n').map_or(0, |i| i + 1);
-        file.set_len(keep as u64)
-            .with_context(|| format!("repairing {}", path.display()))?;
-    }
-    file.write_all(format!("{line}\n").as_bytes())
-        .and_then(|()| file.sync_data())
-        .with_context(|| format!("writing {}", path.display()))
 }

@@ -65,11 +65,7 @@ pub fn write_figures(
     std::fs::create_dir_all(out).with_context(|| format!("creating {}", out.display()))?;
     let mut written = Vec::new();
     let mut both = |name: &str, f: &dyn Fn(&Path) -> Result<()>| -> Result<()> {
-        for ext in ["png", "svg"] {
-            let path = out.join(format!("{name}.{ext}"));
-            f(&path).with_context(|| format!("drawing {}", path.display()))?;
-            written.push(path);
-        }
+        written.extend(crate::draw::png_and_svg(out, name, f)?);
         Ok(())
     };
     let metrics = read_metrics(run)?;

@@ -2,9 +2,8 @@
 //! tiny run trained, extended by `--resume`, evaluated on the SEADS protocol and reported beside
 //! SEADS's modes; the planning commands refuse it in one line.
 
-use std::io::{BufRead, BufReader};
 use std::path::{Path, PathBuf};
-use std::process::{Command, Stdio};
+use std::process::Command;
 
 mod common;
 use common::*;
@@ -158,20 +157,9 @@ fn a_killed_baseline_run_resumes_to_the_same_run() {
     ]);
     for point in [3, 24, 29, 47, 66] {
         let out = dir.path().join(format!("killed-{point}"));
-        let mut child = Command::new(env!("CARGO_BIN_EXE_seads"))
-            .args(["train", "--config", s(&config), "--out", s(&out), "--quiet"])
-            .env("SEADS_CRASH_POINT", point.to_string())
-            .stdout(Stdio::null())
-            .stderr(Stdio::piped())
-            .spawn()
-            .unwrap();
-        let stderr = BufReader::new(child.stderr.take().unwrap());
-        let stopped = stderr
-            .lines()
-            .any(|l| l.unwrap().starts_with("seads: stopped at moment"));
-        assert!(stopped, "the run never reached moment {point}");
-        child.kill().unwrap();
-        child.wait().unwrap();
+        let mut command = Command::new(env!("CARGO_BIN_EXE_seads"));
+        command.args(["train", "--config", s(&config), "--out", s(&out), "--quiet"]);
+        kill_at_moment(command, point);
         seads_ok(&["train", "--resume", s(&out), "--quiet"]);
         assert_eq!(numbers(&out), numbers(&whole), "killed at moment {point}");
     }

@@ -7,12 +7,14 @@
 //! moments spread over the run plus the first of each kind; `SEADS_CRASH_TEST_ALL=1` kills at
 //! every moment (the long variant, 552 kills), `SEADS_CRASH_TEST_EVERY=N` at every N-th.
 
-use std::io::{BufRead, BufReader};
 use std::path::{Path, PathBuf};
-use std::process::{Command, Stdio};
+use std::process::Command;
 use std::sync::OnceLock;
 
 use serde_json::Value;
+
+mod common;
+use common::kill_at_moment;
 
 const SEADS: &str = env!("CARGO_BIN_EXE_seads");
 
@@ -119,23 +121,7 @@ fn baseline() -> &'static Baseline {
 /// Starts a fresh run of `config` into `out` and kills it with SIGKILL where it stopped, at
 /// moment `point`.
 fn start_and_kill(config: &Path, out: &Path, point: usize) {
-    let mut child = train(config, out)
-        .env("SEADS_CRASH_POINT", point.to_string())
-        .stdout(Stdio::null())
-        .stderr(Stdio::piped())
-        .spawn()
-        .unwrap();
-    let stderr = BufReader::new(child.stderr.take().unwrap());
-    let mut stopped = false;
-    for line in stderr.lines() {
-        if line.unwrap().starts_with("seads: stopped at moment") {
-            stopped = true;
-            break;
-        }
-    }
-    assert!(stopped, "the run never reached moment {point}");
-    child.kill().unwrap(); // SIGKILL
-    child.wait().unwrap();
+    kill_at_moment(train(config, out), point);
 }
 
 /// Starts a fresh run, kills it at moment `point`, then resumes it to the end; returns the

@@ -40,6 +40,22 @@ pub struct DepthResult {
     pub skill_steps: Vec<usize>,
 }
 
+impl DepthResult {
+    /// No task yet at `depth`.
+    pub fn new(depth: usize) -> Self {
+        Self {
+            depth,
+            tasks: 0,
+            solved: 0,
+            plan_found: 0,
+            planning_s: Vec::new(),
+            timeouts: 0,
+            solution_steps: Vec::new(),
+            skill_steps: Vec::new(),
+        }
+    }
+}
+
 /// What to evaluate on: an environment, the depths and seeds of its tasks.
 #[derive(Debug, Clone)]
 pub struct Evaluation {
@@ -77,16 +93,7 @@ pub fn evaluate(
         let mut env = make_env(&evaluation.env, &env_config)?;
         let game = env.spec().game.build(env.spec().board_size)?;
         let goal = game.goal();
-        let mut result = DepthResult {
-            depth,
-            tasks: 0,
-            solved: 0,
-            plan_found: 0,
-            planning_s: Vec::new(),
-            timeouts: 0,
-            solution_steps: Vec::new(),
-            skill_steps: Vec::new(),
-        };
+        let mut result = DepthResult::new(depth);
         for &seed in &evaluation.seeds {
             env.seed(seed);
             env.reset()?;

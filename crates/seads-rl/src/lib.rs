@@ -57,8 +57,8 @@ pub use run::{Hook, Learner, Metrics, Moment, Run, RunEvent, load_config, raise_
 pub use sac::{Sac, SacConfig, SacLosses, TransitionBatch};
 pub use seeds::{Purpose, derived_seed, stream, train_env_seed};
 pub use store::{
-    MetricsLine, checkpoint_name, checkpoints, latest_checkpoint, read_metrics, read_metrics_as,
-    write_atomic,
+    MetricsLine, append_json_line, checkpoint_name, checkpoints, latest_checkpoint,
+    read_json_lines, read_metrics, read_metrics_as, write_atomic,
 };
 pub use task_sac::{
     TaskEpochStats, TaskMetrics, TaskSac, TaskTimings, load_policy, task_success, updates_due,

@@ -178,13 +178,19 @@ pub fn read_metrics_as<M: MetricsLine>(dir: &Path) -> Result<Vec<M>, RlError> {
 
 /// The whole lines of `dir/metrics.jsonl`, and whether a torn last line was left out.
 pub(crate) fn read_metrics_text<M: MetricsLine>(dir: &Path) -> Result<(Vec<M>, bool), RlError> {
-    let path = dir.join(METRICS);
-    let text = fs::read_to_string(&path).map_err(|e| RlError::io(&path, e))?;
+    read_json_lines(&dir.join(METRICS))
+}
+
+/// The whole lines of a JSON Lines file, and whether a torn last line (a line without its
+/// newline: the trace of a crash during an append) was left out. Any other line that does not
+/// parse is an error naming its line number.
+pub fn read_json_lines<T: DeserializeOwned>(path: &Path) -> Result<(Vec<T>, bool), RlError> {
+    let text = fs::read_to_string(path).map_err(|e| RlError::io(path, e))?;
     let (whole, torn) = match text.rfind('\n') {
         Some(end) => (&text[..=end], !text[end + 1..].trim().is_empty()),
         None => ("", !text.trim().is_empty()),
     };
-    let metrics = whole
+    let lines = whole
         .lines()
         .enumerate()
         .filter(|(_, l)| !l.trim().is_empty())
@@ -195,21 +201,33 @@ pub(crate) fn read_metrics_text<M: MetricsLine>(dir: &Path) -> Result<(Vec<M>, b
             })
         })
         .collect::<Result<_, _>>()?;
-    Ok((metrics, torn))
+    Ok((lines, torn))
 }
 
 /// Appends one line to `dir/metrics.jsonl` and fsyncs it.
 pub fn append_metrics<M: MetricsLine>(dir: &Path, metrics: &M) -> Result<(), RlError> {
-    let path = dir.join(METRICS);
-    let mut line = serde_json::to_string(metrics).map_err(|e| RlError::io(&path, e))?;
+    append_json_line(&dir.join(METRICS), metrics)
+}
+
+/// Appends `value` as one JSON line to `path` (created if missing) and fsyncs it. A torn last
+/// line that a crash left is cut off first, so the file only ever holds whole lines after it.
+pub fn append_json_line<T: Serialize>(path: &Path, value: &T) -> Result<(), RlError> {
+    let mut line = serde_json::to_string(value).map_err(|e| RlError::io(path, e))?;
     line.push('\n');
     let mut file = fs::OpenOptions::new()
+        .create(true)
         .append(true)
-        .open(&path)
-        .map_err(|e| RlError::io(&path, e))?;
+        .open(path)
+        .map_err(|e| RlError::io(path, e))?;
+    let text = fs::read_to_string(path).map_err(|e| RlError::io(path, e))?;
+    if !text.is_empty() && !text.ends_with('\n') {
+        let keep = text.rfind('\n').map_or(0, |i| i + 1);
+        file.set_len(keep as u64)
+            .map_err(|e| RlError::io(path, e))?;
+    }
     file.write_all(line.as_bytes())
         .and_then(|()| file.sync_data())
-        .map_err(|e| RlError::io(&path, e))
+        .map_err(|e| RlError::io(path, e))
 }
 
 /// Rewrites `dir/metrics.jsonl` with exactly `metrics`.
@@ -242,6 +260,27 @@ mod tests {
         ] {
             assert_eq!(checkpoint_epoch(name), None, "{name}");
         }
+    }
+
+    /// A torn last line is left out when read and cut off by the next append; a bad whole line
+    /// is an error naming its number.
+    #[test]
+    fn json_lines_survive_a_torn_tail() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("log.jsonl");
+        append_json_line(&path, &1).unwrap();
+        append_json_line(&path, &2).unwrap();
+        fs::write(&path, "1\n2\n{\"cut").unwrap();
+        assert_eq!(read_json_lines::<u32>(&path).unwrap(), (vec![1, 2], true));
+        append_json_line(&path, &3).unwrap();
+        assert_eq!(fs::read_to_string(&path).unwrap(), "1\n2\n3\n");
+        assert_eq!(
+            read_json_lines::<u32>(&path).unwrap(),
+            (vec![1, 2, 3], false)
+        );
+        fs::write(&path, "1\nx\n").unwrap();
+        let err = read_json_lines::<u32>(&path).unwrap_err().to_string();
+        assert!(err.contains("log.jsonl:2"), "{err}");
     }
 
     #[test]

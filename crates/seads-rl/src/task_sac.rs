@@ -536,16 +536,7 @@ pub fn task_success(
             ..config.env_config.clone()
         };
         let mut env = TaskEnv::new(make_env(&config.env, &env_config)?, depth)?;
-        let mut result = DepthResult {
-            depth,
-            tasks: 0,
-            solved: 0,
-            plan_found: 0,
-            planning_s: Vec::new(),
-            timeouts: 0,
-            solution_steps: Vec::new(),
-            skill_steps: Vec::new(),
-        };
+        let mut result = DepthResult::new(depth);
         let mut obs = vec![0.0; env.spec().obs_dim];
         for &seed in &seeds {
             env.seed(seed);

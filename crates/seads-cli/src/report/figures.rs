@@ -10,7 +10,7 @@ use plotters::coord::Shift;
 use plotters::prelude::*;
 
 use super::runs::Group;
-use crate::draw::{plot_err, render_to, skill_colour};
+use crate::draw::{plot_err, png_and_svg, render_to, skill_colour};
 
 /// A curve: x, mean, min, max.
 type Band = Vec<(f64, f64, f64, f64)>;
@@ -99,17 +99,6 @@ fn band_figure(
     })
 }
 
-/// Writes PNG and SVG of a figure; returns both paths.
-fn both(out: &Path, name: &str, draw: &dyn Fn(&Path) -> Result<()>) -> Result<Vec<PathBuf>> {
-    let mut written = Vec::new();
-    for ext in ["png", "svg"] {
-        let path = out.join(format!("{name}.{ext}"));
-        draw(&path)?;
-        written.push(path);
-    }
-    Ok(written)
-}
-
 /// Coverage over training per environment; returns the files written.
 pub fn coverage_figures(
     out: &Path,
@@ -142,7 +131,7 @@ pub fn coverage_figures(
             continue;
         }
         let title = format!("Skill coverage: {env} (mean, min–max band)");
-        written.extend(both(out, &format!("coverage-{env}"), &|p| {
+        written.extend(png_and_svg(out, &format!("coverage-{env}"), &|p| {
             band_figure(
                 p,
                 &title,
@@ -203,7 +192,7 @@ pub fn success_figures(out: &Path, groups: &[Group<'_>]) -> Result<Vec<PathBuf>>
         let title = format!(
             "Task success over training: {env} (SEADS re-planning, baselines' policies; depths pooled)"
         );
-        written.extend(both(out, &format!("success-{env}"), &|p| {
+        written.extend(png_and_svg(out, &format!("success-{env}"), &|p| {
             band_figure(p, &title, "test tasks solved (%)", 105.0, &curves)
         })?);
     }
@@ -229,7 +218,9 @@ pub fn length_figures(out: &Path, groups: &[Group<'_>]) -> Result<Vec<PathBuf>> 
         }
         let name = format!("lengths-{}-{}", g.env, g.variant);
         let title = format!("{} / {}", g.env, g.variant);
-        written.extend(both(out, &name, &|p| box_figure(p, &title, &per_depth))?);
+        written.extend(png_and_svg(out, &name, &|p| {
+            box_figure(p, &title, &per_depth)
+        })?);
     }
     Ok(written)
 }

@@ -2,8 +2,9 @@
 
 #![allow(dead_code)] // each test file uses some of them
 
+use std::io::{BufRead, BufReader};
 use std::path::Path;
-use std::process::{Command, Output};
+use std::process::{Command, Output, Stdio};
 
 /// Runs the `seads` binary of this build.
 pub fn seads(args: &[&str]) -> Output {
@@ -45,4 +46,22 @@ pub fn check_bad_input(args: &[&str], needle: &str) {
 /// A path as the `&str` an argument list wants.
 pub fn s(p: &Path) -> &str {
     p.to_str().expect("UTF-8 path")
+}
+
+/// Starts `command` (a `seads` call) stopped at moment `point` of its run (`SEADS_CRASH_POINT`)
+/// and kills it there with SIGKILL.
+pub fn kill_at_moment(mut command: Command, point: usize) {
+    let mut child = command
+        .env("SEADS_CRASH_POINT", point.to_string())
+        .stdout(Stdio::null())
+        .stderr(Stdio::piped())
+        .spawn()
+        .expect("run seads");
+    let stderr = BufReader::new(child.stderr.take().expect("piped stderr"));
+    let stopped = stderr
+        .lines()
+        .any(|l| l.is_ok_and(|l| l.starts_with("seads: stopped at moment")));
+    assert!(stopped, "the run never reached moment {point}");
+    child.kill().expect("SIGKILL");
+    child.wait().expect("reaped");
 }
