@@ -164,3 +164,68 @@ fn a_killed_baseline_run_resumes_to_the_same_run() {
         assert_eq!(numbers(&out), numbers(&whole), "killed at moment {point}");
     }
 }
+
+/// A study with a SAC variant: the sweep trains it from the baseline's preset, evaluates its
+/// policy, shows its progress, and the report puts its success beside SEADS's.
+#[test]
+fn a_sweep_trains_and_reports_the_baseline_beside_seads() {
+    let dir = tempfile::tempdir().unwrap();
+    let manifest = dir.path().join("study.toml");
+    std::fs::write(
+        &manifest,
+        r#"
+name = "tiny-baselines"
+environments = ["lightsout-cursor"]
+seeds = [1]
+reference = "seads"
+
+[overrides]
+env_steps = 240
+eval_every = 10
+checkpoint_every = 10
+portable_numerics = true
+sac = { hidden = [16, 16], batch_size = 16 }
+
+[evaluation]
+boards = 1
+timeout = 600
+max_expanded = 500
+
+[[variant]]
+name = "seads"
+overrides = { sampled_episodes = 16, recent_episodes = 16, episodes_per_epoch = 8, skill_model = { hidden = [16, 16] } }
+
+[[variant]]
+name = "sac"
+overrides = { algorithm = "sac", baseline = { replay_capacity = 100, eval_boards = 1 } }
+"#,
+    )
+    .unwrap();
+    let sweep = dir.path().join("sweep");
+    seads_ok(&["sweep", "plan", s(&manifest), "--out", s(&sweep)]);
+    let sac = sweep.join("runs/lightsout-cursor/sac/seed-1");
+    let config = std::fs::read_to_string(sac.join("config.toml")).unwrap();
+    assert!(
+        config.contains("algorithm = \"sac\"") && config.contains("[baseline]"),
+        "{config}"
+    );
+    seads_ok(&["sweep", "run", s(&sweep), "--quiet"]);
+    let status = json(&["sweep", "status", s(&sweep), "--json"]);
+    assert_eq!(status["done"], 2, "{status}");
+    // Both trained their budget (SEADS finishes its last episodes: a few steps more).
+    assert!(
+        status["runs"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .all(|r| r["env_steps"].as_u64().unwrap() >= 240),
+        "{status}"
+    );
+    assert!(sac.join("evaluation-policy.json").is_file());
+    let report = dir.path().join("report");
+    seads_ok(&["report", s(&sweep), "--out", s(&report)]);
+    let md = std::fs::read_to_string(report.join("report.md")).unwrap();
+    for row in ["| seads | re-planning | 1 |", "| sac | policy | 1 |"] {
+        assert!(md.contains(row), "{row}: {md}");
+    }
+}

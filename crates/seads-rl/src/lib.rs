@@ -57,7 +57,7 @@ pub use run::{Hook, Learner, Metrics, Moment, Run, RunEvent, load_config, raise_
 pub use sac::{Sac, SacConfig, SacLosses, TransitionBatch};
 pub use seeds::{Purpose, derived_seed, stream, train_env_seed};
 pub use store::{
-    MetricsLine, append_json_line, checkpoint_name, checkpoints, latest_checkpoint,
+    MetricsLine, append_json_line, checkpoint_name, checkpoints, last_env_steps, latest_checkpoint,
     read_json_lines, read_metrics, read_metrics_as, write_atomic,
 };
 pub use task_sac::{

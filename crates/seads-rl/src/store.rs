@@ -176,6 +176,17 @@ pub fn read_metrics_as<M: MetricsLine>(dir: &Path) -> Result<Vec<M>, RlError> {
     Ok(read_metrics_text(dir)?.0)
 }
 
+/// Environment steps at the last evaluation in `dir/metrics.jsonl` (0 before the first),
+/// whatever the run trains: every kind of metrics line has `env_steps`.
+pub fn last_env_steps(dir: &Path) -> Result<u64, RlError> {
+    #[derive(serde::Deserialize)]
+    struct Steps {
+        env_steps: u64,
+    }
+    let (lines, _) = read_json_lines::<Steps>(&dir.join(METRICS))?;
+    Ok(lines.last().map_or(0, |l| l.env_steps))
+}
+
 /// The whole lines of `dir/metrics.jsonl`, and whether a torn last line was left out.
 pub(crate) fn read_metrics_text<M: MetricsLine>(dir: &Path) -> Result<(Vec<M>, bool), RlError> {
     read_json_lines(&dir.join(METRICS))

@@ -251,10 +251,7 @@ fn status(args: StatusArgs) -> Result<()> {
         let dir = args.dir.join(&run.dir);
         let (status, record) = state::status(&dir)?;
         let budget = seads_rl::load_config(&dir).map_or(0, |c| c.env_steps);
-        let env_steps = seads_rl::read_metrics(&dir)
-            .ok()
-            .and_then(|m| m.last().map(|m| m.env_steps))
-            .unwrap_or(0);
+        let env_steps = seads_rl::last_env_steps(&dir).unwrap_or(0);
         rows.push(RunStatus {
             index,
             env: run.env.clone(),

@@ -26,11 +26,7 @@ fn progress(run: &Path, done: bool) -> u64 {
     if done {
         return budget;
     }
-    seads_rl::read_metrics(run)
-        .ok()
-        .and_then(|m| m.last().map(|m| m.env_steps))
-        .unwrap_or(0)
-        .min(budget)
+    seads_rl::last_env_steps(run).unwrap_or(0).min(budget)
 }
 
 /// Runs the sweep in `dir` with `workers` parallel tasks sharing `cores` cores.
