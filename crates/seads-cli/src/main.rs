@@ -103,8 +103,21 @@ fn keep_freed_memory() {
     }
 }
 
+/// Ends the process quietly when its output pipe closes (`seads sweep status | head`), as other
+/// Unix tools do: Rust ignores SIGPIPE, so a print to a closed pipe would panic instead.
+fn die_quietly_on_closed_pipes() {
+    #[cfg(unix)]
+    #[allow(unsafe_code)]
+    // SAFETY: restores the default disposition of one signal, once, before any other thread
+    // exists; no handler of this program is replaced.
+    unsafe {
+        libc::signal(libc::SIGPIPE, libc::SIG_DFL);
+    }
+}
+
 fn main() -> ExitCode {
     keep_freed_memory();
+    die_quietly_on_closed_pipes();
     let cli = Cli::parse();
     let result = match cli.command {
         Command::Games(cmd) => games::run(cmd),

@@ -857,3 +857,25 @@ fn numeric_options_reject_negative_nan_and_infinite_values() {
         }
     });
 }
+
+/// Output into a closed pipe (`seads … | head`) ends the process quietly, as for other Unix
+/// tools, instead of a panic.
+#[test]
+fn a_closed_output_pipe_is_not_a_panic() {
+    use std::os::unix::process::ExitStatusExt;
+    let (reader, writer) = std::io::pipe().unwrap();
+    drop(reader);
+    let out = std::process::Command::new(env!("CARGO_BIN_EXE_seads"))
+        .args(["games", "depths", "--game", "tileswap"])
+        .stdout(writer)
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(!stderr.contains("panicked"), "{stderr}");
+    assert_eq!(
+        out.status.signal(),
+        Some(13),
+        "killed by SIGPIPE: {:?}",
+        out.status
+    );
+}
