@@ -228,4 +228,15 @@ overrides = { algorithm = "sac", baseline = { replay_capacity = 100, eval_boards
     for row in ["| seads | re-planning | 1 |", "| sac | policy | 1 |"] {
         assert!(md.contains(row), "{row}: {md}");
     }
+    // The comparison: each run's success over all depths, SAC tested against SEADS.
+    let comparison = &md[md.find("## SEADS against the baselines").expect(&md)..];
+    assert!(
+        comparison.contains("| lightsout-cursor | seads | re-planning | 1 |"),
+        "{comparison}"
+    );
+    let sac_row = comparison
+        .lines()
+        .find(|l| l.starts_with("| lightsout-cursor | sac | policy | 1 |"))
+        .expect(comparison);
+    assert!(sac_row.contains("U = "), "{sac_row}");
 }

@@ -103,6 +103,11 @@ pub fn report(args: ReportArgs) -> Result<()> {
     let _ = writeln!(md, "## Task success at the end of training\n");
     md += &success_md;
     let _ = writeln!(md, "\nAs CSV: `success.csv`.\n");
+    if let Some(comparison) = tables::success_comparison(&groups, reference.as_deref()) {
+        let _ = writeln!(md, "## SEADS against the baselines: task success\n");
+        md += &comparison;
+        md.push('\n');
+    }
     let _ = writeln!(md, "## Skill and solution length\n");
     md += &length_md;
     let _ = writeln!(md, "\nAs CSV: `lengths.csv`.\n");

@@ -242,6 +242,78 @@ pub fn success_tables(groups: &[Group<'_>]) -> (String, String) {
     (md, csv)
 }
 
+/// A run's final task success over all depths, in the mode it is compared in: SEADS with
+/// re-planning, a baseline's policy alone.
+fn pooled_success(run: &RunData) -> Option<(Mode, f64)> {
+    let (mode, results) = match (&run.replan, &run.policy) {
+        (Some(r), _) => (Mode::Replan, r),
+        (None, Some(p)) => (Mode::Policy, p),
+        (None, None) => return None,
+    };
+    let (solved, tasks) = results
+        .iter()
+        .fold((0, 0), |(s, t), d| (s + d.solved, t + d.tasks));
+    Some((mode, solved as f64 / tasks.max(1) as f64))
+}
+
+/// SEADS against the baselines on task success (the paper's Fig. 3 at the end of training):
+/// each run's share of solved test tasks over all depths, tested against the reference with
+/// the one-sided Mann–Whitney U test. `None` when no baseline was evaluated (a Table 1 study).
+pub fn success_comparison(groups: &[Group<'_>], reference: Option<&str>) -> Option<String> {
+    let values = |g: &Group<'_>| -> (Vec<f64>, Option<Mode>) {
+        let pooled: Vec<(Mode, f64)> = g.runs.iter().filter_map(|r| pooled_success(r)).collect();
+        (
+            pooled.iter().map(|p| p.1).collect(),
+            pooled.first().map(|p| p.0),
+        )
+    };
+    if !groups
+        .iter()
+        .any(|g| g.runs.iter().any(|r| r.policy.is_some()))
+    {
+        return None;
+    }
+    let mut md = String::from(
+        "| environment | variant | mode | runs | solved (all depths) | test against the reference |\n|---|---|---|---|---|---|\n",
+    );
+    for g in groups {
+        let (v, mode) = values(g);
+        let (Some(s), Some(mode)) = (summary(&v), mode) else {
+            continue;
+        };
+        let test = reference
+            .filter(|r| *r != g.variant)
+            .and_then(|r| groups.iter().find(|o| o.env == g.env && o.variant == r))
+            .and_then(|o| worse_than(&v, &values(o).0));
+        let value = format!("{:.1} ± {:.1} %", 100.0 * s.mean, 100.0 * s.std);
+        let (value, test) = match test {
+            Some(t) if t.significant() => (
+                format!("**{value}**"),
+                format!("U = {}, p = {:.4}", t.u, t.p),
+            ),
+            Some(t) => (value, format!("U = {}, p = {:.4}", t.u, t.p)),
+            None => (value, String::from("–")),
+        };
+        let _ = writeln!(
+            md,
+            "| {} | {} | {} | {} | {value} | {test} |",
+            g.env,
+            g.variant,
+            mode.label(),
+            s.n
+        );
+    }
+    let _ = write!(
+        md,
+        "\nShare of all test tasks (every depth) solved at the end of training, mean ± sample \
+         standard deviation over the runs; SEADS with re-planning, a baseline's policy acting alone. \
+         U and p: one-sided Mann–Whitney U test that the variant solves less than `{}`; **bold**: \
+         p < 0.01.\n",
+        reference.unwrap_or("-")
+    );
+    Some(md)
+}
+
 /// Median skill length and median solution length (manipulator steps, solved tasks, with
 /// re-planning), pooled over the runs of a group; Markdown and CSV.
 pub fn length_tables(groups: &[Group<'_>]) -> (String, String) {
