@@ -122,6 +122,10 @@ fn scenes_carry_the_fields_heights() {
     );
 }
 
+/// Physics steps per 0.1 s environment step compared with the reference: its own 50 (2 ms), and
+/// the 25 (4 ms) the Jaco presets train with, which must follow the reference as closely.
+const SUBSTEPS: [usize; 2] = [50, 25];
+
 /// The recorded reference episodes (`data/reference/jaco/`, written by
 /// `scripts/reference/jaco_record.py` from the authors' environments in MuJoCo), with our board
 /// for each.
@@ -207,6 +211,12 @@ fn forward_kinematics_matches_the_reference_simulation() {
 /// board (numbers in docs/RESULTS.md; `--nocapture` prints them).
 #[test]
 fn joint_trajectories_follow_the_reference_simulation() {
+    for substeps in SUBSTEPS {
+        joint_trajectories_follow_the_reference_simulation_at(substeps);
+    }
+}
+
+fn joint_trajectories_follow_the_reference_simulation_at(substeps: usize) {
     let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(0);
     for (name, board, data) in references() {
         // Worst arm-joint error so far (radians, wrapped) after 1, 5, 10, 20, 50 steps, per kind.
@@ -218,7 +228,7 @@ fn joint_trajectories_follow_the_reference_simulation() {
             let kind = usize::from(episode["kind"] == "constant");
             episodes[kind] += 1;
             let q0 = floats(&episode["qpos0"]);
-            let mut jaco = Jaco::new(board, 50);
+            let mut jaco = Jaco::new(board, substeps);
             jaco.set_joint_positions(&q0.clone().try_into().unwrap());
             let mut error_so_far = 0.0f32;
             for (t, step) in episode["steps"].as_array().unwrap().iter().enumerate() {
@@ -246,7 +256,7 @@ fn joint_trajectories_follow_the_reference_simulation() {
         for (kind, actions) in ["random actions", "held commands"].iter().enumerate() {
             let w = worst[kind];
             eprintln!(
-                "{name}-jaco vs reference, {actions}: worst arm-joint error after 1/5/10/20/50 steps: {:.4} / {:.4} / {:.4} / {:.4} / {:.4} rad; {} of {} episodes within 0.05 rad to their end",
+                "{name}-jaco ({substeps} substeps) vs reference, {actions}: worst arm-joint error after 1/5/10/20/50 steps: {:.4} / {:.4} / {:.4} / {:.4} / {:.4} rad; {} of {} episodes within 0.05 rad to their end",
                 w[0], w[1], w[2], w[3], w[4], within_at_end[kind], episodes[kind]
             );
             // Measured worst: 0.0031 after 5 steps, 0.026 after 10 (LightsOut3D, held commands).
@@ -260,6 +270,12 @@ fn joint_trajectories_follow_the_reference_simulation() {
 /// it reproduces. (TileSwap: `tileswap_touches_agree_with_the_reference_simulation`.)
 #[test]
 fn presses_agree_with_the_reference_simulation() {
+    for substeps in SUBSTEPS {
+        presses_agree_with_the_reference_simulation_at(substeps);
+    }
+}
+
+fn presses_agree_with_the_reference_simulation_at(substeps: usize) {
     let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(0);
     for (name, board, data) in references() {
         if name == "tileswap" {
@@ -275,7 +291,7 @@ fn presses_agree_with_the_reference_simulation() {
         };
         for episode in data["episodes"].as_array().unwrap() {
             let q0 = floats(&episode["qpos0"]);
-            let mut jaco = Jaco::new(board, 50);
+            let mut jaco = Jaco::new(board, substeps);
             jaco.set_joint_positions(&q0.clone().try_into().unwrap());
             for (t, step) in episode["steps"].as_array().unwrap().iter().enumerate() {
                 let mut ours: i64 = -1;
@@ -297,7 +313,7 @@ fn presses_agree_with_the_reference_simulation() {
         let fraction = agree as f64 / steps as f64;
         let reproduced = reference_presses.iter().filter(|p| p.2 == p.3).count();
         eprintln!(
-            "{name}-jaco vs reference: the same press (or none) on {agree} of {steps} steps ({:.1} %); {reproduced} of its {} presses reproduced (episode, step, field, ours): {reference_presses:?}",
+            "{name}-jaco ({substeps} substeps) vs reference: the same press (or none) on {agree} of {steps} steps ({:.1} %); {reproduced} of its {} presses reproduced (episode, step, field, ours): {reference_presses:?}",
             100.0 * fraction,
             reference_presses.len()
         );
@@ -323,6 +339,12 @@ fn presses_agree_with_the_reference_simulation() {
 /// the layout turns into a swap) on the same steps, at the same place.
 #[test]
 fn tileswap_touches_agree_with_the_reference_simulation() {
+    for substeps in SUBSTEPS {
+        tileswap_touches_agree_with_the_reference_simulation_at(substeps);
+    }
+}
+
+fn tileswap_touches_agree_with_the_reference_simulation_at(substeps: usize) {
     let (_, board, data) = references()
         .into_iter()
         .find(|(name, _, _)| *name == "tileswap")
@@ -332,7 +354,7 @@ fn tileswap_touches_agree_with_the_reference_simulation() {
     let mut touches = Vec::new();
     for episode in data["episodes"].as_array().unwrap() {
         let q0 = floats(&episode["qpos0"]);
-        let mut jaco = Jaco::new(board, 50);
+        let mut jaco = Jaco::new(board, substeps);
         jaco.set_joint_positions(&q0.clone().try_into().unwrap());
         for step in episode["steps"].as_array().unwrap() {
             let mut ours: Option<[f64; 2]> = None;
@@ -360,7 +382,7 @@ fn tileswap_touches_agree_with_the_reference_simulation() {
     }
     let fraction = agree as f64 / steps as f64;
     eprintln!(
-        "tileswap-jaco vs reference: the same touch (within 5 % of the board) or none on {agree} of {steps} steps ({:.1} %); the reference's touches (episode, theirs, ours): {touches:?}",
+        "tileswap-jaco ({substeps} substeps) vs reference: the same touch (within 5 % of the board) or none on {agree} of {steps} steps ({:.1} %); the reference's touches (episode, theirs, ours): {touches:?}",
         100.0 * fraction
     );
     assert!(!touches.is_empty());
@@ -400,8 +422,12 @@ fn forward_kinematics_matches_the_observed_pinch_site() {
 }
 
 /// Presses every move in `moves` from every seed; returns the failures.
-fn sweep(name: &str, seeds: &[u64], moves: &[MoveId]) -> Vec<String> {
-    let mut env = make_env(name, &EnvConfig::default()).unwrap();
+fn sweep(name: &str, substeps: usize, seeds: &[u64], moves: &[MoveId]) -> Vec<String> {
+    let config = EnvConfig {
+        physics_substeps: Some(substeps),
+        ..EnvConfig::default()
+    };
+    let mut env = make_env(name, &config).unwrap();
     let n = env.spec().board_size;
     let mut failures = Vec::new();
     for &seed in seeds {
@@ -442,13 +468,15 @@ fn sweep(name: &str, seeds: &[u64], moves: &[MoveId]) -> Vec<String> {
 }
 
 fn check(name: &str, seeds: &[u64], moves: &[MoveId]) {
-    let failures = sweep(name, seeds, moves);
-    assert!(
-        failures.is_empty(),
-        "{name}: {} of {} presses failed: {failures:?}",
-        failures.len(),
-        seeds.len() * moves.len()
-    );
+    for substeps in SUBSTEPS {
+        let failures = sweep(name, substeps, seeds, moves);
+        assert!(
+            failures.is_empty(),
+            "{name} ({substeps} substeps): {} of {} presses failed: {failures:?}",
+            failures.len(),
+            seeds.len() * moves.len()
+        );
+    }
 }
 
 /// CI: a few moves of each Jaco environment.
@@ -472,16 +500,18 @@ fn jaco_produces_every_move_full_sweep() {
         ("lightsout3d-jaco", 25),
         ("tileswap-jaco", 12),
     ] {
-        let failures = sweep(name, &seeds, &(0..k).collect::<Vec<_>>());
-        eprintln!(
-            "{name}: {} of {} presses made the intended move",
-            seeds.len() * k - failures.len(),
-            seeds.len() * k
-        );
-        assert!(
-            failures.len() * 100 <= seeds.len() * k,
-            "{name}: more than 1 % failed: {failures:?}"
-        );
+        for substeps in SUBSTEPS {
+            let failures = sweep(name, substeps, &seeds, &(0..k).collect::<Vec<_>>());
+            eprintln!(
+                "{name} ({substeps} substeps): {} of {} presses made the intended move",
+                seeds.len() * k - failures.len(),
+                seeds.len() * k
+            );
+            assert!(
+                failures.len() * 100 <= seeds.len() * k,
+                "{name} ({substeps} substeps): more than 1 % failed: {failures:?}"
+            );
+        }
     }
 }
 
