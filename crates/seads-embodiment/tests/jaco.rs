@@ -533,3 +533,49 @@ fn initial_poses_need_no_fallback() {
         assert_eq!(arm.ik_fallbacks(), 0, "{board:?}");
     }
 }
+
+/// The two-sample Kolmogorov–Smirnov statistic: the largest gap between the empirical CDFs.
+fn ks_statistic(a: &[f64], b: &[f64]) -> f64 {
+    let cdf = |xs: &[f64], x: f64| xs.iter().filter(|&&v| v <= x).count() as f64 / xs.len() as f64;
+    a.iter()
+        .chain(b)
+        .map(|&x| (cdf(a, x) - cdf(b, x)).abs())
+        .fold(0.0, f64::max)
+}
+
+/// Reset poses: our random initial pinch-site positions and the reference's (its 40 recorded
+/// resets; the three boards share them) come from the same distribution, coordinate by
+/// coordinate (two-sample Kolmogorov–Smirnov at α = 0.001).
+#[test]
+fn reset_poses_are_distributed_as_the_references() {
+    // The statistic by hand: equal samples 0, disjoint ones 1, [0, 1, 2] against [1, 2, 3] 1/3.
+    assert_eq!(ks_statistic(&[1.0, 2.0], &[1.0, 2.0]), 0.0);
+    assert_eq!(ks_statistic(&[0.0, 1.0], &[2.0, 3.0]), 1.0);
+    assert!((ks_statistic(&[0.0, 1.0, 2.0], &[1.0, 2.0, 3.0]) - 1.0 / 3.0).abs() < 1e-12);
+    let (_, _, data) = references().into_iter().next().unwrap();
+    let theirs: Vec<Vec<f32>> = data["episodes"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|e| floats(&e["pinch0"]))
+        .collect();
+    let mut env = make_env("lightsout-jaco", &EnvConfig::default()).unwrap();
+    let ours: Vec<[f32; 3]> = (0..200)
+        .map(|seed| {
+            env.seed(seed);
+            env.reset().unwrap();
+            let obs = env.observation();
+            [obs[30], obs[31], obs[32]]
+        })
+        .collect();
+    let (n, m) = (ours.len() as f64, theirs.len() as f64);
+    // Critical value of the two-sample test at α = 0.001: 1.95·√((n + m)/(n·m)).
+    let critical = 1.95 * ((n + m) / (n * m)).sqrt();
+    for (axis, name) in ["x", "y", "z"].iter().enumerate() {
+        let a: Vec<f64> = ours.iter().map(|p| f64::from(p[axis])).collect();
+        let b: Vec<f64> = theirs.iter().map(|p| f64::from(p[axis])).collect();
+        let d = ks_statistic(&a, &b);
+        eprintln!("reset pinch site {name}: KS distance {d:.3} (critical {critical:.3})");
+        assert!(d < critical, "{name}: D = {d} ≥ {critical}");
+    }
+}
