@@ -262,6 +262,9 @@ pub struct TaskSac {
     envs: Vec<TaskEnv>,
     /// The current observation of each environment.
     obs: Vec<Vec<f32>>,
+    /// Where the next observation is written before it becomes the current one (no allocation
+    /// per environment step).
+    next_obs: Vec<f32>,
     sac: Sac,
     replay: Replay,
     progress: Progress,
@@ -320,6 +323,7 @@ impl TaskSac {
         };
         let mut agent = Self {
             obs: vec![Vec::new(); envs.len()],
+            next_obs: vec![0.0; spec.obs_dim],
             config,
             spec,
             envs,
@@ -340,9 +344,8 @@ impl TaskSac {
         let env = &mut self.envs[slot];
         env.seed(seed);
         env.reset()?;
-        let mut obs = vec![0.0; self.spec.obs_dim];
-        env.observe(&mut obs);
-        self.obs[slot] = obs;
+        self.obs[slot].resize(self.spec.obs_dim, 0.0);
+        env.observe(&mut self.obs[slot]);
         let open = OpenEpisode {
             seed,
             actions: Vec::new(),
@@ -395,12 +398,16 @@ impl TaskSac {
         for slot in 0..self.envs.len() {
             let action = &actions[slot * a..(slot + 1) * a];
             let step = self.envs[slot].step(action)?;
-            let mut next = vec![0.0; self.spec.obs_dim];
-            self.envs[slot].observe(&mut next);
-            self.replay
-                .push(&self.obs[slot], action, step.reward, &next, step.done);
+            self.envs[slot].observe(&mut self.next_obs);
+            self.replay.push(
+                &self.obs[slot],
+                action,
+                step.reward,
+                &self.next_obs,
+                step.done,
+            );
             self.progress.open[slot].actions.extend_from_slice(action);
-            self.obs[slot] = next;
+            std::mem::swap(&mut self.obs[slot], &mut self.next_obs);
             if step.done {
                 self.progress.ended += 1;
                 self.progress.solved += u64::from(step.solved);
