@@ -321,10 +321,10 @@ pub fn evaluate_run(args: EvaluateArgs) -> Result<()> {
     }
     let config = seads_rl::load_config(&args.run)
         .with_context(|| format!("loading run {}", args.run.display()))?;
-    if config.algorithm == seads_rl::Algorithm::Sac {
+    if config.algorithm.is_baseline() {
         if args.checkpoints.is_some() {
             bail!(BadInput(anyhow::anyhow!(
-                "{}: a SAC baseline's task success over training is in its metrics.jsonl; \
+                "{}: a baseline's task success over training is in its metrics.jsonl; \
                  --checkpoints is for SEADS runs",
                 args.run.display()
             )));
@@ -430,9 +430,9 @@ fn evaluate_policy(
             ))
         })?,
     };
-    let policy = seads_rl::load_policy(config, &checkpoint)
+    let mut policy = seads_rl::load_policy(config, &checkpoint)
         .with_context(|| format!("loading the policy of run {}", args.run.display()))?;
-    let results = seads_rl::task_success(config, &policy, depths, args.boards)?;
+    let results = seads_rl::task_success(config, policy.as_mut(), depths, args.boards)?;
     let name = match (depths.first(), depths.last()) {
         (Some(1), Some(5)) if depths.len() == 5 => POLICY_EVALUATION.to_owned(),
         (Some(a), Some(b)) => format!("evaluation-policy-depths-{a}-{b}.json"),

@@ -6,7 +6,9 @@ use std::path::PathBuf;
 use anyhow::{Context, Result};
 use clap::Args;
 use indicatif::{ProgressBar, ProgressStyle};
-use seads_rl::{Algorithm, Hook, Learner, Moment, Run, TaskSac, TrainConfig, Trainer};
+use seads_rl::{
+    Algorithm, Hac, Hook, Learner, Moment, Run, TaskMetrics, TaskSac, TrainConfig, Trainer,
+};
 
 use crate::BadInput;
 
@@ -16,9 +18,10 @@ pub struct TrainArgs {
     /// Environment to train on, with its preset (the paper's settings; see `seads envs`).
     #[arg(long, required_unless_present_any = ["resume", "config"])]
     env: Option<String>,
-    /// What to train: `seads`, or the flat SAC baseline with the task reward (`sac`, SPEC §5.1;
-    /// its presets are `configs/sac-*.toml`). Default: the config's, else seads.
-    #[arg(long, value_parser = ["seads", "sac"], conflicts_with = "resume")]
+    /// What to train: `seads`, or a baseline with the task reward: flat SAC (`sac`, SPEC §5.1;
+    /// presets `configs/sac-*.toml`) or two-level HAC (`hac`, SPEC §5.2; presets
+    /// `configs/hac-*.toml`). Default: the config's, else seads.
+    #[arg(long, value_parser = ["seads", "sac", "hac"], conflicts_with = "resume")]
     algorithm: Option<String>,
     /// Run directory to create (config.toml, metrics.jsonl, checkpoints/).
     #[arg(long, required_unless_present = "resume")]
@@ -76,6 +79,7 @@ fn config(args: &TrainArgs) -> Result<TrainConfig> {
 fn algorithm(name: Option<&str>) -> Algorithm {
     match name {
         Some("sac") => Algorithm::Sac,
+        Some("hac") => Algorithm::Hac,
         _ => Algorithm::Seads,
     }
 }
@@ -98,6 +102,7 @@ pub fn train(args: TrainArgs) -> Result<()> {
                     drive(&mut resume(dir, Run::<Trainer>::resume(dir))?, args.quiet)
                 }
                 Algorithm::Sac => drive(&mut resume(dir, Run::<TaskSac>::resume(dir))?, args.quiet),
+                Algorithm::Hac => drive(&mut resume(dir, Run::<Hac>::resume(dir))?, args.quiet),
             }
         }
         None => {
@@ -107,6 +112,7 @@ pub fn train(args: TrainArgs) -> Result<()> {
             match config.algorithm {
                 Algorithm::Seads => drive(&mut create::<Trainer>(out, config)?, args.quiet),
                 Algorithm::Sac => drive(&mut create::<TaskSac>(out, config)?, args.quiet),
+                Algorithm::Hac => drive(&mut create::<Hac>(out, config)?, args.quiet),
             }
         }
     }
@@ -216,17 +222,7 @@ impl Shown for TaskSac {
         (m.epoch, m.env_steps, m.steps_per_s)
     }
     fn headline(&self, m: &Self::Metrics) -> String {
-        let per_depth: Vec<String> = m
-            .success
-            .iter()
-            .map(|s| format!("{:.0}", 100.0 * s))
-            .collect();
-        format!(
-            "task success {:>5.1} % (depths 1-5: {} %)  training episodes solved {:.1} %",
-            100.0 * m.mean_success,
-            per_depth.join("/"),
-            100.0 * m.train_solved
-        )
+        task_headline(m)
     }
     fn phases(&self) -> String {
         let t = self.timings();
@@ -235,6 +231,47 @@ impl Shown for TaskSac {
             t.collect, t.sac, t.evaluate
         )
     }
+}
+
+impl Shown for Hac {
+    fn steps(&self) -> u64 {
+        self.env_steps()
+    }
+    fn stats_steps(stats: &Self::Stats) -> (u64, u64) {
+        (stats.epoch, stats.env_steps)
+    }
+    fn metrics_steps(m: &Self::Metrics) -> (u64, u64, f64) {
+        (m.epoch, m.env_steps, m.steps_per_s)
+    }
+    fn headline(&self, m: &Self::Metrics) -> String {
+        format!(
+            "{}  subgoals reached {:.1} %",
+            task_headline(m),
+            100.0 * self.subgoals_reached()
+        )
+    }
+    fn phases(&self) -> String {
+        let t = self.timings();
+        format!(
+            "collect {:.1} s, SAC updates of both levels {:.1} s, evaluation {:.1} s",
+            t.collect, t.sac, t.evaluate
+        )
+    }
+}
+
+/// A baseline's evaluation in a few words.
+fn task_headline(m: &TaskMetrics) -> String {
+    let per_depth: Vec<String> = m
+        .success
+        .iter()
+        .map(|s| format!("{:.0}", 100.0 * s))
+        .collect();
+    format!(
+        "task success {:>5.1} % (depths 1-5: {} %)  training episodes solved {:.1} %",
+        100.0 * m.mean_success,
+        per_depth.join("/"),
+        100.0 * m.train_solved
+    )
 }
 
 /// Trains `run` to its budget, showing progress, and prints a summary.

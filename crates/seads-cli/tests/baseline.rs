@@ -1,6 +1,6 @@
-//! The flat SAC baseline through the binary: `seads train --algorithm sac` with its preset, a
-//! tiny run trained, extended by `--resume`, evaluated on the SEADS protocol and reported beside
-//! SEADS's modes; the planning commands refuse it in one line.
+//! The task-reward baselines through the binary: `seads train --algorithm sac|hac` with their
+//! presets, tiny runs trained, extended by `--resume`, killed and resumed, evaluated on the SEADS
+//! protocol and reported beside SEADS's modes; the planning commands refuse them in one line.
 
 use std::path::{Path, PathBuf};
 use std::process::Command;
@@ -8,13 +8,20 @@ use std::process::Command;
 mod common;
 use common::*;
 
-/// A tiny baseline run: 30 epochs of 8 steps, evaluations and checkpoints every 10 epochs.
-fn tiny_config(dir: &Path) -> PathBuf {
-    let path = dir.join("sac.toml");
+/// A tiny baseline run of `algorithm` (sac or hac): 30 epochs of 8 steps, evaluations and
+/// checkpoints every 10 epochs.
+fn tiny_config(dir: &Path, algorithm: &str) -> PathBuf {
+    let path = dir.join(format!("{algorithm}.toml"));
+    let hac = if algorithm == "hac" {
+        "[hac]\nsubgoal_horizon = 4\n"
+    } else {
+        ""
+    };
     std::fs::write(
         &path,
-        r#"
-algorithm = "sac"
+        format!(
+            r#"
+algorithm = "{algorithm}"
 env = "lightsout-cursor"
 seed = 3
 env_steps = 240
@@ -30,7 +37,9 @@ alpha = 0.1
 [baseline]
 replay_capacity = 100
 eval_boards = 1
-"#,
+
+{hac}"#
+        ),
     )
     .unwrap();
     path
@@ -58,9 +67,9 @@ fn numbers(run: &Path) -> Vec<serde_json::Value> {
 }
 
 #[test]
-fn the_preset_is_the_papers_baseline() {
+fn the_presets_are_the_papers_baselines() {
     let dir = tempfile::tempdir().unwrap();
-    let run = dir.path().join("run");
+    let run = dir.path().join("sac");
     let args = [
         "train",
         "--env",
@@ -84,12 +93,86 @@ fn the_preset_is_the_papers_baseline() {
         assert!(config.contains(line), "{config}");
     }
     assert_eq!(metrics(&run)[0]["success"].as_array().unwrap().len(), 5);
+
+    let run = dir.path().join("hac");
+    let out = seads_ok(&[
+        "train",
+        "--env",
+        "tileswap-cursor",
+        "--algorithm",
+        "hac",
+        "--env-steps",
+        "8",
+        "--out",
+        s(&run),
+        "--quiet",
+    ]);
+    assert!(String::from_utf8_lossy(&out.stdout).contains("subgoals reached"));
+    let config = std::fs::read_to_string(run.join("config.toml")).unwrap();
+    for line in [
+        "algorithm = \"hac\"",
+        "hidden = [512, 512]",
+        "temperature = 0.5",
+        "alpha_high = 0.001",
+        "subgoal_horizon = 10",
+    ] {
+        assert!(config.contains(line), "{config}");
+    }
+}
+
+/// A mistaken algorithm or setting is one line on stderr and exit 2, and no run is created.
+#[test]
+fn bad_baseline_settings_are_bad_input() {
+    let dir = tempfile::tempdir().unwrap();
+    let run = dir.path().join("run");
+    let out = seads(&[
+        "train",
+        "--env",
+        "lightsout-cursor",
+        "--algorithm",
+        "ppo",
+        "--out",
+        s(&run),
+    ]);
+    assert_eq!(out.status.code(), Some(2));
+    for (text, needle) in [
+        (
+            "algorithm = \"hac\"\n[hac]\ntemperature = 0.0\n",
+            "hac.temperature",
+        ),
+        (
+            "algorithm = \"sac\"\n[baseline]\nupdates_per_epoch = -1.0\n",
+            "updates_per_epoch",
+        ),
+        (
+            "algorithm = \"sac\"\nnum_skills = 30\n",
+            "num_skills is not a setting",
+        ),
+        (
+            "[baseline]\nupdates_per_epoch = 0.5\n",
+            "baseline is not a setting of SEADS",
+        ),
+    ] {
+        let config = dir.path().join("bad.toml");
+        std::fs::write(&config, text).unwrap();
+        check_bad_input(&["train", "--config", s(&config), "--out", s(&run)], needle);
+        assert!(!run.exists(), "{text}");
+    }
 }
 
 #[test]
-fn a_baseline_run_trains_resumes_evaluates_and_is_reported() {
+fn a_sac_run_trains_resumes_evaluates_and_is_reported() {
+    trains_resumes_evaluates_and_is_reported("sac");
+}
+
+#[test]
+fn a_hac_run_trains_resumes_evaluates_and_is_reported() {
+    trains_resumes_evaluates_and_is_reported("hac");
+}
+
+fn trains_resumes_evaluates_and_is_reported(algorithm: &str) {
     let dir = tempfile::tempdir().unwrap();
-    let config = tiny_config(dir.path());
+    let config = tiny_config(dir.path(), algorithm);
     let run = dir.path().join("run");
     seads_ok(&["train", "--config", s(&config), "--out", s(&run), "--quiet"]);
     let epochs: Vec<u64> = metrics(&run)
@@ -141,11 +224,20 @@ fn a_baseline_run_trains_resumes_evaluates_and_is_reported() {
 
 /// Killed with SIGKILL at moments spread over its life (collection, metrics appends, checkpoint
 /// writes; `SEADS_CRASH_POINT` counts them) and resumed, a baseline run ends as the uninterrupted
-/// one: the replay buffer, the streams and the open episodes come back exactly.
+/// one: the replay buffers, the streams, the open episodes and HAC's subgoals come back exactly.
 #[test]
-fn a_killed_baseline_run_resumes_to_the_same_run() {
+fn a_killed_sac_run_resumes_to_the_same_run() {
+    killed_run_resumes_to_the_same_run("sac", &[3, 24, 29, 47, 66]);
+}
+
+#[test]
+fn a_killed_hac_run_resumes_to_the_same_run() {
+    killed_run_resumes_to_the_same_run("hac", &[5, 29, 47, 66]);
+}
+
+fn killed_run_resumes_to_the_same_run(algorithm: &str, points: &[usize]) {
     let dir = tempfile::tempdir().unwrap();
-    let config = tiny_config(dir.path());
+    let config = tiny_config(dir.path(), algorithm);
     let whole = dir.path().join("whole");
     seads_ok(&[
         "train",
@@ -155,7 +247,7 @@ fn a_killed_baseline_run_resumes_to_the_same_run() {
         s(&whole),
         "--quiet",
     ]);
-    for point in [3, 24, 29, 47, 66] {
+    for &point in points {
         let out = dir.path().join(format!("killed-{point}"));
         let mut command = Command::new(env!("CARGO_BIN_EXE_seads"));
         command.args(["train", "--config", s(&config), "--out", s(&out), "--quiet"]);
@@ -165,8 +257,8 @@ fn a_killed_baseline_run_resumes_to_the_same_run() {
     }
 }
 
-/// A study with a SAC variant: the sweep trains it from the baseline's preset, evaluates its
-/// policy, shows its progress, and the report puts its success beside SEADS's.
+/// A study with SAC and HAC variants: the sweep trains each from its baseline's preset,
+/// evaluates its policy, shows its progress, and the report puts its success beside SEADS's.
 #[test]
 fn a_sweep_trains_and_reports_the_baseline_beside_seads() {
     let dir = tempfile::tempdir().unwrap();
@@ -198,6 +290,10 @@ overrides = { sampled_episodes = 16, recent_episodes = 16, episodes_per_epoch = 
 [[variant]]
 name = "sac"
 overrides = { algorithm = "sac", baseline = { replay_capacity = 100, eval_boards = 1 } }
+
+[[variant]]
+name = "hac"
+overrides = { algorithm = "hac", baseline = { replay_capacity = 100, eval_boards = 1 }, hac = { subgoal_horizon = 4 } }
 "#,
     )
     .unwrap();
@@ -211,7 +307,7 @@ overrides = { algorithm = "sac", baseline = { replay_capacity = 100, eval_boards
     );
     seads_ok(&["sweep", "run", s(&sweep), "--quiet"]);
     let status = json(&["sweep", "status", s(&sweep), "--json"]);
-    assert_eq!(status["done"], 2, "{status}");
+    assert_eq!(status["done"], 3, "{status}");
     // Both trained their budget (SEADS finishes its last episodes: a few steps more).
     assert!(
         status["runs"]
@@ -222,10 +318,16 @@ overrides = { algorithm = "sac", baseline = { replay_capacity = 100, eval_boards
         "{status}"
     );
     assert!(sac.join("evaluation-policy.json").is_file());
+    let hac = sweep.join("runs/lightsout-cursor/hac/seed-1");
+    assert!(hac.join("evaluation-policy.json").is_file());
     let report = dir.path().join("report");
     seads_ok(&["report", s(&sweep), "--out", s(&report)]);
     let md = std::fs::read_to_string(report.join("report.md")).unwrap();
-    for row in ["| seads | re-planning | 1 |", "| sac | policy | 1 |"] {
+    for row in [
+        "| seads | re-planning | 1 |",
+        "| sac | policy | 1 |",
+        "| hac | policy | 1 |",
+    ] {
         assert!(md.contains(row), "{row}: {md}");
     }
     // The comparison: each run's success over all depths, SAC tested against SEADS.
@@ -239,4 +341,8 @@ overrides = { algorithm = "sac", baseline = { replay_capacity = 100, eval_boards
         .find(|l| l.starts_with("| lightsout-cursor | sac | policy | 1 |"))
         .expect(comparison);
     assert!(sac_row.contains("U = "), "{sac_row}");
+    assert!(
+        comparison.contains("| lightsout-cursor | hac | policy | 1 |"),
+        "{comparison}"
+    );
 }

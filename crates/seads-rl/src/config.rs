@@ -37,6 +37,8 @@ pub enum Algorithm {
     Seads,
     /// The flat SAC baseline with the task reward (SPEC §5.1).
     Sac,
+    /// The two-level HAC baseline with the task reward (SPEC §5.2).
+    Hac,
 }
 
 impl Algorithm {
@@ -45,7 +47,13 @@ impl Algorithm {
         match self {
             Algorithm::Seads => "seads",
             Algorithm::Sac => "sac",
+            Algorithm::Hac => "hac",
         }
+    }
+
+    /// Whether it is a task-reward baseline (SAC or HAC).
+    pub fn is_baseline(self) -> bool {
+        self != Algorithm::Seads
     }
 }
 
@@ -70,6 +78,33 @@ impl Default for BaselineConfig {
             samples_per_epoch: 8,
             updates_per_epoch: 1.0,
             eval_boards: 20,
+        }
+    }
+}
+
+/// Settings of the HAC baseline (SPEC §5.2) beyond those it shares with SAC: the low level is the
+/// `[sac]` section (its α is α_low), the high level has the same networks and optimiser with
+/// its own α. Choices where the seed is silent follow Levy's HAC (docs/ARCHITECTURE.md).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct HacConfig {
+    /// Temperature τ_RB of the high level's RelaxedBernoulli policy.
+    pub temperature: f64,
+    /// Fixed entropy temperature α_high of the high level.
+    pub alpha_high: f64,
+    /// Low-level steps a subgoal may take, H (the presets: the environment's steps per skill).
+    pub subgoal_horizon: usize,
+    /// Share of subgoals tested: pursued without exploration noise, and penalised when missed.
+    pub subgoal_test_p: f64,
+}
+
+impl Default for HacConfig {
+    fn default() -> Self {
+        Self {
+            temperature: 0.1,
+            alpha_high: 0.001,
+            subgoal_horizon: 10,
+            subgoal_test_p: 0.3,
         }
     }
 }
@@ -125,9 +160,12 @@ pub struct TrainConfig {
     /// `COMPATIBLE` branch), so that the seed alone fixes the run. About 1.8× slower per SAC
     /// update; off in the presets, on for the demo and the tests (see `seads_rl::numerics`).
     pub portable_numerics: bool,
-    /// The task-reward baselines' settings (`algorithm = "sac"`).
+    /// The task-reward baselines' settings (`algorithm = "sac"` or `"hac"`).
     #[serde(skip_serializing_if = "is_default_baseline")]
     pub baseline: BaselineConfig,
+    /// The HAC baseline's own settings (`algorithm = "hac"`).
+    #[serde(skip_serializing_if = "is_default_hac")]
+    pub hac: HacConfig,
 }
 
 fn is_seads(algorithm: &Algorithm) -> bool {
@@ -136,6 +174,10 @@ fn is_seads(algorithm: &Algorithm) -> bool {
 
 fn is_default_baseline(baseline: &BaselineConfig) -> bool {
     *baseline == BaselineConfig::default()
+}
+
+fn is_default_hac(hac: &HacConfig) -> bool {
+    *hac == HacConfig::default()
 }
 
 impl Default for TrainConfig {
@@ -162,6 +204,7 @@ impl Default for TrainConfig {
             sac_threads_alone: 2,
             portable_numerics: false,
             baseline: BaselineConfig::default(),
+            hac: HacConfig::default(),
         }
     }
 }
@@ -195,6 +238,38 @@ const PRESETS: &[(&str, &str)] = &[
     (
         "lightsout3d-jaco",
         include_str!("../configs/lightsout3d-jaco.toml"),
+    ),
+];
+
+/// The presets of the HAC baseline (`configs/hac-*.toml`).
+const HAC_PRESETS: &[(&str, &str)] = &[
+    (
+        "lightsout-cursor",
+        include_str!("../configs/hac-lightsout-cursor.toml"),
+    ),
+    (
+        "tileswap-cursor",
+        include_str!("../configs/hac-tileswap-cursor.toml"),
+    ),
+    (
+        "lightsout-reacher",
+        include_str!("../configs/hac-lightsout-reacher.toml"),
+    ),
+    (
+        "tileswap-reacher",
+        include_str!("../configs/hac-tileswap-reacher.toml"),
+    ),
+    (
+        "lightsout-jaco",
+        include_str!("../configs/hac-lightsout-jaco.toml"),
+    ),
+    (
+        "tileswap-jaco",
+        include_str!("../configs/hac-tileswap-jaco.toml"),
+    ),
+    (
+        "lightsout3d-jaco",
+        include_str!("../configs/hac-lightsout3d-jaco.toml"),
     ),
 ];
 
@@ -241,6 +316,7 @@ impl TrainConfig {
         let presets = match algorithm {
             Algorithm::Seads => PRESETS,
             Algorithm::Sac => SAC_PRESETS,
+            Algorithm::Hac => HAC_PRESETS,
         };
         let text = presets
             .iter()
@@ -265,6 +341,11 @@ impl TrainConfig {
         SAC_PRESETS
     }
 
+    /// Every preset of the HAC baseline, as `(environment, TOML text)`.
+    pub fn hac_presets() -> &'static [(&'static str, &'static str)] {
+        HAC_PRESETS
+    }
+
     /// Parses a TOML configuration and validates its values (not the environment: see
     /// [`TrainConfig::validate`]).
     pub fn from_toml(text: &str) -> Result<Self, RlError> {
@@ -274,15 +355,20 @@ impl TrainConfig {
         Ok(config)
     }
 
-    /// The configuration as TOML. A SEADS config leaves out the baselines' section; a
-    /// baseline's always has it, defaults included.
+    /// The configuration as TOML. A SEADS config leaves out the baselines' sections; a
+    /// baseline's always has its own, defaults included.
     pub fn to_toml(&self) -> String {
-        let text = toml::to_string(self).expect("a config serialises");
-        if self.algorithm == Algorithm::Seads || !is_default_baseline(&self.baseline) {
-            return text;
+        let mut text = toml::to_string(self).expect("a config serialises");
+        let section = |name: &str, body: Result<String, toml::ser::Error>| {
+            format!("\n[{name}]\n{}", body.expect("a config serialises"))
+        };
+        if self.algorithm.is_baseline() && is_default_baseline(&self.baseline) {
+            text += &section("baseline", toml::to_string(&self.baseline));
         }
-        let section = toml::to_string(&self.baseline).expect("a config serialises");
-        format!("{text}\n[baseline]\n{section}")
+        if self.algorithm == Algorithm::Hac && is_default_hac(&self.hac) {
+            text += &section("hac", toml::to_string(&self.hac));
+        }
+        text
     }
 
     /// Checks every value, and that the environment exists with these options.
@@ -344,12 +430,74 @@ impl TrainConfig {
         for (name, p) in [
             ("relabel.skill_model_p", self.relabel.skill_model_p),
             ("relabel.sac_p", self.relabel.sac_p),
+            ("hac.subgoal_test_p", self.hac.subgoal_test_p),
         ] {
             if !(0.0..=1.0).contains(&p) {
                 return bad(format!("{name} must lie in [0, 1], got {p}"));
             }
         }
-        Ok(())
+        for (name, v) in [
+            ("hac.temperature", self.hac.temperature),
+            ("hac.alpha_high", self.hac.alpha_high),
+        ] {
+            if !(v.is_finite() && v > 0.0) {
+                return bad(format!("{name} must be positive, got {v}"));
+            }
+        }
+        if self.hac.subgoal_horizon == 0 {
+            return bad("hac.subgoal_horizon must be at least 1".into());
+        }
+        self.check_algorithm_fields()
+    }
+
+    /// A setting of another algorithm than the run's, changed from its default, is a mistake:
+    /// SEADS's skills, skill model, reward and relabelling mean nothing to a baseline, and the
+    /// baselines' sections nothing to SEADS.
+    fn check_algorithm_fields(&self) -> Result<(), RlError> {
+        let d = Self::default();
+        let seads_only = [
+            ("num_skills", self.num_skills == d.num_skills),
+            (
+                "episodes_per_epoch",
+                self.episodes_per_epoch == d.episodes_per_epoch,
+            ),
+            ("buffer_capacity", self.buffer_capacity == d.buffer_capacity),
+            ("recent_episodes", self.recent_episodes == d.recent_episodes),
+            (
+                "sampled_episodes",
+                self.sampled_episodes == d.sampled_episodes,
+            ),
+            ("eval_seeds", self.eval_seeds == d.eval_seeds),
+            ("skill_model", self.skill_model == d.skill_model),
+            ("reward", self.reward == d.reward),
+            ("relabel", self.relabel == d.relabel),
+            (
+                "sac.updates_per_epoch",
+                self.sac.updates_per_epoch == d.sac.updates_per_epoch,
+            ),
+        ];
+        let (name, others): (&str, Vec<(&str, bool)>) = match self.algorithm {
+            Algorithm::Seads => (
+                "SEADS",
+                vec![
+                    ("baseline", is_default_baseline(&self.baseline)),
+                    ("hac", is_default_hac(&self.hac)),
+                ],
+            ),
+            Algorithm::Sac => {
+                let mut v = seads_only.to_vec();
+                v.push(("hac", is_default_hac(&self.hac)));
+                ("the SAC baseline", v)
+            }
+            Algorithm::Hac => ("the HAC baseline", seads_only.to_vec()),
+        };
+        match others.iter().find(|(_, default)| !default) {
+            Some((field, _)) => Err(RlError::Config(format!(
+                "{field} is not a setting of {name} (algorithm = {:?}); remove it",
+                self.algorithm.name()
+            ))),
+            None => Ok(()),
+        }
     }
 }
 

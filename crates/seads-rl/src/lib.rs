@@ -37,32 +37,35 @@ mod buffers;
 mod checkpoint;
 mod config;
 mod episode;
+mod hac;
 mod numerics;
 mod relaxed;
+mod replay;
 mod run;
 mod sac;
 mod seeds;
 mod store;
+mod task_policy;
 mod task_sac;
 mod trainer;
 
 use std::path::Path;
 
 pub use agent::{Agent, AgentPolicy};
-pub use config::{Algorithm, BaselineConfig, RelabelConfig, TrainConfig};
+pub use config::{Algorithm, BaselineConfig, HacConfig, RelabelConfig, TrainConfig};
 pub use episode::{Episode, policy_input, run_episodes, skill_coverage};
+pub use hac::{Hac, HacPolicy};
 pub use numerics::{FAST_KERNELS, PORTABLE_KERNELS, kernel_environment, portable_kernels_active};
 pub use relaxed::RelaxedBernoulli;
 pub use run::{Hook, Learner, Metrics, Moment, Run, RunEvent, load_config, raise_budget};
-pub use sac::{Sac, SacConfig, SacLosses, TransitionBatch};
+pub use sac::{Sac, SacConfig, SacLosses, TransitionBatch, checkpoint_files};
 pub use seeds::{Purpose, derived_seed, stream, train_env_seed};
 pub use store::{
     MetricsLine, append_json_line, checkpoint_name, checkpoints, last_env_steps, latest_checkpoint,
     read_json_lines, read_metrics, read_metrics_as, write_atomic,
 };
-pub use task_sac::{
-    TaskEpochStats, TaskMetrics, TaskSac, TaskTimings, load_policy, task_success, updates_due,
-};
+pub use task_policy::{TaskPolicy, load_policy, task_success};
+pub use task_sac::{TaskEpochStats, TaskMetrics, TaskSac, TaskTimings, updates_due};
 pub use trainer::{COVERAGE_SEED, EpochStats, Timings, Trainer};
 
 /// Sets the number of libtorch intra-op threads of the process.

@@ -1,9 +1,12 @@
 //! Soft actor-critic (SPEC §3.2): tanh-squashed Gaussian policy, twin Q critics with
 //! Polyak-averaged targets, a fixed entropy temperature α, Adam.
+//!
+//! The same agent with a factorised [`RelaxedBernoulli`] policy over (0, 1)^D is the discrete SAC
+//! of the HAC baseline's high level (SPEC §5.2; [`Sac::relaxed_bernoulli`]).
 
 use std::path::Path;
 
-use rand::{Rng, SeedableRng};
+use rand::{Rng, RngExt, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use rand_distr::{Distribution, StandardNormal};
 use seads_skillmodel::nn::{Adam, Mlp, flatten_parameters, mean_f32, xavier_linear};
@@ -11,7 +14,7 @@ use serde::{Deserialize, Serialize};
 use tch::nn::{self, Module};
 use tch::{Device, Kind, Tensor};
 
-use crate::RlError;
+use crate::{RelaxedBernoulli, RlError};
 
 /// SAC hyper-parameters. `Default` = the reference's SEADS settings (Cursor α).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -106,11 +109,14 @@ pub struct SacLosses {
     pub q: f32,
 }
 
-/// The actor: an MLP trunk with a mean head and a log σ head.
+/// The actor.
 #[derive(Debug)]
-struct Actor {
-    mean: Mlp,
-    log_std: nn::Linear,
+enum Actor {
+    /// A tanh-squashed Gaussian: an MLP trunk with a mean head and a log σ head.
+    Gaussian { mean: Mlp, log_std: nn::Linear },
+    /// A factorised RelaxedBernoulli of temperature τ: an MLP giving logits clamped to
+    /// [−5, 5].
+    Bernoulli { logits: Mlp, temperature: f64 },
 }
 
 /// Soft actor-critic on inputs of `input_dim` values and actions in a box.
@@ -145,8 +151,17 @@ pub const RESUME_FILES: [&str; 4] = [
     "sac_critic_adam.safetensors",
 ];
 
+/// The checkpoint files of a SAC agent saved under `prefix` ([`Sac::save_as`]), the actor first:
+/// `sac` gives [`ACTOR_FILE`] and [`RESUME_FILES`].
+pub fn checkpoint_files(prefix: &str) -> [String; 5] {
+    ["actor", "critic", "target", "actor_adam", "critic_adam"]
+        .map(|part| format!("{prefix}_{part}.safetensors"))
+}
+
 const LOG_STD_MIN: f64 = -20.0;
 const LOG_STD_MAX: f64 = 2.0;
+/// The RelaxedBernoulli policy's logit bounds (the reference's `RelaxedBernoulliPolicy`).
+const LOGIT_BOUND: f64 = 5.0;
 
 impl Sac {
     /// Fresh networks for inputs of `input_dim` and actions in `[low, high]`, initialised from `seed`.
@@ -158,13 +173,59 @@ impl Sac {
         device: Device,
         seed: u64,
     ) -> Self {
+        Self::build(input_dim, low, high, None, config, device, seed)
+    }
+
+    /// A discrete SAC for binary actions in {0,1}^`action_dim` (the HAC high level's subgoals):
+    /// a factorised RelaxedBernoulli policy of `temperature` τ > 0 whose logits are clamped to
+    /// [−5, 5]. Sampled actions lie in (0, 1); deterministic ones are 1 where the logit is
+    /// positive. The critics see the relaxed action.
+    pub fn relaxed_bernoulli(
+        input_dim: usize,
+        action_dim: usize,
+        temperature: f64,
+        config: &SacConfig,
+        device: Device,
+        seed: u64,
+    ) -> Self {
+        let (low, high) = (vec![0.0; action_dim], vec![1.0; action_dim]);
+        Self::build(
+            input_dim,
+            &low,
+            &high,
+            Some(temperature),
+            config,
+            device,
+            seed,
+        )
+    }
+
+    fn build(
+        input_dim: usize,
+        low: &[f32],
+        high: &[f32],
+        temperature: Option<f64>,
+        config: &SacConfig,
+        device: Device,
+        seed: u64,
+    ) -> Self {
         let mut rng = ChaCha8Rng::seed_from_u64(seed);
         let action_dim = low.len();
         let (i, a) = (input_dim as i64, action_dim as i64);
         let actor_vs = nn::VarStore::new(device);
         let mean = Mlp::new(&(actor_vs.root() / "actor"), i, &config.hidden, a, &mut rng);
-        let last = *config.hidden.last().expect("validated");
-        let log_std = xavier_linear(&(actor_vs.root() / "actor_log_std"), last, a, &mut rng);
+        let actor = match temperature {
+            None => {
+                let last = *config.hidden.last().expect("validated");
+                let log_std =
+                    xavier_linear(&(actor_vs.root() / "actor_log_std"), last, a, &mut rng);
+                Actor::Gaussian { mean, log_std }
+            }
+            Some(temperature) => Actor::Bernoulli {
+                logits: mean,
+                temperature,
+            },
+        };
         // Twin critics (their targets are initialised the same way, then overwritten by a copy).
         let twin_critics = |vs: &nn::VarStore, rng: &mut ChaCha8Rng| {
             ["q1", "q2"].map(|name| Mlp::new(&(vs.root() / name), i + a, &config.hidden, 1, rng))
@@ -190,7 +251,7 @@ impl Sac {
             actor_vs,
             critic_vs,
             target_vs,
-            actor: Actor { mean, log_std },
+            actor,
             q,
             q_target,
             actor_opt,
@@ -221,49 +282,85 @@ impl Sac {
             .to_device(self.device)
     }
 
-    fn gaussian<R: Rng + ?Sized>(&self, rows: usize, rng: &mut R) -> Tensor {
-        let noise: Vec<f32> = (0..rows * self.action_dim)
-            .map(|_| StandardNormal.sample(rng))
-            .collect();
+    /// Standard-normal noise for a Gaussian actor, uniforms on [0, 1) for a RelaxedBernoulli one.
+    fn noise<R: Rng + ?Sized>(&self, rows: usize, rng: &mut R) -> Tensor {
+        let noise: Vec<f32> = match self.actor {
+            Actor::Gaussian { .. } => (0..rows * self.action_dim)
+                .map(|_| StandardNormal.sample(rng))
+                .collect(),
+            Actor::Bernoulli { .. } => (0..rows * self.action_dim)
+                .map(|_| rng.random::<f32>())
+                .collect(),
+        };
         self.tensor(&noise, self.action_dim)
     }
 
     /// Mean and log σ of the pre-squash Gaussian.
-    fn distribution(&self, x: &Tensor) -> (Tensor, Tensor) {
-        let h = self.actor.mean.features(x);
+    fn gaussian(mean: &Mlp, log_std: &nn::Linear, x: &Tensor) -> (Tensor, Tensor) {
+        let h = mean.features(x);
         (
-            self.actor.mean.head().forward(&h),
-            self.actor
-                .log_std
-                .forward(&h)
-                .clamp(LOG_STD_MIN, LOG_STD_MAX),
+            mean.head().forward(&h),
+            log_std.forward(&h).clamp(LOG_STD_MIN, LOG_STD_MAX),
         )
     }
 
-    /// A reparameterised sample a = tanh(mean + σ·ε)·scale + bias and its log-probability.
+    fn bernoulli(logits: &Mlp, temperature: f64, x: &Tensor) -> RelaxedBernoulli {
+        RelaxedBernoulli::new(
+            temperature,
+            logits.forward(x).clamp(-LOGIT_BOUND, LOGIT_BOUND),
+        )
+    }
+
+    /// A reparameterised sample and its log-probability (summed over the action's entries):
+    /// a = tanh(mean + σ·ε)·scale + bias for a Gaussian actor, the relaxed sample for uniforms
+    /// `noise` for a RelaxedBernoulli one.
     fn sample(&self, x: &Tensor, noise: &Tensor) -> (Tensor, Tensor) {
-        let (mean, log_std) = self.distribution(x);
-        let u = &mean + log_std.exp() * noise;
-        let t = u.tanh();
-        let action = &t * &self.scale + &self.bias;
-        let log_normal = noise.square() * -0.5 - &log_std - 0.5 * (2.0 * std::f64::consts::PI).ln();
-        let one_minus_t2: Tensor = 1.0 - t.square();
-        let squash = (&self.scale * one_minus_t2 + 1e-6).log();
-        let log_prob = (log_normal - squash).sum_dim_intlist(1, true, Kind::Float);
-        (action, log_prob)
+        match &self.actor {
+            Actor::Gaussian { mean, log_std } => {
+                let (mean, log_std) = Self::gaussian(mean, log_std, x);
+                let u = &mean + log_std.exp() * noise;
+                let t = u.tanh();
+                let action = &t * &self.scale + &self.bias;
+                let log_normal =
+                    noise.square() * -0.5 - &log_std - 0.5 * (2.0 * std::f64::consts::PI).ln();
+                let one_minus_t2: Tensor = 1.0 - t.square();
+                let squash = (&self.scale * one_minus_t2 + 1e-6).log();
+                let log_prob = (log_normal - squash).sum_dim_intlist(1, true, Kind::Float);
+                (action, log_prob)
+            }
+            Actor::Bernoulli {
+                logits,
+                temperature,
+            } => {
+                let dist = Self::bernoulli(logits, *temperature, x);
+                let action = dist.rsample_with(noise);
+                let log_prob = dist.log_prob(&action).sum_dim_intlist(1, true, Kind::Float);
+                (action, log_prob)
+            }
+        }
     }
 
     /// Actions for a batch of inputs (rows of `input_dim`): sampled from the policy with noise
-    /// from `rng`, or deterministic (tanh of the mean) when `rng` is `None`.
+    /// from `rng`, or deterministic (tanh of the mean; for a RelaxedBernoulli actor the mode)
+    /// when `rng` is `None`.
     pub fn act(&self, inputs: &[f32], rng: Option<&mut ChaCha8Rng>) -> Vec<f32> {
         tch::no_grad(|| {
             let x = self.tensor(inputs, self.input_dim);
-            let action = match rng {
-                Some(rng) => {
-                    let noise = self.gaussian(inputs.len() / self.input_dim, rng);
+            let action = match (rng, &self.actor) {
+                (Some(rng), _) => {
+                    let noise = self.noise(inputs.len() / self.input_dim, rng);
                     self.sample(&x, &noise).0
                 }
-                None => self.distribution(&x).0.tanh() * &self.scale + &self.bias,
+                (None, Actor::Gaussian { mean, log_std }) => {
+                    Self::gaussian(mean, log_std, &x).0.tanh() * &self.scale + &self.bias
+                }
+                (
+                    None,
+                    Actor::Bernoulli {
+                        logits,
+                        temperature,
+                    },
+                ) => Self::bernoulli(logits, *temperature, &x).mode(),
             };
             Vec::<f32>::try_from(action.view([-1]).to_device(Device::Cpu)).expect("float actions")
         })
@@ -278,13 +375,14 @@ impl Sac {
     /// policy's noise drawn from `rng` (for the next actions first, then for the actor's).
     pub fn update(&mut self, batch: &TransitionBatch, rng: &mut ChaCha8Rng) -> SacLosses {
         let rows = batch.rewards.len();
-        let next_noise = self.gaussian(rows, rng);
-        let policy_noise = self.gaussian(rows, rng);
+        let next_noise = self.noise(rows, rng);
+        let policy_noise = self.noise(rows, rng);
         self.update_with_noise(batch, &next_noise, &policy_noise)
     }
 
-    /// [`Sac::update`] with given standard-normal noise (rows × action_dim each): for the next
-    /// actions of the target and for the actor's reparameterised actions.
+    /// [`Sac::update`] with given noise (rows × action_dim each; standard normal for a Gaussian
+    /// actor, uniform for a RelaxedBernoulli one): for the next actions of the target and for
+    /// the actor's reparameterised actions.
     pub fn update_with_noise(
         &mut self,
         batch: &TransitionBatch,
@@ -333,7 +431,13 @@ impl Sac {
 
     /// Writes networks and optimiser states into `dir` (the actor file and the resume files).
     pub fn save(&self, dir: &Path) -> Result<(), RlError> {
-        for (file, vs) in self.stores() {
+        self.save_as(dir, "sac")
+    }
+
+    /// [`Sac::save`] into the files [`checkpoint_files`]`(prefix)`, so that several agents share
+    /// a checkpoint folder.
+    pub fn save_as(&self, dir: &Path, prefix: &str) -> Result<(), RlError> {
+        for (file, vs) in checkpoint_files(prefix).iter().zip(self.stores()) {
             let path = dir.join(file);
             vs.save(&path).map_err(|e| RlError::io(&path, e))?;
         }
@@ -348,32 +452,38 @@ impl Sac {
 
     /// Reads what [`Sac::save`] wrote; with `actor_only`, just the actor.
     pub fn load(&mut self, dir: &Path, actor_only: bool) -> Result<(), RlError> {
+        self.load_as(dir, "sac", actor_only)
+    }
+
+    /// Reads what [`Sac::save_as`] wrote under `prefix`; with `actor_only`, just the actor.
+    pub fn load_as(&mut self, dir: &Path, prefix: &str, actor_only: bool) -> Result<(), RlError> {
         let count = if actor_only { 1 } else { 5 };
-        for (file, vs) in self.stores_mut().into_iter().take(count) {
+        let files = checkpoint_files(prefix);
+        for (file, vs) in files.iter().zip(self.stores_mut()).take(count) {
             let path = dir.join(file);
             vs.load(&path).map_err(|e| RlError::unreadable(&path, e))?;
         }
         Ok(())
     }
 
-    /// The var stores and their files, the actor first.
-    fn stores(&self) -> [(&'static str, &nn::VarStore); 5] {
+    /// The var stores in the order of [`checkpoint_files`], the actor first.
+    fn stores(&self) -> [&nn::VarStore; 5] {
         [
-            (ACTOR_FILE, &self.actor_vs),
-            (RESUME_FILES[0], &self.critic_vs),
-            (RESUME_FILES[1], &self.target_vs),
-            (RESUME_FILES[2], self.actor_opt.state()),
-            (RESUME_FILES[3], self.critic_opt.state()),
+            &self.actor_vs,
+            &self.critic_vs,
+            &self.target_vs,
+            self.actor_opt.state(),
+            self.critic_opt.state(),
         ]
     }
 
-    fn stores_mut(&mut self) -> [(&'static str, &mut nn::VarStore); 5] {
+    fn stores_mut(&mut self) -> [&mut nn::VarStore; 5] {
         [
-            (ACTOR_FILE, &mut self.actor_vs),
-            (RESUME_FILES[0], &mut self.critic_vs),
-            (RESUME_FILES[1], &mut self.target_vs),
-            (RESUME_FILES[2], self.actor_opt.state_mut()),
-            (RESUME_FILES[3], self.critic_opt.state_mut()),
+            &mut self.actor_vs,
+            &mut self.critic_vs,
+            &mut self.target_vs,
+            self.actor_opt.state_mut(),
+            self.critic_opt.state_mut(),
         ]
     }
 }

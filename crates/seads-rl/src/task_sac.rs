@@ -14,173 +14,61 @@
 use std::path::Path;
 use std::time::Instant;
 
-use rand::RngExt;
 use rand_chacha::ChaCha8Rng;
 use seads_embodiment::{EnvConfig, EnvSpec, TaskEnv, make_env};
 use seads_games::Split;
-use seads_planner::{DepthResult, EVALUATION_SEEDS};
+use seads_planner::DepthResult;
 use serde::{Deserialize, Serialize};
-use tch::{Device, Tensor};
+use tch::Device;
 
+use crate::replay::Replay;
 use crate::run::Learner;
 use crate::store::MetricsLine;
-use crate::{Moment, Purpose, RlError, Sac, SacLosses, TrainConfig, TransitionBatch};
-use crate::{derived_seed, stream};
+use crate::{Moment, Purpose, RlError, Sac, SacLosses, TrainConfig};
+use crate::{derived_seed, stream, task_success};
 
 /// The replay buffer of a run's checkpoint.
 pub const REPLAY_FILE: &str = "replay.safetensors";
 /// Epoch, steps, random streams and open episodes of a run's checkpoint.
 pub const TASK_PROGRESS_FILE: &str = "task-progress.json";
 
-/// The most recent transitions, in a ring.
-#[derive(Debug, Clone, PartialEq, Default)]
-struct Replay {
-    capacity: usize,
-    obs_dim: usize,
-    action_dim: usize,
-    obs: Vec<f32>,
-    actions: Vec<f32>,
-    rewards: Vec<f32>,
-    next_obs: Vec<f32>,
-    dones: Vec<f32>,
-    /// Where the next transition goes once the ring is full.
-    next: usize,
-}
-
-impl Replay {
-    fn new(capacity: usize, obs_dim: usize, action_dim: usize) -> Self {
-        Self {
-            capacity,
-            obs_dim,
-            action_dim,
-            ..Self::default()
-        }
-    }
-
-    fn len(&self) -> usize {
-        self.rewards.len()
-    }
-
-    fn push(&mut self, obs: &[f32], action: &[f32], reward: f32, next_obs: &[f32], done: bool) {
-        let done = if done { 1.0 } else { 0.0 };
-        if self.len() < self.capacity {
-            self.obs.extend_from_slice(obs);
-            self.actions.extend_from_slice(action);
-            self.rewards.push(reward);
-            self.next_obs.extend_from_slice(next_obs);
-            self.dones.push(done);
-        } else {
-            let (i, o, a) = (self.next, self.obs_dim, self.action_dim);
-            self.obs[i * o..(i + 1) * o].copy_from_slice(obs);
-            self.actions[i * a..(i + 1) * a].copy_from_slice(action);
-            self.rewards[i] = reward;
-            self.next_obs[i * o..(i + 1) * o].copy_from_slice(next_obs);
-            self.dones[i] = done;
-            self.next = (self.next + 1) % self.capacity;
-        }
-    }
-
-    /// `rows` transitions drawn uniformly with replacement.
-    fn sample(&self, rows: usize, rng: &mut ChaCha8Rng) -> TransitionBatch {
-        let (o, a) = (self.obs_dim, self.action_dim);
-        let mut batch = TransitionBatch::default();
-        for _ in 0..rows {
-            let i = rng.random_range(0..self.len());
-            batch.obs.extend_from_slice(&self.obs[i * o..(i + 1) * o]);
-            batch
-                .actions
-                .extend_from_slice(&self.actions[i * a..(i + 1) * a]);
-            batch.rewards.push(self.rewards[i]);
-            batch
-                .next_obs
-                .extend_from_slice(&self.next_obs[i * o..(i + 1) * o]);
-            batch.dones.push(self.dones[i]);
-        }
-        batch
-    }
-
-    fn save(&self, path: &Path) -> Result<(), RlError> {
-        let (o, a) = (self.obs_dim as i64, self.action_dim as i64);
-        let tensors = [
-            ("obs", Tensor::from_slice(&self.obs).view([-1, o])),
-            ("actions", Tensor::from_slice(&self.actions).view([-1, a])),
-            ("rewards", Tensor::from_slice(&self.rewards)),
-            ("next_obs", Tensor::from_slice(&self.next_obs).view([-1, o])),
-            ("dones", Tensor::from_slice(&self.dones)),
-            ("next", Tensor::from_slice(&[self.next as i64])),
-        ];
-        Tensor::write_safetensors(&tensors, path).map_err(|e| RlError::io(path, e))
-    }
-
-    fn load(&mut self, path: &Path) -> Result<(), RlError> {
-        let bad = |reason: String| RlError::Checkpoint {
-            path: path.display().to_string(),
-            reason,
-        };
-        let named = Tensor::read_safetensors(path).map_err(|e| RlError::unreadable(path, e))?;
-        let get = |name: &str| -> Result<&Tensor, RlError> {
-            named
-                .iter()
-                .find(|(n, _)| n == name)
-                .map(|(_, t)| t)
-                .ok_or_else(|| bad(format!("no tensor {name:?}")))
-        };
-        let floats = |name: &str| -> Result<Vec<f32>, RlError> {
-            Vec::<f32>::try_from(get(name)?.view([-1])).map_err(|e| bad(format!("{name}: {e}")))
-        };
-        let rewards = floats("rewards")?;
-        let n = rewards.len();
-        let (obs, actions, next_obs, dones) = (
-            floats("obs")?,
-            floats("actions")?,
-            floats("next_obs")?,
-            floats("dones")?,
-        );
-        let next =
-            Vec::<i64>::try_from(get("next")?.view([-1])).map_err(|e| bad(format!("next: {e}")))?;
-        let next = match next.as_slice() {
-            [i] if *i >= 0 && (*i as usize) < self.capacity.max(1) => *i as usize,
-            _ => return Err(bad("a bad ring position".into())),
-        };
-        if n > self.capacity
-            || obs.len() != n * self.obs_dim
-            || next_obs.len() != n * self.obs_dim
-            || actions.len() != n * self.action_dim
-            || dones.len() != n
-        {
-            return Err(bad(format!(
-                "a replay buffer of another shape ({n} transitions, capacity {})",
-                self.capacity
-            )));
-        }
-        *self = Self {
-            obs,
-            actions,
-            rewards,
-            next_obs,
-            dones,
-            next,
-            ..self.clone()
-        };
-        Ok(())
-    }
-}
-
 /// The open episode of one environment: enough to rebuild its state by replaying.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-struct OpenEpisode {
+pub(crate) struct OpenEpisode {
     /// The environment seed it was reset with.
-    seed: u64,
+    pub(crate) seed: u64,
     /// Its actions so far, row-major.
-    actions: Vec<f32>,
+    pub(crate) actions: Vec<f32>,
 }
 
 /// Random streams of a baseline run.
 #[derive(Debug, Clone, Serialize, Deserialize)]
-struct Streams {
-    collect: ChaCha8Rng,
-    sample: ChaCha8Rng,
-    sac: ChaCha8Rng,
+pub(crate) struct Streams {
+    pub(crate) collect: ChaCha8Rng,
+    pub(crate) sample: ChaCha8Rng,
+    pub(crate) sac: ChaCha8Rng,
+}
+
+impl Streams {
+    pub(crate) fn new(seed: u64) -> Self {
+        Self {
+            collect: stream(seed, Purpose::Collect),
+            sample: stream(seed, Purpose::Sample),
+            sac: stream(seed, Purpose::Sac),
+        }
+    }
+}
+
+/// The environments of a baseline in training: task mode on the train split.
+pub(crate) fn training_envs(config: &TrainConfig) -> Result<Vec<TaskEnv>, RlError> {
+    let train = EnvConfig {
+        reset_split: Split::Train,
+        ..config.env_config.clone()
+    };
+    let max_depth = train.max_solution_depth;
+    (0..config.baseline.samples_per_epoch)
+        .map(|_| Ok(TaskEnv::new(make_env(&config.env, &train)?, max_depth)?))
+        .collect()
 }
 
 /// Seconds per phase since the start of the run.
@@ -246,6 +134,35 @@ pub struct TaskMetrics {
     pub timings: TaskTimings,
 }
 
+impl TaskMetrics {
+    /// The line after `(epoch, env_steps)` for the per-depth `results` of an evaluation.
+    pub(crate) fn new(
+        results: &[DepthResult],
+        (epoch, env_steps): (u64, u64),
+        wall_s: f64,
+        train_solved: f64,
+        stats: &TaskEpochStats,
+        timings: TaskTimings,
+    ) -> Self {
+        let success: Vec<f64> = results
+            .iter()
+            .map(|r| r.solved as f64 / r.tasks.max(1) as f64)
+            .collect();
+        Self {
+            epoch,
+            env_steps,
+            wall_s,
+            mean_success: success.iter().sum::<f64>() / success.len().max(1) as f64,
+            success,
+            train_solved,
+            critic_loss: stats.sac.critic,
+            actor_loss: stats.sac.actor,
+            steps_per_s: env_steps as f64 / wall_s.max(1e-9),
+            timings,
+        }
+    }
+}
+
 impl MetricsLine for TaskMetrics {
     fn epoch(&self) -> u64 {
         self.epoch
@@ -285,14 +202,7 @@ impl TaskSac {
         if config.threads > 0 {
             tch::set_num_threads(config.threads as i32);
         }
-        let train = EnvConfig {
-            reset_split: Split::Train,
-            ..config.env_config.clone()
-        };
-        let max_depth = train.max_solution_depth;
-        let envs = (0..config.baseline.samples_per_epoch)
-            .map(|_| TaskEnv::new(make_env(&config.env, &train)?, max_depth))
-            .collect::<Result<Vec<_>, _>>()?;
+        let envs = training_envs(&config)?;
         let spec = envs[0].spec().clone();
         let sac = Sac::new(
             spec.obs_dim,
@@ -314,11 +224,7 @@ impl TaskSac {
             ended: 0,
             solved: 0,
             timings: TaskTimings::default(),
-            streams: Streams {
-                collect: stream(config.seed, Purpose::Collect),
-                sample: stream(config.seed, Purpose::Sample),
-                sac: stream(config.seed, Purpose::Sac),
-            },
+            streams: Streams::new(config.seed),
             open: Vec::new(),
         };
         let mut agent = Self {
@@ -452,7 +358,7 @@ impl TaskSac {
     /// (the authors' evaluation seeds first), as the SEADS evaluation's per-depth results.
     pub fn task_success(&mut self, boards: usize) -> Result<Vec<DepthResult>, RlError> {
         let start = Instant::now();
-        let results = task_success(&self.config, &self.sac, &[1, 2, 3, 4, 5], boards)?;
+        let results = task_success(&self.config, &mut &self.sac, &[1, 2, 3, 4, 5], boards)?;
         self.progress.timings.evaluate += start.elapsed().as_secs_f64();
         Ok(results)
     }
@@ -501,72 +407,6 @@ impl TaskSac {
     }
 }
 
-/// The policy saved in a checkpoint folder of a baseline run with `config` (only the actor is
-/// read: older checkpoints keep nothing else).
-pub fn load_policy(config: &TrainConfig, checkpoint: &Path) -> Result<Sac, RlError> {
-    let spec = make_env(&config.env, &config.env_config)?.spec().clone();
-    let mut sac = Sac::new(
-        spec.obs_dim,
-        &spec.action_low,
-        &spec.action_high,
-        &config.sac,
-        Device::Cpu,
-        0,
-    );
-    sac.load(checkpoint, true)?;
-    Ok(sac)
-}
-
-/// Task success of `policy` (deterministic) on the SEADS protocol: `boards` test boards per
-/// depth (1–5 in the protocol), the authors' evaluation seeds first, each episode until solved
-/// or T_lim.
-pub fn task_success(
-    config: &TrainConfig,
-    policy: &Sac,
-    depths: &[usize],
-    boards: usize,
-) -> Result<Vec<DepthResult>, RlError> {
-    let seeds: Vec<u64> = (0..boards as u64)
-        .map(|i| {
-            EVALUATION_SEEDS
-                .get(i as usize)
-                .copied()
-                .unwrap_or_else(|| derived_seed(4343, Purpose::TrainEnvs, i))
-        })
-        .collect();
-    let mut results = Vec::new();
-    for &depth in depths {
-        let env_config = EnvConfig {
-            reset_split: Split::Test,
-            max_solution_depth: depth,
-            random_solution_depth: false,
-            ..config.env_config.clone()
-        };
-        let mut env = TaskEnv::new(make_env(&config.env, &env_config)?, depth)?;
-        let mut result = DepthResult::new(depth);
-        let mut obs = vec![0.0; env.spec().obs_dim];
-        for &seed in &seeds {
-            env.seed(seed);
-            env.reset()?;
-            result.tasks += 1;
-            loop {
-                env.observe(&mut obs);
-                let action = policy.act(&obs, None);
-                let step = env.step(&action)?;
-                if step.done {
-                    if step.solved {
-                        result.solved += 1;
-                        result.solution_steps.push(env.steps());
-                    }
-                    break;
-                }
-            }
-        }
-        results.push(result);
-    }
-    Ok(results)
-}
-
 impl Learner for TaskSac {
     type Stats = TaskEpochStats;
     type Metrics = TaskMetrics;
@@ -593,23 +433,15 @@ impl Learner for TaskSac {
     }
     fn metrics(&mut self, stats: &TaskEpochStats, wall_s: f64) -> Result<TaskMetrics, RlError> {
         let results = self.task_success(self.config.baseline.eval_boards)?;
-        let success: Vec<f64> = results
-            .iter()
-            .map(|r| r.solved as f64 / r.tasks.max(1) as f64)
-            .collect();
         let p = &self.progress;
-        Ok(TaskMetrics {
-            epoch: p.epoch,
-            env_steps: p.env_steps,
+        Ok(TaskMetrics::new(
+            &results,
+            (p.epoch, p.env_steps),
             wall_s,
-            mean_success: success.iter().sum::<f64>() / success.len().max(1) as f64,
-            success,
-            train_solved: p.solved as f64 / p.ended.max(1) as f64,
-            critic_loss: stats.sac.critic,
-            actor_loss: stats.sac.actor,
-            steps_per_s: p.env_steps as f64 / wall_s.max(1e-9),
-            timings: p.timings,
-        })
+            p.solved as f64 / p.ended.max(1) as f64,
+            stats,
+            p.timings,
+        ))
     }
     fn save(&self, dir: &Path) -> Result<(), RlError> {
         TaskSac::save(self, dir)
@@ -623,34 +455,5 @@ impl Learner for TaskSac {
             .chain(&[REPLAY_FILE, TASK_PROGRESS_FILE])
             .copied()
             .collect()
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    /// The ring keeps the most recent `capacity` transitions, and a checkpoint restores it
-    /// exactly; a buffer of another shape is refused.
-    #[test]
-    fn the_replay_ring_keeps_the_newest_and_round_trips() {
-        let mut replay = Replay::new(3, 2, 1);
-        for i in 0..5 {
-            let x = i as f32;
-            replay.push(&[x, x], &[-x], x, &[x + 0.5, x], i == 4);
-        }
-        // Transitions 3 and 4 overwrote 0 and 1; the next goes where 2 is.
-        assert_eq!(replay.rewards, [3.0, 4.0, 2.0]);
-        assert_eq!(replay.obs, [3.0, 3.0, 4.0, 4.0, 2.0, 2.0]);
-        assert_eq!(replay.dones, [0.0, 1.0, 0.0]);
-        assert_eq!(replay.next, 2);
-        let dir = tempfile::tempdir().unwrap();
-        let path = dir.path().join(REPLAY_FILE);
-        replay.save(&path).unwrap();
-        let mut back = Replay::new(3, 2, 1);
-        back.load(&path).unwrap();
-        assert_eq!(back, replay);
-        let mut other = Replay::new(3, 3, 1);
-        assert!(matches!(other.load(&path), Err(RlError::Checkpoint { .. })));
     }
 }

@@ -46,7 +46,7 @@ impl RunData {
     pub fn env_steps(&self) -> u64 {
         match self.config.algorithm {
             Algorithm::Seads => self.metrics.last().map_or(0, |m| m.env_steps),
-            Algorithm::Sac => self.task_metrics.last().map_or(0, |m| m.env_steps),
+            Algorithm::Sac | Algorithm::Hac => self.task_metrics.last().map_or(0, |m| m.env_steps),
         }
     }
 
@@ -59,7 +59,7 @@ impl RunData {
         let config = seads_rl::load_config(dir)?;
         let (metrics, task_metrics) = match config.algorithm {
             Algorithm::Seads => (seads_rl::read_metrics(dir).unwrap_or_default(), Vec::new()),
-            Algorithm::Sac => (
+            Algorithm::Sac | Algorithm::Hac => (
                 Vec::new(),
                 seads_rl::read_metrics_as::<TaskMetrics>(dir).unwrap_or_default(),
             ),

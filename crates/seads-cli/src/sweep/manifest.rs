@@ -219,7 +219,7 @@ impl Manifest {
     }
 
     /// The preset of `env` with the study's, the variant's and the environment's overrides.
-    /// A layer that sets `algorithm = "sac"` starts from the baseline's preset.
+    /// A layer that sets `algorithm = "sac"` or `"hac"` starts from that baseline's preset.
     fn config(&self, env: &str, variant: &Variant, seed: u64) -> Result<TrainConfig> {
         let env_layer = variant.env_overrides.get(env);
         let named = [Some(&self.overrides), Some(&variant.overrides), env_layer]
@@ -229,6 +229,7 @@ impl Manifest {
             .next_back();
         let presets = match named {
             Some("sac") => TrainConfig::sac_presets(),
+            Some("hac") => TrainConfig::hac_presets(),
             _ => TrainConfig::presets(),
         };
         let preset = presets
@@ -419,7 +420,15 @@ env_overrides = { "lightsout-cursor" = { num_skills = 30 }, "tileswap-cursor" = 
             ),
             (
                 include_str!("../../../../experiments/baselines.toml"),
-                2 * 2 * 5,
+                2 * 3 * 5,
+            ),
+            (
+                include_str!("../../../../experiments/hac-grid-cursor.toml"),
+                2 * 64 * 5,
+            ),
+            (
+                include_str!("../../../../experiments/hac-grid.toml"),
+                4 * 16 * 5,
             ),
             (
                 include_str!("../../../../experiments/sac-grid.toml"),
@@ -438,9 +447,11 @@ env_overrides = { "lightsout-cursor" = { num_skills = 30 }, "tileswap-cursor" = 
             );
             for run in &runs {
                 // Each variant changes only what its name says (SPEC §3.9, §3.10, §5.1).
-                let baseline = m.name == "sac-grid" || run.variant == "sac";
-                let algorithm = if baseline {
+                let hac_grid = m.name.starts_with("hac-grid");
+                let algorithm = if m.name == "sac-grid" || run.variant == "sac" {
                     seads_rl::Algorithm::Sac
+                } else if hac_grid || run.variant == "hac" {
+                    seads_rl::Algorithm::Hac
                 } else {
                     seads_rl::Algorithm::Seads
                 };
@@ -449,7 +460,15 @@ env_overrides = { "lightsout-cursor" = { num_skills = 30 }, "tileswap-cursor" = 
                 expected.seed = run.seed;
                 let c = &run.config;
                 match run.variant.as_str() {
-                    "seads" | "size-5" | "sac" => {}
+                    "seads" | "size-5" | "sac" | "hac" => {}
+                    v if hac_grid => {
+                        // t<tau_RB>-l<alpha_low>-h<alpha_high>.
+                        let (t, rest) = v[1..].split_once("-l").unwrap();
+                        let (low, high) = rest.split_once("-h").unwrap();
+                        expected.hac.temperature = t.parse().unwrap();
+                        expected.sac.alpha = low.parse().unwrap();
+                        expected.hac.alpha_high = high.parse().unwrap();
+                    }
                     v if m.name == "sac-grid" => {
                         // n<N>-a<alpha>, N with "_" for ".".
                         let (n, a) = v[1..].split_once("-a").unwrap();

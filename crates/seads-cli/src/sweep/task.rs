@@ -5,7 +5,9 @@
 use std::path::Path;
 
 use anyhow::{Context, Result};
-use seads_rl::{Algorithm, Run, TaskSac, Trainer};
+use seads_rl::{Algorithm, Hac, Run, TaskSac, Trainer};
+
+use crate::train::Shown;
 use seads_skillmodel::SkillModelKind;
 
 use super::index::Sweep;
@@ -50,8 +52,10 @@ fn train_and_evaluate(sweep: &Sweep, run: &Path, cores: usize) -> Result<()> {
         seads_rl::load_config(run).with_context(|| format!("loading {}", run.display()))?;
     crate::kernels::use_kernels(config.portable_numerics)?;
     let (threads, alone) = thread_split(cores);
-    if config.algorithm == Algorithm::Sac {
-        return train_and_evaluate_baseline(sweep, run, cores);
+    match config.algorithm {
+        Algorithm::Sac => return train_and_evaluate_baseline::<TaskSac>(sweep, run, cores),
+        Algorithm::Hac => return train_and_evaluate_baseline::<Hac>(sweep, run, cores),
+        Algorithm::Seads => {}
     }
     let mut training = crate::train::resume(
         run,
@@ -122,29 +126,35 @@ fn train_and_evaluate(sweep: &Sweep, run: &Path, cores: usize) -> Result<()> {
 
 /// A baseline run: training on all of the task's cores (one training thread), then task success
 /// of the final policy on the study's boards per depth (`evaluation-policy.json`).
-fn train_and_evaluate_baseline(sweep: &Sweep, run: &Path, cores: usize) -> Result<()> {
+fn train_and_evaluate_baseline<L: Shown>(sweep: &Sweep, run: &Path, cores: usize) -> Result<()> {
     let mut training = crate::train::resume(
         run,
         Run::resume_with(run, |mut c| {
             c.threads = cores.max(1);
             c.sac_threads_alone = 0;
-            TaskSac::new(c)
+            L::build(c)
         }),
     )?;
+    let config = training.trainer().config().clone();
     if !training.finished() {
         println!(
-            "{}: training the SAC baseline from epoch {} with {} libtorch thread(s)",
+            "{}: training the {} baseline from epoch {} with {} libtorch thread(s)",
             run.display(),
+            config.algorithm.name().to_uppercase(),
             training.trainer().epoch(),
             cores.max(1)
         );
         crate::train::drive(&mut training, true)?;
     }
+    drop(training);
     if sweep.evaluation.last {
-        let config = training.trainer().config().clone();
+        // The final checkpoint holds the trained policy.
+        let checkpoint = seads_rl::latest_checkpoint(run)?
+            .with_context(|| format!("{} has no checkpoint", run.display()))?;
+        let mut policy = seads_rl::load_policy(&config, &checkpoint)?;
         let results = seads_rl::task_success(
             &config,
-            training.trainer().policy(),
+            policy.as_mut(),
             &[1, 2, 3, 4, 5],
             sweep.evaluation.boards,
         )?;

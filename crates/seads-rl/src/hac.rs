@@ -1,0 +1,711 @@
+//! The two-level HAC baseline with the task reward (SPEC §5.2), after Levy et al.'s
+//! Hierarchical Actor-Critic.
+//!
+//! - The **high level** is a discrete SAC ([`Sac::relaxed_bernoulli`]) on the environment's
+//!   observation. Its action is a subgoal z ∈ {0,1}^D, a symbolic state: the relaxed sample
+//!   thresholded at 0.5 (in training), the mode (in evaluation). Its reward is the task reward.
+//! - The **low level** is a Gaussian SAC on the observation and the subgoal. It pursues a subgoal
+//!   for at most H steps and is rewarded 1 (and its return ends) on the step whose board is z.
+//!
+//! What the seed leaves open follows Levy's HAC (docs/ARCHITECTURE.md gives the reasons):
+//! - *hindsight action transitions*: the high level stores each subgoal attempt with the board
+//!   actually reached as its action, so every attempt teaches it a reachable subgoal;
+//! - *hindsight goal transitions*: the low level also stores every attempt that missed its
+//!   subgoal as if the board it ended on had been the subgoal;
+//! - *subgoal testing*: a share λ of subgoals is pursued without exploration noise, and a tested
+//!   subgoal that is missed gives the high level a terminal transition of reward 0 for it, the
+//!   lowest return of the task, as Levy's penalty −H is the lowest of his;
+//! - the top level's goal is the game's goal board, the same in every episode, so it is not an
+//!   input and needs no hindsight goals.
+//!
+//! An epoch steps each of the 8 environments once (as the SAC baseline does) and then takes N
+//! gradient steps of each level whose replay holds a batch. Resuming is exact, as for the SAC
+//! baseline: the open episodes are replayed from their seeds and actions, which also restores
+//! each environment's observations since its subgoal began.
+
+use std::path::Path;
+use std::time::Instant;
+
+use rand::RngExt;
+use seads_embodiment::{EnvSpec, TaskEnv};
+use seads_games::SymbolicState;
+use seads_planner::DepthResult;
+use serde::{Deserialize, Serialize};
+use tch::Device;
+
+use crate::replay::Replay;
+use crate::run::Learner;
+use crate::task_policy::TaskPolicy;
+use crate::task_sac::{OpenEpisode, Streams, training_envs};
+use crate::{
+    Moment, Purpose, RlError, Sac, SacConfig, SacLosses, TaskEpochStats, TaskMetrics, TaskTimings,
+    TrainConfig, derived_seed, task_success, updates_due,
+};
+
+/// File prefix of the high level's networks in a checkpoint ([`crate::sac::checkpoint_files`]).
+pub const HIGH_PREFIX: &str = "hac_high";
+/// File prefix of the low level's networks in a checkpoint.
+pub const LOW_PREFIX: &str = "hac_low";
+/// The high level's replay buffer in a checkpoint.
+pub const HIGH_REPLAY_FILE: &str = "hac-high-replay.safetensors";
+/// The low level's replay buffer in a checkpoint.
+pub const LOW_REPLAY_FILE: &str = "hac-low-replay.safetensors";
+/// Epoch, steps, random streams, open episodes and subgoals of a checkpoint.
+pub const HAC_PROGRESS_FILE: &str = "hac-progress.json";
+
+/// Reward and return end of a tested subgoal that was missed (the task's lowest return).
+const MISSED_TEST_REWARD: f32 = 0.0;
+
+/// A subgoal being pursued in one environment.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+struct Attempt {
+    subgoal: SymbolicState,
+    /// Pursued without exploration noise.
+    testing: bool,
+    /// The step of the episode it started at.
+    start: usize,
+    /// Task reward collected since (1 if the board was solved).
+    reward: f32,
+}
+
+#[derive(Debug, Clone, Serialize, Deserialize)]
+struct Progress {
+    epoch: u64,
+    env_steps: u64,
+    /// Episodes started, over all environments (numbers their seeds).
+    episodes: u64,
+    /// Episodes ended, and how many of them solved their board.
+    ended: u64,
+    solved: u64,
+    /// Subgoal attempts ended, and how many reached their subgoal.
+    attempts: u64,
+    reached: u64,
+    timings: TaskTimings,
+    streams: Streams,
+    open: Vec<OpenEpisode>,
+    /// The subgoal of each environment (`None` between attempts).
+    subgoals: Vec<Option<Attempt>>,
+}
+
+/// A two-level HAC agent in training on the task reward.
+pub struct Hac {
+    config: TrainConfig,
+    spec: EnvSpec,
+    envs: Vec<TaskEnv>,
+    /// Every observation of each environment's open episode, row-major (steps + 1 rows).
+    observations: Vec<Vec<f32>>,
+    high: Sac,
+    low: Sac,
+    high_replay: Replay,
+    low_replay: Replay,
+    progress: Progress,
+}
+
+/// The low level's input: the observation followed by the subgoal's D bits.
+fn low_input(obs: &[f32], subgoal: SymbolicState, d: usize, out: &mut Vec<f32>) {
+    out.extend_from_slice(obs);
+    let at = out.len();
+    out.resize(at + d, 0.0);
+    subgoal.write_f32(&mut out[at..]);
+}
+
+/// A subgoal from the high level's action: 1 where it exceeds 0.5.
+fn threshold(action: &[f32]) -> SymbolicState {
+    SymbolicState::from_bools(&action.iter().map(|&v| v > 0.5).collect::<Vec<_>>())
+}
+
+/// The two levels' networks for `config` on an environment of `spec`.
+fn levels(config: &TrainConfig, spec: &EnvSpec) -> (Sac, Sac) {
+    let d = spec.symbolic_len;
+    let high_config = SacConfig {
+        alpha: config.hac.alpha_high,
+        ..config.sac.clone()
+    };
+    let high = Sac::relaxed_bernoulli(
+        spec.obs_dim,
+        d,
+        config.hac.temperature,
+        &high_config,
+        Device::Cpu,
+        derived_seed(config.seed, Purpose::SacInit, 1),
+    );
+    let low = Sac::new(
+        spec.obs_dim + d,
+        &spec.action_low,
+        &spec.action_high,
+        &config.sac,
+        Device::Cpu,
+        derived_seed(config.seed, Purpose::SacInit, 2),
+    );
+    (high, low)
+}
+
+impl Hac {
+    /// A fresh agent for `config` (validated; `config.algorithm` is not checked here).
+    pub fn new(config: TrainConfig) -> Result<Self, RlError> {
+        config.validate()?;
+        crate::numerics::check(config.portable_numerics)?;
+        if config.threads > 0 {
+            tch::set_num_threads(config.threads as i32);
+        }
+        let envs = training_envs(&config)?;
+        let spec = envs[0].spec().clone();
+        let (high, low) = levels(&config, &spec);
+        let d = spec.symbolic_len;
+        let capacity = config.baseline.replay_capacity;
+        let progress = Progress {
+            epoch: 0,
+            env_steps: 0,
+            episodes: 0,
+            ended: 0,
+            solved: 0,
+            attempts: 0,
+            reached: 0,
+            timings: TaskTimings::default(),
+            streams: Streams::new(config.seed),
+            open: Vec::new(),
+            subgoals: vec![None; envs.len()],
+        };
+        let mut agent = Self {
+            observations: vec![Vec::new(); envs.len()],
+            high_replay: Replay::new(capacity, spec.obs_dim, d),
+            low_replay: Replay::new(capacity, spec.obs_dim + d, spec.action_dim),
+            config,
+            spec,
+            envs,
+            high,
+            low,
+            progress,
+        };
+        for slot in 0..agent.envs.len() {
+            agent.start_episode(slot)?;
+        }
+        Ok(agent)
+    }
+
+    /// Resets environment `slot` for the next episode, seeded by the episode's number.
+    fn start_episode(&mut self, slot: usize) -> Result<(), RlError> {
+        let seed = derived_seed(self.config.seed, Purpose::TrainEnvs, self.progress.episodes);
+        self.progress.episodes += 1;
+        let env = &mut self.envs[slot];
+        env.seed(seed);
+        env.reset()?;
+        let obs = &mut self.observations[slot];
+        obs.clear();
+        obs.resize(self.spec.obs_dim, 0.0);
+        env.observe(obs);
+        let open = OpenEpisode {
+            seed,
+            actions: Vec::new(),
+        };
+        match self.progress.open.get_mut(slot) {
+            Some(o) => *o = open,
+            None => self.progress.open.push(open),
+        }
+        self.progress.subgoals[slot] = None;
+        Ok(())
+    }
+
+    /// Row `i` of environment `slot`'s episode observations.
+    fn observation(&self, slot: usize, i: usize) -> &[f32] {
+        let o = self.spec.obs_dim;
+        &self.observations[slot][i * o..(i + 1) * o]
+    }
+
+    /// The current observation of environment `slot`.
+    fn current(&self, slot: usize) -> &[f32] {
+        let rows = self.observations[slot].len() / self.spec.obs_dim;
+        self.observation(slot, rows - 1)
+    }
+
+    /// The configuration.
+    pub fn config(&self) -> &TrainConfig {
+        &self.config
+    }
+
+    /// Epochs run so far.
+    pub fn epoch(&self) -> u64 {
+        self.progress.epoch
+    }
+
+    /// Environment steps so far.
+    pub fn env_steps(&self) -> u64 {
+        self.progress.env_steps
+    }
+
+    /// Whether the step budget is spent.
+    pub fn finished(&self) -> bool {
+        self.progress.env_steps >= self.config.env_steps
+    }
+
+    /// Time spent per phase.
+    pub fn timings(&self) -> TaskTimings {
+        self.progress.timings
+    }
+
+    /// Share of the subgoal attempts ended so far that reached their subgoal.
+    pub fn subgoals_reached(&self) -> f64 {
+        self.progress.reached as f64 / self.progress.attempts.max(1) as f64
+    }
+
+    /// The deterministic two-level policy.
+    pub fn policy(&self) -> HacPolicy<'_> {
+        HacPolicy::new(
+            &self.high,
+            &self.low,
+            &self.spec,
+            self.config.hac.subgoal_horizon,
+        )
+    }
+
+    /// Gives environment `slot` a subgoal from the stochastic high level, tested with
+    /// probability λ.
+    fn propose(&mut self, slot: usize) {
+        let o = self.spec.obs_dim;
+        let start = self.observations[slot].len() / o - 1;
+        let obs = &self.observations[slot][start * o..];
+        let streams = &mut self.progress.streams;
+        let action = self.high.act(obs, Some(&mut streams.collect));
+        let testing = streams.collect.random::<f64>() < self.config.hac.subgoal_test_p;
+        self.progress.subgoals[slot] = Some(Attempt {
+            subgoal: threshold(&action),
+            testing,
+            start,
+            reward: 0.0,
+        });
+    }
+
+    /// One epoch: a step of every environment (new subgoals where needed), then the gradient
+    /// steps due of both levels.
+    pub fn run_epoch(&mut self) -> Result<TaskEpochStats, RlError> {
+        let start = Instant::now();
+        let (d, a) = (self.spec.symbolic_len, self.spec.action_dim);
+        for slot in 0..self.envs.len() {
+            if self.progress.subgoals[slot].is_none() {
+                self.propose(slot);
+            }
+        }
+        let mut inputs = Vec::new();
+        for slot in 0..self.envs.len() {
+            let attempt = self.progress.subgoals[slot].as_ref().expect("proposed");
+            low_input(self.current(slot), attempt.subgoal, d, &mut inputs);
+        }
+        let noisy = self
+            .low
+            .act(&inputs, Some(&mut self.progress.streams.collect));
+        let tested = self.progress.subgoals.iter().flatten().any(|s| s.testing);
+        let deterministic = tested.then(|| self.low.act(&inputs, None));
+        for slot in 0..self.envs.len() {
+            let attempt = self.progress.subgoals[slot].clone().expect("proposed");
+            let action = match (&deterministic, attempt.testing) {
+                (Some(actions), true) => &actions[slot * a..(slot + 1) * a],
+                _ => &noisy[slot * a..(slot + 1) * a],
+            };
+            let step = self.envs[slot].step(action)?;
+            let o = self.spec.obs_dim;
+            let rows = self.observations[slot].len();
+            self.observations[slot].resize(rows + o, 0.0);
+            self.envs[slot].observe(&mut self.observations[slot][rows..]);
+            self.progress.open[slot].actions.extend_from_slice(action);
+            let reached = self.spec.phi(self.current(slot)) == attempt.subgoal;
+            // The low level's transition toward its subgoal.
+            let (mut from, mut to) = (Vec::new(), Vec::new());
+            let steps = self.progress.open[slot].actions.len() / a;
+            low_input(
+                self.observation(slot, steps - 1),
+                attempt.subgoal,
+                d,
+                &mut from,
+            );
+            low_input(self.current(slot), attempt.subgoal, d, &mut to);
+            let reward = if reached { 1.0 } else { 0.0 };
+            self.low_replay.push(&from, action, reward, &to, reached);
+            let attempt = Attempt {
+                reward: attempt.reward + step.reward,
+                ..attempt
+            };
+            let over =
+                reached || steps - attempt.start >= self.config.hac.subgoal_horizon || step.done;
+            if over {
+                self.end_attempt(slot, &attempt, reached, step.done);
+            } else {
+                self.progress.subgoals[slot] = Some(attempt);
+            }
+            if step.done {
+                self.progress.ended += 1;
+                self.progress.solved += u64::from(step.solved);
+                self.start_episode(slot)?;
+            }
+        }
+        self.progress.env_steps += self.envs.len() as u64;
+        self.progress.timings.collect += start.elapsed().as_secs_f64();
+
+        let start = Instant::now();
+        let due = updates_due(self.progress.epoch, self.config.baseline.updates_per_epoch);
+        let batch_size = self.config.sac.batch_size;
+        let mut updates = 0;
+        let mut total = SacLosses::default();
+        for _ in 0..due {
+            if self.low_replay.len() >= batch_size {
+                let streams = &mut self.progress.streams;
+                let batch = self.low_replay.sample(batch_size, &mut streams.sample);
+                let l = self.low.update(&batch, &mut streams.sac);
+                total.critic += l.critic;
+                total.actor += l.actor;
+                total.q += l.q;
+                updates += 1;
+            }
+            if self.high_replay.len() >= batch_size {
+                let streams = &mut self.progress.streams;
+                let batch = self.high_replay.sample(batch_size, &mut streams.sample);
+                self.high.update(&batch, &mut streams.sac);
+            }
+        }
+        self.progress.timings.sac += start.elapsed().as_secs_f64();
+        self.progress.epoch += 1;
+        let n = updates.max(1) as f32;
+        Ok(TaskEpochStats {
+            epoch: self.progress.epoch,
+            env_steps: self.progress.env_steps,
+            updates,
+            sac: SacLosses {
+                critic: total.critic / n,
+                actor: total.actor / n,
+                q: total.q / n,
+            },
+        })
+    }
+
+    /// Stores what an ended subgoal attempt teaches both levels.
+    fn end_attempt(&mut self, slot: usize, attempt: &Attempt, reached: bool, episode_done: bool) {
+        let (d, a) = (self.spec.symbolic_len, self.spec.action_dim);
+        let actions = &self.progress.open[slot].actions;
+        let end = actions.len() / a;
+        let achieved = self.spec.phi(self.current(slot));
+        // Hindsight goal transitions: the missed attempt as one toward the board it ended on.
+        if !reached {
+            for i in attempt.start..end {
+                let next = self.spec.phi(self.observation(slot, i + 1)) == achieved;
+                let (mut from, mut to) = (Vec::new(), Vec::new());
+                low_input(self.observation(slot, i), achieved, d, &mut from);
+                low_input(self.observation(slot, i + 1), achieved, d, &mut to);
+                let reward = if next { 1.0 } else { 0.0 };
+                self.low_replay
+                    .push(&from, &actions[i * a..(i + 1) * a], reward, &to, next);
+            }
+        }
+        // The hindsight action transition: the board reached as the subgoal proposed.
+        let mut reached_bits = vec![0.0; d];
+        achieved.write_f32(&mut reached_bits);
+        let from = self.observation(slot, attempt.start).to_vec();
+        let to = self.current(slot).to_vec();
+        self.high_replay
+            .push(&from, &reached_bits, attempt.reward, &to, episode_done);
+        // Subgoal testing: a missed tested subgoal ends its return with the lowest reward.
+        if attempt.testing && !reached {
+            let mut proposed = vec![0.0; d];
+            attempt.subgoal.write_f32(&mut proposed);
+            self.high_replay
+                .push(&from, &proposed, MISSED_TEST_REWARD, &to, true);
+        }
+        self.progress.attempts += 1;
+        self.progress.reached += u64::from(reached);
+        self.progress.subgoals[slot] = None;
+    }
+
+    /// Task success of the deterministic policy on `boards` test boards of each depth 1–5.
+    pub fn task_success(&mut self, boards: usize) -> Result<Vec<DepthResult>, RlError> {
+        let start = Instant::now();
+        let config = self.config.clone();
+        let results = task_success(&config, &mut self.policy(), &[1, 2, 3, 4, 5], boards)?;
+        self.progress.timings.evaluate += start.elapsed().as_secs_f64();
+        Ok(results)
+    }
+
+    /// Writes the complete training state into `dir` (which must exist).
+    pub fn save(&self, dir: &Path) -> Result<(), RlError> {
+        self.high.save_as(dir, HIGH_PREFIX)?;
+        self.low.save_as(dir, LOW_PREFIX)?;
+        self.high_replay.save(&dir.join(HIGH_REPLAY_FILE))?;
+        self.low_replay.save(&dir.join(LOW_REPLAY_FILE))?;
+        let path = dir.join(HAC_PROGRESS_FILE);
+        let text = serde_json::to_string(&self.progress).map_err(|e| RlError::io(&path, e))?;
+        std::fs::write(&path, text).map_err(|e| RlError::io(&path, e))
+    }
+
+    /// Restores what [`Hac::save`] wrote, replaying each environment's open episode.
+    pub fn load(&mut self, dir: &Path) -> Result<(), RlError> {
+        self.high.load_as(dir, HIGH_PREFIX, false)?;
+        self.low.load_as(dir, LOW_PREFIX, false)?;
+        self.high_replay.load(&dir.join(HIGH_REPLAY_FILE))?;
+        self.low_replay.load(&dir.join(LOW_REPLAY_FILE))?;
+        let path = dir.join(HAC_PROGRESS_FILE);
+        let text = std::fs::read_to_string(&path).map_err(|e| RlError::io(&path, e))?;
+        let progress: Progress =
+            serde_json::from_str(&text).map_err(|e| RlError::unreadable(&path, e))?;
+        let n = self.envs.len();
+        if progress.open.len() != n || progress.subgoals.len() != n {
+            return Err(RlError::Checkpoint {
+                path: path.display().to_string(),
+                reason: format!(
+                    "{} open episodes and {} subgoals for {n} environments",
+                    progress.open.len(),
+                    progress.subgoals.len()
+                ),
+            });
+        }
+        let (a, o) = (self.spec.action_dim, self.spec.obs_dim);
+        for (slot, open) in progress.open.iter().enumerate() {
+            let env = &mut self.envs[slot];
+            env.seed(open.seed);
+            env.reset()?;
+            let obs = &mut self.observations[slot];
+            obs.clear();
+            obs.resize(o, 0.0);
+            env.observe(obs);
+            for action in open.actions.chunks(a) {
+                env.step(action)?;
+                let rows = obs.len();
+                obs.resize(rows + o, 0.0);
+                env.observe(&mut obs[rows..]);
+            }
+            if let Some(attempt) = &progress.subgoals[slot]
+                && attempt.start * a > open.actions.len()
+            {
+                return Err(RlError::Checkpoint {
+                    path: path.display().to_string(),
+                    reason: format!("a subgoal of environment {slot} starts after its episode"),
+                });
+            }
+        }
+        self.progress = progress;
+        Ok(())
+    }
+}
+
+/// The deterministic HAC policy: the high level's mode as the subgoal, a new one when it is
+/// reached or after H steps, and the low level's deterministic action toward it.
+pub struct HacPolicy<'a> {
+    levels: Levels<'a>,
+    symbolic: SymbolicSlice,
+    horizon: usize,
+    subgoal: Option<(SymbolicState, usize)>,
+    input: Vec<f32>,
+}
+
+/// The two levels, borrowed from an agent in training or loaded from a checkpoint.
+enum Levels<'a> {
+    Borrowed(&'a Sac, &'a Sac),
+    Owned(Box<(Sac, Sac)>),
+}
+
+/// Where the symbolic state lies in an observation.
+#[derive(Clone, Copy)]
+struct SymbolicSlice {
+    start: usize,
+    len: usize,
+}
+
+impl SymbolicSlice {
+    fn of(spec: &EnvSpec) -> Self {
+        Self {
+            start: spec.manipulator_dim,
+            len: spec.symbolic_len,
+        }
+    }
+
+    fn phi(self, obs: &[f32]) -> SymbolicState {
+        SymbolicState::from_observation(&obs[self.start..self.start + self.len])
+    }
+}
+
+impl<'a> HacPolicy<'a> {
+    fn new(high: &'a Sac, low: &'a Sac, spec: &EnvSpec, horizon: usize) -> Self {
+        Self {
+            levels: Levels::Borrowed(high, low),
+            symbolic: SymbolicSlice::of(spec),
+            horizon,
+            subgoal: None,
+            input: Vec::new(),
+        }
+    }
+}
+
+impl HacPolicy<'static> {
+    /// The policy saved in a checkpoint folder of a HAC run with `config` on `spec` (only the
+    /// actors are read).
+    pub fn load(config: &TrainConfig, spec: &EnvSpec, checkpoint: &Path) -> Result<Self, RlError> {
+        let (mut high, mut low) = levels(config, spec);
+        high.load_as(checkpoint, HIGH_PREFIX, true)?;
+        low.load_as(checkpoint, LOW_PREFIX, true)?;
+        Ok(Self {
+            levels: Levels::Owned(Box::new((high, low))),
+            symbolic: SymbolicSlice::of(spec),
+            horizon: config.hac.subgoal_horizon,
+            subgoal: None,
+            input: Vec::new(),
+        })
+    }
+}
+
+impl TaskPolicy for HacPolicy<'_> {
+    fn begin(&mut self) {
+        self.subgoal = None;
+    }
+
+    fn act(&mut self, obs: &[f32]) -> Vec<f32> {
+        let (high, low) = match &self.levels {
+            Levels::Borrowed(high, low) => (*high, *low),
+            Levels::Owned(levels) => (&levels.0, &levels.1),
+        };
+        let board = self.symbolic.phi(obs);
+        let subgoal = match self.subgoal {
+            Some((z, steps)) if steps < self.horizon && !(steps > 0 && board == z) => (z, steps),
+            _ => (threshold(&high.act(obs, None)), 0),
+        };
+        self.subgoal = Some((subgoal.0, subgoal.1 + 1));
+        self.input.clear();
+        low_input(obs, subgoal.0, self.symbolic.len, &mut self.input);
+        low.act(&self.input, None)
+    }
+}
+
+impl Learner for Hac {
+    type Stats = TaskEpochStats;
+    type Metrics = TaskMetrics;
+
+    fn build(config: TrainConfig) -> Result<Self, RlError> {
+        Self::new(config)
+    }
+    fn config(&self) -> &TrainConfig {
+        &self.config
+    }
+    fn epoch(&self) -> u64 {
+        self.progress.epoch
+    }
+    fn finished(&self) -> bool {
+        Hac::finished(self)
+    }
+    fn run_epoch_observed(
+        &mut self,
+        hook: &mut dyn FnMut(Moment),
+    ) -> Result<TaskEpochStats, RlError> {
+        let stats = self.run_epoch()?;
+        hook(Moment::Collected);
+        Ok(stats)
+    }
+    fn metrics(&mut self, stats: &TaskEpochStats, wall_s: f64) -> Result<TaskMetrics, RlError> {
+        let results = self.task_success(self.config.baseline.eval_boards)?;
+        let p = &self.progress;
+        Ok(TaskMetrics::new(
+            &results,
+            (p.epoch, p.env_steps),
+            wall_s,
+            p.solved as f64 / p.ended.max(1) as f64,
+            stats,
+            p.timings,
+        ))
+    }
+    fn save(&self, dir: &Path) -> Result<(), RlError> {
+        Hac::save(self, dir)
+    }
+    fn load(&mut self, dir: &Path) -> Result<(), RlError> {
+        Hac::load(self, dir)
+    }
+    fn resume_only_files() -> Vec<&'static str> {
+        // The actors stay in every checkpoint (they are the policy); the rest is for resuming.
+        const FILES: [&str; 11] = [
+            "hac_high_critic.safetensors",
+            "hac_high_target.safetensors",
+            "hac_high_actor_adam.safetensors",
+            "hac_high_critic_adam.safetensors",
+            "hac_low_critic.safetensors",
+            "hac_low_target.safetensors",
+            "hac_low_actor_adam.safetensors",
+            "hac_low_critic_adam.safetensors",
+            HIGH_REPLAY_FILE,
+            LOW_REPLAY_FILE,
+            HAC_PROGRESS_FILE,
+        ];
+        FILES.to_vec()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn small(test_p: f64) -> TrainConfig {
+        let mut config =
+            TrainConfig::preset_for("lightsout-cursor", crate::Algorithm::Hac).unwrap();
+        config.sac.hidden = vec![16];
+        config.sac.batch_size = 16;
+        config.hac.subgoal_horizon = 4;
+        config.hac.subgoal_test_p = test_p;
+        config.portable_numerics = true;
+        config
+    }
+
+    /// Every transition in both replays follows the rules of HAC: a low-level transition is
+    /// rewarded 1, and ends, exactly when its next board is the subgoal in its input (hindsight
+    /// goals included); a high-level transition either has the board reached as its action
+    /// (hindsight action) or is the terminal 0 of a missed tested subgoal. With every subgoal
+    /// tested there is one penalty per missed attempt; with none, none.
+    #[test]
+    fn replays_hold_hacs_transitions() {
+        for test_p in [0.0, 1.0] {
+            let mut hac = Hac::new(small(test_p)).unwrap();
+            for _ in 0..60 {
+                hac.run_epoch().unwrap();
+            }
+            let (o, d) = (hac.spec.obs_dim, hac.spec.symbolic_len);
+            let phi = |row: &[f32]| hac.spec.phi(row);
+            let low = &hac.low_replay;
+            let mut hindsight_rewards = 0;
+            for i in 0..low.len() {
+                let next = &low.next_obs[i * (o + d)..(i + 1) * (o + d)];
+                let goal = SymbolicState::from_observation(&next[o..]);
+                let hit = phi(&next[..o]) == goal;
+                assert_eq!(
+                    low.rewards[i],
+                    f32::from(u8::from(hit)),
+                    "low transition {i}"
+                );
+                assert_eq!(low.dones[i], low.rewards[i]);
+                hindsight_rewards += usize::from(hit);
+            }
+            assert!(
+                hindsight_rewards > 0,
+                "hindsight goals reward the boards reached"
+            );
+            let high = &hac.high_replay;
+            let mut penalties = 0;
+            for i in 0..high.len() {
+                let action = threshold(&high.actions[i * d..(i + 1) * d]);
+                if action != phi(&high.next_obs[i * o..(i + 1) * o]) {
+                    assert_eq!((high.rewards[i], high.dones[i]), (0.0, 1.0), "{i}");
+                    penalties += 1;
+                }
+            }
+            let p = &hac.progress;
+            assert!(p.attempts > 20);
+            let missed = (p.attempts - p.reached) as usize;
+            assert_eq!(
+                high.len(),
+                p.attempts as usize + if test_p > 0.0 { missed } else { 0 }
+            );
+            assert_eq!(penalties, if test_p > 0.0 { missed } else { 0 });
+        }
+    }
+
+    /// The resume-only files are the checkpoint files of both levels except their actors.
+    #[test]
+    fn resume_only_files_are_all_but_the_actors() {
+        let mut expected: Vec<String> = [HIGH_PREFIX, LOW_PREFIX]
+            .iter()
+            .flat_map(|p| crate::sac::checkpoint_files(p).into_iter().skip(1))
+            .collect();
+        expected.extend([HIGH_REPLAY_FILE, LOW_REPLAY_FILE, HAC_PROGRESS_FILE].map(String::from));
+        assert_eq!(Hac::resume_only_files(), expected);
+    }
+}

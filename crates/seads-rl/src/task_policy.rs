@@ -1,0 +1,110 @@
+//! What the task-reward baselines share at evaluation: a policy acting in task mode, its task
+//! success on the SEADS protocol's boards, and loading it from a checkpoint.
+
+use std::path::Path;
+
+use seads_embodiment::{EnvConfig, TaskEnv, make_env};
+use seads_games::Split;
+use seads_planner::{DepthResult, EVALUATION_SEEDS};
+use tch::Device;
+
+use crate::hac::HacPolicy;
+use crate::{Algorithm, Purpose, RlError, Sac, TrainConfig, derived_seed};
+
+/// A deterministic policy acting in task mode: one action per observation of an episode.
+pub trait TaskPolicy {
+    /// A new episode starts (a hierarchical policy forgets its subgoal).
+    fn begin(&mut self) {}
+    /// The action for the episode's current observation.
+    fn act(&mut self, obs: &[f32]) -> Vec<f32>;
+}
+
+/// The flat SAC baseline: the deterministic action of its Gaussian policy.
+impl TaskPolicy for &Sac {
+    fn act(&mut self, obs: &[f32]) -> Vec<f32> {
+        Sac::act(self, obs, None)
+    }
+}
+
+impl TaskPolicy for Sac {
+    fn act(&mut self, obs: &[f32]) -> Vec<f32> {
+        Sac::act(self, obs, None)
+    }
+}
+
+/// The policy saved in a checkpoint folder of a baseline run with `config` (only the actors are
+/// read: older checkpoints keep nothing else).
+pub fn load_policy(
+    config: &TrainConfig,
+    checkpoint: &Path,
+) -> Result<Box<dyn TaskPolicy>, RlError> {
+    let spec = make_env(&config.env, &config.env_config)?.spec().clone();
+    match config.algorithm {
+        Algorithm::Sac => {
+            let mut sac = Sac::new(
+                spec.obs_dim,
+                &spec.action_low,
+                &spec.action_high,
+                &config.sac,
+                Device::Cpu,
+                0,
+            );
+            sac.load(checkpoint, true)?;
+            Ok(Box::new(sac))
+        }
+        Algorithm::Hac => Ok(Box::new(HacPolicy::load(config, &spec, checkpoint)?)),
+        Algorithm::Seads => Err(RlError::Config(
+            "a SEADS run has skills and a forward model, not a task policy; plan with it".into(),
+        )),
+    }
+}
+
+/// Task success of `policy` on the SEADS protocol: `boards` test boards per depth (1–5 in the
+/// protocol), the authors' evaluation seeds first, each episode until solved or T_lim.
+pub fn task_success(
+    config: &TrainConfig,
+    policy: &mut dyn TaskPolicy,
+    depths: &[usize],
+    boards: usize,
+) -> Result<Vec<DepthResult>, RlError> {
+    let seeds: Vec<u64> = (0..boards as u64)
+        .map(|i| {
+            EVALUATION_SEEDS
+                .get(i as usize)
+                .copied()
+                .unwrap_or_else(|| derived_seed(4343, Purpose::TrainEnvs, i))
+        })
+        .collect();
+    let mut results = Vec::new();
+    for &depth in depths {
+        let env_config = EnvConfig {
+            reset_split: Split::Test,
+            max_solution_depth: depth,
+            random_solution_depth: false,
+            ..config.env_config.clone()
+        };
+        let mut env = TaskEnv::new(make_env(&config.env, &env_config)?, depth)?;
+        let mut result = DepthResult::new(depth);
+        let mut obs = vec![0.0; env.spec().obs_dim];
+        for &seed in &seeds {
+            env.seed(seed);
+            env.reset()?;
+            policy.begin();
+            result.tasks += 1;
+            loop {
+                env.observe(&mut obs);
+                let action = policy.act(&obs);
+                let step = env.step(&action)?;
+                if step.done {
+                    if step.solved {
+                        result.solved += 1;
+                        result.solution_steps.push(env.steps());
+                    }
+                    break;
+                }
+            }
+        }
+        results.push(result);
+    }
+    Ok(results)
+}

@@ -1,0 +1,369 @@
+//! The task-reward baselines, flat SAC (SPEC §5.1) and two-level HAC (SPEC §5.2): the update
+//! schedule by hand, determinism, exact resume through a run directory, task success on the
+//! SEADS protocol's boards, and the presets against the seed's settings.
+
+use seads_rl::{
+    Algorithm, Hac, Learner, Run, TaskMetrics, TaskSac, TrainConfig, read_metrics_as, task_success,
+    updates_due,
+};
+
+/// A small baseline run on LightsOutCursor: 8 environments, one update per epoch once 32
+/// transitions are stored.
+fn small(seed: u64, steps: u64) -> TrainConfig {
+    small_of(Algorithm::Sac, seed, steps)
+}
+
+fn small_of(algorithm: Algorithm, seed: u64, steps: u64) -> TrainConfig {
+    let mut config = TrainConfig::preset_for("lightsout-cursor", algorithm).unwrap();
+    config.seed = seed;
+    config.env_steps = steps;
+    config.sac.hidden = vec![32, 32];
+    config.sac.batch_size = 32;
+    config.baseline.eval_boards = 2;
+    config.eval_every = 20;
+    config.checkpoint_every = 20;
+    config.portable_numerics = true;
+    // Subgoals of 7 steps in episodes of 10·S: checkpoints fall inside subgoal attempts.
+    if algorithm == Algorithm::Hac {
+        config.hac.subgoal_horizon = 7;
+    }
+    config
+}
+
+/// A metrics line without its wall-clock fields.
+type Numbers = (u64, u64, Vec<f64>, u64, u32, u32);
+
+/// The metrics without the wall-clock fields.
+fn numbers(metrics: &[TaskMetrics]) -> Vec<Numbers> {
+    metrics
+        .iter()
+        .map(|m| {
+            (
+                m.epoch,
+                m.env_steps,
+                m.success.clone(),
+                m.train_solved.to_bits(),
+                m.critic_loss.to_bits(),
+                m.actor_loss.to_bits(),
+            )
+        })
+        .collect()
+}
+
+#[test]
+fn the_update_schedule_follows_n_per_epoch() {
+    let over =
+        |n: f64, epochs: u64| -> Vec<usize> { (0..epochs).map(|e| updates_due(e, n)).collect() };
+    assert_eq!(over(1.0, 4), [1, 1, 1, 1]);
+    assert_eq!(over(2.0, 3), [2, 2, 2]);
+    // N < 1: one update every 1/N epochs (SPEC §5.1: 16 samples per update for N = 0.5, 32 for
+    // N = 0.25 with 8 samples per epoch).
+    assert_eq!(over(0.5, 6), [0, 1, 0, 1, 0, 1]);
+    assert_eq!(over(0.25, 8), [0, 0, 0, 1, 0, 0, 0, 1]);
+}
+
+/// The numbers of a whole run of `config`.
+fn whole_run<L: Learner<Metrics = TaskMetrics>>(config: TrainConfig) -> Vec<Numbers> {
+    let dir = tempfile::tempdir().unwrap();
+    let mut run = Run::<L>::create(dir.path(), config).unwrap();
+    while !run.finished() {
+        run.step().unwrap();
+    }
+    numbers(&read_metrics_as::<TaskMetrics>(dir.path()).unwrap())
+}
+
+/// Two runs of one seed are the same run, bit for bit; another seed is another run.
+fn a_seed_gives_the_same_run<L: Learner<Metrics = TaskMetrics>>(algorithm: Algorithm) {
+    let a = whole_run::<L>(small_of(algorithm, 4, 480));
+    assert_eq!(
+        a.len(),
+        4,
+        "evaluations at epochs 1, 20, 40 and 60 (the last)"
+    );
+    assert_eq!(a, whole_run::<L>(small_of(algorithm, 4, 480)));
+    assert_ne!(a, whole_run::<L>(small_of(algorithm, 5, 480)));
+}
+
+#[test]
+fn a_seed_gives_the_same_sac_run() {
+    a_seed_gives_the_same_run::<TaskSac>(Algorithm::Sac);
+}
+
+#[test]
+fn a_seed_gives_the_same_hac_run() {
+    a_seed_gives_the_same_run::<Hac>(Algorithm::Hac);
+}
+
+/// A run stopped after its epoch-40 checkpoint and resumed in a new process state (a fresh
+/// `Run`) ends exactly as the uninterrupted run: the replay buffers, the streams, the open
+/// episodes (replayed from their seeds and actions) and HAC's subgoals are all restored.
+fn a_resumed_run_is_the_uninterrupted_run<L: Learner<Metrics = TaskMetrics>>(algorithm: Algorithm) {
+    let config = || small_of(algorithm, 6, 800);
+    let whole = whole_run::<L>(config());
+    let parted = tempfile::tempdir().unwrap();
+    let mut run = Run::<L>::create(parted.path(), config()).unwrap();
+    // Past the checkpoint at epoch 40: epochs 41–52 are lost and redone.
+    for _ in 0..52 {
+        run.step().unwrap();
+    }
+    drop(run);
+    let mut run = Run::<L>::resume(parted.path()).unwrap();
+    assert_eq!(run.trainer().epoch(), 40);
+    while !run.finished() {
+        run.step().unwrap();
+    }
+    assert_eq!(
+        numbers(&read_metrics_as::<TaskMetrics>(parted.path()).unwrap()),
+        whole
+    );
+}
+
+#[test]
+fn a_resumed_sac_run_is_the_uninterrupted_run() {
+    a_resumed_run_is_the_uninterrupted_run::<TaskSac>(Algorithm::Sac);
+}
+
+#[test]
+fn a_resumed_hac_run_is_the_uninterrupted_run() {
+    a_resumed_run_is_the_uninterrupted_run::<Hac>(Algorithm::Hac);
+}
+
+/// Task success runs the SEADS protocol's test boards: every depth 1–5, the requested number of
+/// boards each, and a solved task took at most T_lim = 10·S steps.
+#[test]
+fn task_success_covers_every_depth() {
+    let config = small(1, 800);
+    let agent = TaskSac::new(config.clone()).unwrap();
+    let results = task_success(&config, &mut agent.policy(), &[1, 2, 3, 4, 5], 3).unwrap();
+    assert_eq!(
+        results.iter().map(|r| r.depth).collect::<Vec<_>>(),
+        [1, 2, 3, 4, 5]
+    );
+    for r in &results {
+        assert_eq!(r.tasks, 3);
+        assert!(r.solved <= 3);
+        assert!(r.solution_steps.iter().all(|&s| s <= 10 * r.depth));
+    }
+}
+
+/// The shipped presets carry SPEC §5.1's settings: 3 × 512 units, batch 256, a replay buffer of
+/// 10⁶, 8 samples per epoch, and the seed's best (N, α) per environment.
+#[test]
+fn presets_carry_the_seeds_best_settings() {
+    let best = [
+        ("lightsout-cursor", 1.0, 0.1),
+        ("tileswap-cursor", 1.0, 0.1),
+        ("lightsout-reacher", 0.5, 0.001),
+        ("tileswap-reacher", 0.25, 0.001),
+        ("lightsout-jaco", 0.5, 0.0001),
+        ("tileswap-jaco", 0.5, 0.0001),
+    ];
+    assert_eq!(TrainConfig::sac_presets().len(), 7, "and LightsOut3DJaco");
+    for (env, n, alpha) in best {
+        let c = TrainConfig::preset_for(env, Algorithm::Sac).unwrap();
+        c.validate().unwrap();
+        assert_eq!(c.algorithm, Algorithm::Sac);
+        assert_eq!(c.env, env);
+        assert_eq!(c.sac.hidden, [512, 512, 512]);
+        assert_eq!(
+            (c.sac.batch_size, c.sac.lr, c.sac.gamma, c.sac.tau),
+            (256, 3e-4, 0.99, 0.005)
+        );
+        assert_eq!(
+            (c.baseline.updates_per_epoch, c.sac.alpha),
+            (n, alpha),
+            "{env}"
+        );
+        assert_eq!(
+            (c.baseline.replay_capacity, c.baseline.samples_per_epoch),
+            (1_000_000, 8)
+        );
+        let budget = if env.ends_with("cursor") {
+            500_000
+        } else {
+            10_000_000
+        };
+        assert_eq!(c.env_steps, budget);
+    }
+}
+
+/// A baseline's config.toml names all its settings, defaults included, and reads back equal; a
+/// SEADS config has no baselines' section.
+#[test]
+fn configs_round_trip_through_toml() {
+    let sac = TrainConfig::preset_for("tileswap-cursor", Algorithm::Sac).unwrap();
+    let text = sac.to_toml();
+    assert!(
+        text.contains("[baseline]") && text.contains("updates_per_epoch = 1.0"),
+        "{text}"
+    );
+    assert_eq!(TrainConfig::from_toml(&text).unwrap(), sac);
+    let seads = TrainConfig::preset("tileswap-cursor").unwrap();
+    let text = seads.to_toml();
+    assert!(
+        !text.contains("baseline") && !text.contains("algorithm"),
+        "{text}"
+    );
+    assert_eq!(TrainConfig::from_toml(&text).unwrap(), seads);
+}
+
+/// The HAC presets carry SPEC §5.2's settings: 2 × 512 units for both levels, lr 3·10⁻⁴,
+/// τ 0.005, γ 0.99, and the seed's best (τ_RB, α_low, α_high) per environment.
+#[test]
+fn hac_presets_carry_the_seeds_best_settings() {
+    let best = [
+        ("lightsout-cursor", 0.1, 0.1, 0.001),
+        ("tileswap-cursor", 0.5, 0.5, 0.001),
+        ("lightsout-reacher", 0.1, 0.0001, 0.0001),
+        ("tileswap-reacher", 0.1, 0.0001, 0.0001),
+        ("lightsout-jaco", 0.1, 0.001, 0.001),
+        ("tileswap-jaco", 0.1, 0.0001, 0.001),
+    ];
+    assert_eq!(TrainConfig::hac_presets().len(), 7, "and LightsOut3DJaco");
+    for (env, temperature, alpha_low, alpha_high) in best {
+        let c = TrainConfig::preset_for(env, Algorithm::Hac).unwrap();
+        c.validate().unwrap();
+        assert_eq!((c.algorithm, c.env.as_str()), (Algorithm::Hac, env));
+        assert_eq!(c.sac.hidden, [512, 512]);
+        assert_eq!((c.sac.lr, c.sac.gamma, c.sac.tau), (3e-4, 0.99, 0.005));
+        assert_eq!(
+            (c.hac.temperature, c.sac.alpha, c.hac.alpha_high),
+            (temperature, alpha_low, alpha_high),
+            "{env}"
+        );
+        // A subgoal gets the steps of one skill: T_max = 10 (Cursor) or 50.
+        let horizon = if env.ends_with("cursor") { 10 } else { 50 };
+        assert_eq!(c.hac.subgoal_horizon, horizon);
+        let sac = TrainConfig::preset_for(env, Algorithm::Sac).unwrap();
+        assert_eq!(
+            c.baseline, sac.baseline,
+            "{env}: N and the buffer as for SAC"
+        );
+        assert_eq!(c.env_steps, sac.env_steps);
+    }
+}
+
+/// A HAC config.toml names both baseline sections, defaults included, and reads back equal.
+#[test]
+fn hac_configs_round_trip_through_toml() {
+    let mut hac = TrainConfig::preset_for("lightsout-cursor", Algorithm::Hac).unwrap();
+    hac.hac = Default::default();
+    let text = hac.to_toml();
+    assert!(
+        text.contains("[hac]") && text.contains("[baseline]"),
+        "{text}"
+    );
+    assert_eq!(TrainConfig::from_toml(&text).unwrap(), hac);
+}
+
+/// Bad values and settings of another algorithm are refused with a message naming them.
+#[test]
+fn bad_baseline_settings_are_refused() {
+    let refused = |text: &str, needle: &str| {
+        let e = TrainConfig::from_toml(text).unwrap_err().to_string();
+        assert!(e.contains(needle), "{text:?}: {e}");
+    };
+    refused("algorithm = \"ppo\"", "unknown variant");
+    refused(
+        "algorithm = \"hac\"\n[hac]\ntemperature = 0.0",
+        "hac.temperature",
+    );
+    refused(
+        "algorithm = \"hac\"\n[hac]\ntemperature = -1.0",
+        "hac.temperature",
+    );
+    refused(
+        "algorithm = \"hac\"\n[hac]\nsubgoal_horizon = 0",
+        "hac.subgoal_horizon",
+    );
+    refused(
+        "algorithm = \"sac\"\n[baseline]\nupdates_per_epoch = 0.0",
+        "updates_per_epoch",
+    );
+    refused(
+        "algorithm = \"sac\"\nnum_skills = 30",
+        "num_skills is not a setting of the SAC",
+    );
+    refused(
+        "algorithm = \"hac\"\n[relabel]\nsac_p = 0.0",
+        "relabel is not a setting of the HAC",
+    );
+    refused("[hac]\ntemperature = 0.5", "hac is not a setting of SEADS");
+    refused(
+        "algorithm = \"sac\"\n[hac]\ntemperature = 0.5",
+        "hac is not a setting of the SAC",
+    );
+    refused(
+        "[baseline]\nsamples_per_epoch = 4",
+        "baseline is not a setting of SEADS",
+    );
+}
+
+/// HAC's task success runs the protocol as SAC's does: every depth, the requested boards, and a
+/// solved task within T_lim.
+#[test]
+fn hac_task_success_covers_every_depth() {
+    let config = small_of(Algorithm::Hac, 1, 800);
+    let agent = Hac::new(config.clone()).unwrap();
+    let results = task_success(&config, &mut agent.policy(), &[1, 2, 3, 4, 5], 3).unwrap();
+    assert_eq!(results.len(), 5);
+    for r in &results {
+        assert_eq!(r.tasks, 3);
+        assert!(r.solution_steps.iter().all(|&s| s <= 10 * r.depth));
+    }
+}
+
+/// HAC's high level on a toy problem: on a board z ∈ {0,1}⁴ it proposes a subgoal, and a
+/// subgoal is reachable when one move (one flipped bit) away. Rewarded 1 for a reachable
+/// subgoal (the attempt succeeds) and 0 otherwise (a tested subgoal that is missed), the discrete
+/// SAC with the RelaxedBernoulli policy learns to propose a reachable subgoal on (almost) every
+/// board, where a random subgoal is reachable on a quarter of the proposals.
+#[test]
+fn hacs_high_level_learns_to_propose_reachable_subgoals() {
+    use rand::{RngExt, SeedableRng};
+    use seads_rl::{Sac, SacConfig, TransitionBatch};
+    const D: usize = 4;
+    let config = SacConfig {
+        hidden: vec![64, 64],
+        alpha: 0.01,
+        lr: 1e-3,
+        batch_size: 64,
+        ..SacConfig::default()
+    };
+    let mut high = Sac::relaxed_bernoulli(D, D, 0.1, &config, tch::Device::Cpu, 3);
+    let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(3);
+    let bits = |board: usize| -> Vec<f32> { (0..D).map(|d| ((board >> d) & 1) as f32).collect() };
+    let reachable = |board: usize, subgoal: &[f32]| {
+        let flipped = (0..D).filter(|&d| (subgoal[d] > 0.5) != ((board >> d) & 1 == 1));
+        flipped.count() == 1
+    };
+    let share = |high: &Sac| {
+        let hits = (0..1 << D).filter(|&b| reachable(b, &high.act(&bits(b), None)));
+        hits.count() as f64 / (1 << D) as f64
+    };
+    let mut replay: Vec<(Vec<f32>, Vec<f32>, f32)> = Vec::new();
+    let before = share(&high);
+    for _ in 0..1000 {
+        for _ in 0..8 {
+            let board = rng.random_range(0..1 << D);
+            let subgoal = high.act(&bits(board), Some(&mut rng));
+            let reward = f32::from(u8::from(reachable(board, &subgoal)));
+            replay.push((bits(board), subgoal, reward));
+        }
+        let mut batch = TransitionBatch::default();
+        for _ in 0..config.batch_size {
+            let (obs, action, reward) = &replay[rng.random_range(0..replay.len())];
+            batch.obs.extend(obs);
+            batch.actions.extend(action);
+            batch.rewards.push(*reward);
+            batch.next_obs.extend(obs);
+            batch.dones.push(1.0);
+        }
+        high.update(&batch, &mut rng);
+    }
+    // A factorised policy cannot spread over the four reachable subgoals of a board, so the
+    // fixed entropy bonus may leave one board's mode between two of them.
+    assert!(before < 0.5, "the untrained policy: {before}");
+    let after = share(&high);
+    assert!(after >= 0.9, "reachable on {after} of the boards");
+}
