@@ -13,8 +13,9 @@
 //! - *hindsight goal transitions*: the low level also stores every attempt that missed its
 //!   subgoal as if the board it ended on had been the subgoal;
 //! - *subgoal testing*: a share λ of subgoals is pursued without exploration noise, and a tested
-//!   subgoal that is missed gives the high level a terminal transition of reward 0 for it, the
-//!   lowest return of the task, as Levy's penalty −H is the lowest of his;
+//!   subgoal that is missed gives the high level a terminal transition of reward −1 for it: worse
+//!   than any return of the task (0 to 1), as Levy's penalty −H is at least as bad as any return
+//!   of his −1-per-step rewards;
 //! - the top level's goal is the game's goal board, the same in every episode, so it is not an
 //!   input and needs no hindsight goals.
 //!
@@ -53,8 +54,9 @@ pub const LOW_REPLAY_FILE: &str = "hac-low-replay.safetensors";
 /// Epoch, steps, random streams, open episodes and subgoals of a checkpoint.
 pub const HAC_PROGRESS_FILE: &str = "hac-progress.json";
 
-/// Reward and return end of a tested subgoal that was missed (the task's lowest return).
-const MISSED_TEST_REWARD: f32 = 0.0;
+/// Reward (with the return's end) of a tested subgoal that was missed: below every return of the
+/// task reward, which lie in [0, 1].
+const MISSED_TEST_REWARD: f32 = -1.0;
 
 /// A subgoal being pursued in one environment.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -401,7 +403,7 @@ impl Hac {
         let to = self.current(slot).to_vec();
         self.high_replay
             .push(&from, &reached_bits, attempt.reward, &to, episode_done);
-        // Subgoal testing: a missed tested subgoal ends its return with the lowest reward.
+        // Subgoal testing: a missed tested subgoal ends its return with the penalty.
         if attempt.testing && !reached {
             let mut proposed = vec![0.0; d];
             attempt.subgoal.write_f32(&mut proposed);
@@ -649,7 +651,7 @@ mod tests {
     /// Every transition in both replays follows the rules of HAC: a low-level transition is
     /// rewarded 1, and ends, exactly when its next board is the subgoal in its input (hindsight
     /// goals included); a high-level transition either has the board reached as its action
-    /// (hindsight action) or is the terminal 0 of a missed tested subgoal. With every subgoal
+    /// (hindsight action) or is the terminal −1 of a missed tested subgoal. With every subgoal
     /// tested there is one penalty per missed attempt; with none, none.
     #[test]
     fn replays_hold_hacs_transitions() {
@@ -683,7 +685,7 @@ mod tests {
             for i in 0..high.len() {
                 let action = threshold(&high.actions[i * d..(i + 1) * d]);
                 if action != phi(&high.next_obs[i * o..(i + 1) * o]) {
-                    assert_eq!((high.rewards[i], high.dones[i]), (0.0, 1.0), "{i}");
+                    assert_eq!((high.rewards[i], high.dones[i]), (-1.0, 1.0), "{i}");
                     penalties += 1;
                 }
             }
