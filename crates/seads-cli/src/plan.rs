@@ -10,8 +10,8 @@ use rand::{RngExt, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use seads_games::{BoardDataset, BoardGame, LightsOut, Split};
 use seads_planner::{
-    DepthResult, EVALUATION_SEEDS, Evaluation, PlannerConfig, SolveConfig, bfs_plan, evaluate,
-    solve, summarise,
+    DepthResult, EVALUATION_SEEDS, Evaluation, PlannerConfig, SolveConfig, TaskRecord, bfs_plan,
+    evaluate, solve, summarise,
 };
 use seads_rl::Agent;
 use seads_skillmodel::{SkillModelConfig, agreement_with_game, fit_to_game};
@@ -253,6 +253,16 @@ pub fn evaluate_agent(
     tasks: &Tasks,
     bar: &ProgressBar,
 ) -> Result<Vec<DepthResult>> {
+    evaluate_agent_with(agent, tasks, bar, |_| {})
+}
+
+/// [`evaluate_agent`], calling `each` with every task as it ends.
+fn evaluate_agent_with(
+    agent: &mut Agent,
+    tasks: &Tasks,
+    bar: &ProgressBar,
+    mut each: impl FnMut(&TaskRecord<'_>),
+) -> Result<Vec<DepthResult>> {
     let evaluation = Evaluation {
         env: agent.config.env.clone(),
         env_config: agent.config.env_config.clone(),
@@ -270,9 +280,10 @@ pub fn evaluate_agent(
         },
     };
     let (policy, model) = agent.parts()?;
-    evaluate(&evaluation, policy, model, |depth, _| {
-        bar.set_message(format!("depth {depth}"));
+    evaluate(&evaluation, policy, model, |task| {
+        bar.set_message(format!("depth {}", task.depth));
         bar.inc(1);
+        each(task);
     })
     .map_err(|e| BadInput(e.into()).into())
 }
@@ -290,21 +301,63 @@ pub fn run_evaluation(
     } else {
         ProgressBar::new((tasks.depths.len() * tasks.seeds.len()) as u64)
     };
-    let results = evaluate_agent(agent, &tasks, &bar)?;
+    let spec = seads_embodiment::make_env(&agent.config.env, &agent.config.env_config)?
+        .spec()
+        .clone();
+    let game = spec.game.build(spec.board_size)?;
+    let mut lines = String::new();
+    let results = evaluate_agent_with(agent, &tasks, &bar, |task| {
+        lines += &task_line(game.as_ref(), task).to_string();
+        lines.push('\n');
+    })?;
     bar.finish_and_clear();
     // The standard depths 1–5 are what `seads plot` draws; other studies are kept beside them.
     let depths = &tasks.depths;
     let mode = if tasks.replan { "replan" } else { "plan-once" };
-    let name = match (depths.first(), depths.last()) {
-        (Some(1), Some(5)) if depths.len() == 5 => format!("evaluation-{mode}.json"),
-        (Some(a), Some(b)) => format!("evaluation-{mode}-depths-{a}-{b}.json"),
-        _ => format!("evaluation-{mode}.json"),
+    let stem = match (depths.first(), depths.last()) {
+        (Some(1), Some(5)) if depths.len() == 5 => format!("evaluation-{mode}"),
+        (Some(a), Some(b)) => format!("evaluation-{mode}-depths-{a}-{b}"),
+        _ => format!("evaluation-{mode}"),
     };
     seads_rl::write_atomic(
-        &run.join(name),
+        &run.join(format!("{stem}.json")),
         serde_json::to_string_pretty(&results)?.as_bytes(),
     )?;
+    seads_rl::write_atomic(&run.join(format!("{stem}-tasks.jsonl")), lines.as_bytes())?;
     Ok(results)
+}
+
+/// One line of `evaluation-*-tasks.jsonl`: a task, how it ended, and every skill that left
+/// another board than the forward model predicted (boards as `seads solve --board` takes them).
+fn task_line(game: &dyn BoardGame, task: &TaskRecord<'_>) -> serde_json::Value {
+    let o = task.outcome;
+    let deviations: Vec<serde_json::Value> = o
+        .deviations
+        .iter()
+        .map(|d| {
+            serde_json::json!({
+                "step": d.step,
+                "skill": d.skill,
+                "before": game.format(d.before),
+                "predicted": game.format(d.predicted),
+                "reached": game.format(d.reached),
+            })
+        })
+        .collect();
+    serde_json::json!({
+        "depth": task.depth,
+        "seed": task.seed,
+        "board": game.format(task.board),
+        "solved": o.solved,
+        "plan_found": o.plan_found,
+        "plans": o.plans,
+        "first_plan": o.first_plan,
+        "executed": o.executed,
+        "skill_steps": o.skill_steps,
+        "timed_out": o.timed_out,
+        "failure": o.failure,
+        "deviations": deviations,
+    })
 }
 
 /// `seads evaluate`.

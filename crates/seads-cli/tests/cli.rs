@@ -405,6 +405,7 @@ fn solve_evaluate_and_plot_a_trained_run() {
         "2",
         "--timeout",
         "0.5",
+        "--replan",
         "--json",
     ]);
     for key in [
@@ -422,6 +423,30 @@ fn solve_evaluate_and_plot_a_trained_run() {
     }
     let rate = v["success_rate"]["1"].as_f64().unwrap();
     assert!((0.0..=1.0).contains(&rate));
+    // One line per task, with what every skill did against the model's prediction: with
+    // re-planning, each deviation of a solved task cost one more search.
+    let tasks =
+        std::fs::read_to_string(tiny_run().join("run/evaluation-replan-depths-1-2-tasks.jsonl"))
+            .unwrap();
+    let tasks: Vec<serde_json::Value> = tasks
+        .lines()
+        .map(|l| serde_json::from_str(l).unwrap())
+        .collect();
+    assert_eq!(tasks.len(), 4, "2 boards x depths 1 and 2");
+    for task in &tasks {
+        let deviations = task["deviations"].as_array().unwrap();
+        for d in deviations {
+            assert_ne!(d["predicted"], d["reached"], "{task}");
+        }
+        if task["solved"] == true {
+            assert_eq!(
+                task["plans"].as_u64().unwrap(),
+                1 + deviations.len() as u64,
+                "{task}"
+            );
+        }
+        assert_eq!(task["board"].as_str().unwrap().split(',').count(), 25);
+    }
     let figures = tiny_run().join("figures");
     seads_ok(&[
         "plot",

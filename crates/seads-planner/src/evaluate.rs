@@ -4,10 +4,25 @@
 use std::collections::BTreeMap;
 
 use seads_embodiment::{EnvConfig, EnvError, SkillPolicy, make_env};
-use seads_games::{Split, Successor};
+use seads_games::{Split, Successor, SymbolicState};
 use serde::{Deserialize, Serialize};
 
-use crate::{SolveConfig, solve};
+use crate::{SolveConfig, SolveOutcome, solve};
+
+/// One task of an evaluation, as it ended.
+#[derive(Debug, Clone, Copy)]
+pub struct TaskRecord<'a> {
+    /// Its solution depth.
+    pub depth: usize,
+    /// The environment seed that drew its board.
+    pub seed: u64,
+    /// The board it started from.
+    pub board: SymbolicState,
+    /// Tasks of this depth done so far, this one included.
+    pub done: usize,
+    /// What solving it did.
+    pub outcome: &'a SolveOutcome,
+}
 
 /// The 20 environment seeds of the authors' evaluation jobs (the first 20 draws of
 /// `randint(0, 10^8)` from NumPy's `RandomState(4343)`). They select other boards here than in
@@ -74,13 +89,12 @@ pub struct Evaluation {
 }
 
 /// Evaluates `policy` and `successor`: for each depth, boards of exactly that depth from the
-/// split, one per seed (seed, reset once, solve). `progress(depth, tasks done)` is called after
-/// every task.
+/// split, one per seed (seed, reset once, solve). `each` is called with every task as it ends.
 pub fn evaluate(
     evaluation: &Evaluation,
     policy: &dyn SkillPolicy,
     successor: &mut dyn Successor,
-    mut progress: impl FnMut(usize, usize),
+    mut each: impl FnMut(&TaskRecord<'_>),
 ) -> Result<Vec<DepthResult>, EnvError> {
     let mut results = Vec::new();
     for &depth in &evaluation.depths {
@@ -97,6 +111,7 @@ pub fn evaluate(
         for &seed in &evaluation.seeds {
             env.seed(seed);
             env.reset()?;
+            let board = env.board();
             let outcome = solve(env.as_mut(), policy, successor, goal, &evaluation.solve)?;
             result.tasks += 1;
             result.plan_found += outcome.plan_found as usize;
@@ -107,7 +122,13 @@ pub fn evaluate(
                 result.solution_steps.push(outcome.manipulator_steps);
                 result.skill_steps.extend(&outcome.skill_steps);
             }
-            progress(depth, result.tasks);
+            each(&TaskRecord {
+                depth,
+                seed,
+                board,
+                done: result.tasks,
+                outcome: &outcome,
+            });
         }
         results.push(result);
     }

@@ -54,9 +54,26 @@ pub struct SolveOutcome {
     pub timed_out: bool,
     /// Why the task failed, if it did.
     pub failure: Option<String>,
+    /// Every executed skill that left another board than the forward model predicted.
+    pub deviations: Vec<Deviation>,
     /// What each executed skill did (manipulator path and pushes), for figures.
     #[serde(skip)]
     pub runs: Vec<SkillRun>,
+}
+
+/// An executed skill whose board differs from the plan's prediction.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+pub struct Deviation {
+    /// Its index among the executed skills.
+    pub step: usize,
+    /// The skill.
+    pub skill: usize,
+    /// The board before it ran.
+    pub before: SymbolicState,
+    /// The board the plan predicted after it.
+    pub predicted: SymbolicState,
+    /// The board it left.
+    pub reached: SymbolicState,
 }
 
 /// Solves the task in `env` (its current board towards `goal`) with `policy`, planning with
@@ -79,6 +96,7 @@ pub fn solve(
         planning_s: 0.0,
         timed_out: false,
         failure: None,
+        deviations: Vec::new(),
         runs: Vec::new(),
     };
     let mut plan = match search(env.board(), successor, goal, config, &mut outcome) {
@@ -92,8 +110,8 @@ pub fn solve(
     outcome.first_plan = plan.skills.clone();
     if !config.replan {
         // Algorithm 1: execute the whole plan; only the final board counts.
-        for &skill in &plan.skills {
-            run(env, policy, skill, &mut outcome)?;
+        for (&skill, &predicted) in plan.skills.iter().zip(&plan.predicted) {
+            run(env, policy, skill, predicted, &mut outcome)?;
         }
         outcome.solved = env.board() == goal;
         if !outcome.solved {
@@ -104,7 +122,13 @@ pub fn solve(
     // Algorithm 2: execute skill by skill, re-planning on a deviation from the prediction.
     let mut step = 0;
     loop {
-        run(env, policy, plan.skills[step], &mut outcome)?;
+        run(
+            env,
+            policy,
+            plan.skills[step],
+            plan.predicted[step],
+            &mut outcome,
+        )?;
         let board = env.board();
         if board == goal {
             outcome.solved = true;
@@ -143,13 +167,26 @@ fn search(
     plan
 }
 
+/// Executes `skill`, recording a deviation when the board it leaves is not `predicted`.
 fn run(
     env: &mut dyn Environment,
     policy: &dyn SkillPolicy,
     skill: usize,
+    predicted: SymbolicState,
     outcome: &mut SolveOutcome,
 ) -> Result<(), EnvError> {
+    let before = env.board();
     let r = execute_skill(env, policy, skill)?;
+    let reached = env.board();
+    if reached != predicted {
+        outcome.deviations.push(Deviation {
+            step: outcome.executed.len(),
+            skill,
+            before,
+            predicted,
+            reached,
+        });
+    }
     outcome.executed.push(skill);
     outcome.skill_steps.push(r.steps);
     outcome.manipulator_steps += r.steps;

@@ -33,6 +33,6 @@ mod execute;
 
 pub use bfs::{Plan, PlanError, PlannerConfig, bfs_plan};
 pub use evaluate::{
-    DepthResult, EVALUATION_SEEDS, Evaluation, EvaluationSummary, evaluate, summarise,
+    DepthResult, EVALUATION_SEEDS, Evaluation, EvaluationSummary, TaskRecord, evaluate, summarise,
 };
-pub use execute::{SolveConfig, SolveOutcome, solve};
+pub use execute::{Deviation, SolveConfig, SolveOutcome, solve};

@@ -313,7 +313,10 @@ fn evaluation_protocol_reports_per_depth() {
         &evaluation,
         &CursorPolicy::lightsout(None),
         &mut GameSuccessor::new(lo),
-        |_, _| calls += 1,
+        |task| {
+            calls += 1;
+            assert!(task.outcome.solved && task.outcome.deviations.is_empty());
+        },
     )
     .unwrap();
     assert_eq!(calls, 8);

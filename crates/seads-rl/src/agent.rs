@@ -86,6 +86,7 @@ impl Agent {
         checkpoint: &Path,
     ) -> Result<Self, RlError> {
         crate::numerics::check(config.portable_numerics)?;
+        crate::store::check_origin(checkpoint, &config)?;
         let k = config.num_skills.unwrap_or(spec.num_skills);
         let mut sac = Sac::new(
             spec.obs_dim + k,

@@ -16,9 +16,9 @@ use std::time::Instant;
 use serde::{Deserialize, Serialize};
 
 use crate::store::{
-    CHECKPOINTS, CONFIG, LATEST, METRICS, MetricsLine, append_metrics, checkpoint_name,
-    checkpoints, clean_leftovers, commit_dir, hidden_sibling, latest_pointer, read_metrics_text,
-    write_atomic, write_metrics,
+    CHECKPOINTS, CONFIG, LATEST, METRICS, MetricsLine, append_metrics, check_origin,
+    checkpoint_name, checkpoints, clean_leftovers, commit_dir, hidden_sibling, latest_pointer,
+    read_metrics_text, write_atomic, write_metrics, write_origin,
 };
 use crate::{EpochStats, RlError, Timings, TrainConfig, Trainer};
 
@@ -226,7 +226,7 @@ impl<L: Learner> Run<L> {
         let mut failures: Vec<RlError> = Vec::new();
         let mut resumed = None;
         for candidate in candidates {
-            match trainer.load(&candidate) {
+            match check_origin(&candidate, &config).and_then(|()| trainer.load(&candidate)) {
                 Ok(()) => {
                     resumed = Some(candidate);
                     break;
@@ -326,6 +326,7 @@ impl<L: Learner> Run<L> {
         let _ = fs::remove_dir_all(&tmp);
         fs::create_dir_all(&tmp).map_err(|e| RlError::io(&tmp, e))?;
         self.trainer.save(&tmp)?;
+        write_origin(&tmp, self.trainer.config())?;
         (self.hook)(Moment::CheckpointWritten);
         commit_dir(&tmp, &dest)?;
         (self.hook)(Moment::CheckpointRenamed);

@@ -34,6 +34,49 @@ pub const LATEST: &str = "latest";
 pub const METRICS: &str = "metrics.jsonl";
 /// The configuration of a run directory.
 pub const CONFIG: &str = "config.toml";
+/// In every checkpoint folder: the environment and algorithm that wrote it.
+pub const ORIGIN: &str = "origin.json";
+
+/// Where a checkpoint comes from.
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
+struct Origin {
+    env: String,
+    algorithm: crate::Algorithm,
+}
+
+/// Writes the origin of a checkpoint of a run with `config` into its folder `dir`.
+pub(crate) fn write_origin(dir: &Path, config: &crate::TrainConfig) -> Result<(), RlError> {
+    let origin = Origin {
+        env: config.env.clone(),
+        algorithm: config.algorithm,
+    };
+    let path = dir.join(ORIGIN);
+    let text = serde_json::to_string(&origin).map_err(|e| RlError::io(&path, e))?;
+    fs::write(&path, text).map_err(|e| RlError::io(&path, e))
+}
+
+/// Refuses a checkpoint written by a run of another environment or algorithm than `config`'s,
+/// naming both. A checkpoint without an origin (written before it was recorded) passes.
+pub fn check_origin(checkpoint: &Path, config: &crate::TrainConfig) -> Result<(), RlError> {
+    let path = checkpoint.join(ORIGIN);
+    let Ok(text) = fs::read_to_string(&path) else {
+        return Ok(());
+    };
+    let origin: Origin = serde_json::from_str(&text).map_err(|e| RlError::unreadable(&path, e))?;
+    if origin.env != config.env || origin.algorithm != config.algorithm {
+        return Err(RlError::Checkpoint {
+            path: checkpoint.display().to_string(),
+            reason: format!(
+                "it was written by a {} run on {}, not a {} run on {}",
+                origin.algorithm.name(),
+                origin.env,
+                config.algorithm.name(),
+                config.env
+            ),
+        });
+    }
+    Ok(())
+}
 
 /// Writes `bytes` to `path` atomically and durably: a temporary file in the same folder,
 /// fsynced, renamed over `path`, and the folder fsynced.

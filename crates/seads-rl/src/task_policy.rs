@@ -38,6 +38,7 @@ pub fn load_policy(
     config: &TrainConfig,
     checkpoint: &Path,
 ) -> Result<Box<dyn TaskPolicy>, RlError> {
+    crate::store::check_origin(checkpoint, config)?;
     let spec = make_env(&config.env, &config.env_config)?.spec().clone();
     match config.algorithm {
         Algorithm::Sac => {

@@ -367,3 +367,66 @@ fn hacs_high_level_learns_to_propose_reachable_subgoals() {
     let after = share(&high);
     assert!(after >= 0.9, "reachable on {after} of the boards");
 }
+
+/// A checkpoint written by a run of another environment is refused on resume and on loading its
+/// policy, with both environments named.
+#[test]
+fn a_checkpoint_of_another_environment_is_refused_naming_both() {
+    let train = |config: TrainConfig| {
+        let dir = tempfile::tempdir().unwrap();
+        let mut run = Run::<TaskSac>::create(dir.path(), config).unwrap();
+        while !run.finished() {
+            run.step().unwrap();
+        }
+        dir
+    };
+    let lightsout = train(small(1, 160));
+    let mut config = small(1, 160);
+    config.env = "tileswap-cursor".into();
+    let tileswap = train(config.clone());
+    // The tileswap run's checkpoints replaced by the lightsout run's.
+    let checkpoints = tileswap.path().join("checkpoints");
+    std::fs::remove_dir_all(&checkpoints).unwrap();
+    std::fs::create_dir(&checkpoints).unwrap();
+    for entry in std::fs::read_dir(lightsout.path().join("checkpoints")).unwrap() {
+        let entry = entry.unwrap();
+        let to = checkpoints.join(entry.file_name());
+        if entry.file_type().unwrap().is_dir() {
+            std::fs::create_dir(&to).unwrap();
+            for file in std::fs::read_dir(entry.path()).unwrap() {
+                let file = file.unwrap();
+                std::fs::copy(file.path(), to.join(file.file_name())).unwrap();
+            }
+        } else {
+            std::fs::copy(entry.path(), &to).unwrap();
+        }
+    }
+    let chain = |e: &dyn std::error::Error| {
+        let mut text = e.to_string();
+        let mut source = e.source();
+        while let Some(s) = source {
+            text += &format!(": {s}");
+            source = s.source();
+        }
+        text
+    };
+    let e = Run::<TaskSac>::resume(tileswap.path())
+        .err()
+        .expect("refused");
+    let text = chain(&e);
+    assert!(
+        text.contains("a sac run on lightsout-cursor, not a sac run on tileswap-cursor"),
+        "{text}"
+    );
+    let latest = seads_rl::latest_checkpoint(tileswap.path())
+        .unwrap()
+        .unwrap();
+    let e = seads_rl::load_policy(&config, &latest)
+        .err()
+        .expect("refused");
+    assert!(
+        chain(&e).contains("on lightsout-cursor, not"),
+        "{}",
+        chain(&e)
+    );
+}
