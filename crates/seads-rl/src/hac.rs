@@ -2,8 +2,11 @@
 //! Hierarchical Actor-Critic.
 //!
 //! - The **high level** is a discrete SAC ([`Sac::relaxed_bernoulli`]) on the environment's
-//!   observation. Its action is a subgoal z ∈ {0,1}^D, a symbolic state: the relaxed sample
-//!   thresholded at 0.5 (in training), the mode (in evaluation). Its reward is the task reward.
+//!   observation and a goal board, as Levy's top level is conditioned on the task's goal. Its
+//!   action is a subgoal z ∈ {0,1}^D, a symbolic state: the relaxed sample thresholded at 0.5 (in
+//!   training), the mode (in evaluation). Its reward is the task reward: 1 when the board reaches
+//!   the goal (the game's goal board; in hindsight, a board the episode reached), which ends the
+//!   return.
 //! - The **low level** is a Gaussian SAC on the observation and the subgoal. It pursues a subgoal
 //!   for at most H steps and is rewarded 1 (and its return ends) on the step whose board is z.
 //!
@@ -11,13 +14,14 @@
 //! - *hindsight action transitions*: the high level stores each subgoal attempt with the board
 //!   actually reached as its action, so every attempt teaches it a reachable subgoal;
 //! - *hindsight goal transitions*: the low level also stores every attempt that missed its
-//!   subgoal as if the board it ended on had been the subgoal;
+//!   subgoal as if the board it ended on had been the subgoal; at the end of an episode the high
+//!   level stores its attempts again toward boards the episode reached (the last attempt's and
+//!   up to two more, Levy's three), so it learns which subgoals lead where long before it solves
+//!   a board;
 //! - *subgoal testing*: a share λ of subgoals is pursued without exploration noise, and a tested
 //!   subgoal that is missed gives the high level a terminal transition of reward −1 for it: worse
 //!   than any return of the task (0 to 1), as Levy's penalty −H is at least as bad as any return
 //!   of his −1-per-step rewards;
-//! - the top level's goal is the game's goal board, the same in every episode, so it is not an
-//!   input and needs no hindsight goals.
 //!
 //! An epoch steps each of the 8 environments once (as the SAC baseline does) and then takes N
 //! gradient steps of each level whose replay holds a batch. Resuming is exact, as for the SAC
@@ -54,9 +58,20 @@ pub const LOW_REPLAY_FILE: &str = "hac-low-replay.safetensors";
 /// Epoch, steps, random streams, open episodes and subgoals of a checkpoint.
 pub const HAC_PROGRESS_FILE: &str = "hac-progress.json";
 
+/// Goals per ended episode for the high level's hindsight goal transitions (Levy's number).
+const HINDSIGHT_GOALS: usize = 3;
+
 /// Reward (with the return's end) of a tested subgoal that was missed: below every return of the
 /// task reward, which lie in [0, 1].
 const MISSED_TEST_REWARD: f32 = -1.0;
+
+/// An attempt of the open episode that has ended: what the high level's hindsight goals need.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+struct Ended {
+    /// The steps of the episode it started and ended at.
+    start: usize,
+    end: usize,
+}
 
 /// A subgoal being pursued in one environment.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -87,6 +102,8 @@ struct Progress {
     open: Vec<OpenEpisode>,
     /// The subgoal of each environment (`None` between attempts).
     subgoals: Vec<Option<Attempt>>,
+    /// The ended attempts of each environment's open episode.
+    ended_attempts: Vec<Vec<Ended>>,
 }
 
 /// A two-level HAC agent in training on the task reward.
@@ -101,10 +118,13 @@ pub struct Hac {
     high_replay: Replay,
     low_replay: Replay,
     progress: Progress,
+    /// The game's goal board.
+    goal: SymbolicState,
 }
 
-/// The low level's input: the observation followed by the subgoal's D bits.
-fn low_input(obs: &[f32], subgoal: SymbolicState, d: usize, out: &mut Vec<f32>) {
+/// An input of either level: the observation followed by a board's D bits (the low level's
+/// subgoal, the high level's goal).
+fn with_board(obs: &[f32], subgoal: SymbolicState, d: usize, out: &mut Vec<f32>) {
     out.extend_from_slice(obs);
     let at = out.len();
     out.resize(at + d, 0.0);
@@ -116,6 +136,15 @@ fn threshold(action: &[f32]) -> SymbolicState {
     SymbolicState::from_bools(&action.iter().map(|&v| v > 0.5).collect::<Vec<_>>())
 }
 
+/// The goal board of the game of `spec`.
+fn game_goal(spec: &EnvSpec) -> Result<SymbolicState, RlError> {
+    let game = spec
+        .game
+        .build(spec.board_size)
+        .map_err(seads_embodiment::EnvError::from)?;
+    Ok(game.goal())
+}
+
 /// The two levels' networks for `config` on an environment of `spec`.
 fn levels(config: &TrainConfig, spec: &EnvSpec) -> (Sac, Sac) {
     let d = spec.symbolic_len;
@@ -124,7 +153,7 @@ fn levels(config: &TrainConfig, spec: &EnvSpec) -> (Sac, Sac) {
         ..config.sac.clone()
     };
     let high = Sac::relaxed_bernoulli(
-        spec.obs_dim,
+        spec.obs_dim + d,
         d,
         config.hac.temperature,
         &high_config,
@@ -154,6 +183,7 @@ impl Hac {
         let spec = envs[0].spec().clone();
         let (high, low) = levels(&config, &spec);
         let d = spec.symbolic_len;
+        let goal = game_goal(&spec)?;
         let capacity = config.baseline.replay_capacity;
         let progress = Progress {
             epoch: 0,
@@ -167,10 +197,12 @@ impl Hac {
             streams: Streams::new(config.seed),
             open: Vec::new(),
             subgoals: vec![None; envs.len()],
+            ended_attempts: vec![Vec::new(); envs.len()],
         };
         let mut agent = Self {
             observations: vec![Vec::new(); envs.len()],
-            high_replay: Replay::new(capacity, spec.obs_dim, d),
+            high_replay: Replay::new(capacity, spec.obs_dim + d, d),
+            goal,
             low_replay: Replay::new(capacity, spec.obs_dim + d, spec.action_dim),
             config,
             spec,
@@ -205,6 +237,7 @@ impl Hac {
             None => self.progress.open.push(open),
         }
         self.progress.subgoals[slot] = None;
+        self.progress.ended_attempts[slot].clear();
         Ok(())
     }
 
@@ -256,6 +289,7 @@ impl Hac {
             &self.high,
             &self.low,
             &self.spec,
+            self.goal,
             self.config.hac.subgoal_horizon,
         )
     }
@@ -265,9 +299,15 @@ impl Hac {
     fn propose(&mut self, slot: usize) {
         let o = self.spec.obs_dim;
         let start = self.observations[slot].len() / o - 1;
-        let obs = &self.observations[slot][start * o..];
+        let mut input = Vec::new();
+        with_board(
+            &self.observations[slot][start * o..],
+            self.goal,
+            self.spec.symbolic_len,
+            &mut input,
+        );
         let streams = &mut self.progress.streams;
-        let action = self.high.act(obs, Some(&mut streams.collect));
+        let action = self.high.act(&input, Some(&mut streams.collect));
         let testing = streams.collect.random::<f64>() < self.config.hac.subgoal_test_p;
         self.progress.subgoals[slot] = Some(Attempt {
             subgoal: threshold(&action),
@@ -290,7 +330,7 @@ impl Hac {
         let mut inputs = Vec::new();
         for slot in 0..self.envs.len() {
             let attempt = self.progress.subgoals[slot].as_ref().expect("proposed");
-            low_input(self.current(slot), attempt.subgoal, d, &mut inputs);
+            with_board(self.current(slot), attempt.subgoal, d, &mut inputs);
         }
         let noisy = self
             .low
@@ -313,13 +353,13 @@ impl Hac {
             // The low level's transition toward its subgoal.
             let (mut from, mut to) = (Vec::new(), Vec::new());
             let steps = self.progress.open[slot].actions.len() / a;
-            low_input(
+            with_board(
                 self.observation(slot, steps - 1),
                 attempt.subgoal,
                 d,
                 &mut from,
             );
-            low_input(self.current(slot), attempt.subgoal, d, &mut to);
+            with_board(self.current(slot), attempt.subgoal, d, &mut to);
             let reward = if reached { 1.0 } else { 0.0 };
             self.low_replay.push(&from, action, reward, &to, reached);
             let attempt = Attempt {
@@ -336,6 +376,7 @@ impl Hac {
             if step.done {
                 self.progress.ended += 1;
                 self.progress.solved += u64::from(step.solved);
+                self.relabel_episode(slot);
                 self.start_episode(slot)?;
             }
         }
@@ -389,8 +430,8 @@ impl Hac {
             for i in attempt.start..end {
                 let next = self.spec.phi(self.observation(slot, i + 1)) == achieved;
                 let (mut from, mut to) = (Vec::new(), Vec::new());
-                low_input(self.observation(slot, i), achieved, d, &mut from);
-                low_input(self.observation(slot, i + 1), achieved, d, &mut to);
+                with_board(self.observation(slot, i), achieved, d, &mut from);
+                with_board(self.observation(slot, i + 1), achieved, d, &mut to);
                 let reward = if next { 1.0 } else { 0.0 };
                 self.low_replay
                     .push(&from, &actions[i * a..(i + 1) * a], reward, &to, next);
@@ -399,8 +440,14 @@ impl Hac {
         // The hindsight action transition: the board reached as the subgoal proposed.
         let mut reached_bits = vec![0.0; d];
         achieved.write_f32(&mut reached_bits);
-        let from = self.observation(slot, attempt.start).to_vec();
-        let to = self.current(slot).to_vec();
+        let (mut from, mut to) = (Vec::new(), Vec::new());
+        with_board(
+            self.observation(slot, attempt.start),
+            self.goal,
+            d,
+            &mut from,
+        );
+        with_board(self.current(slot), self.goal, d, &mut to);
         self.high_replay
             .push(&from, &reached_bits, attempt.reward, &to, episode_done);
         // Subgoal testing: a missed tested subgoal ends its return with the penalty.
@@ -410,9 +457,45 @@ impl Hac {
             self.high_replay
                 .push(&from, &proposed, MISSED_TEST_REWARD, &to, true);
         }
+        self.progress.ended_attempts[slot].push(Ended {
+            start: attempt.start,
+            end,
+        });
         self.progress.attempts += 1;
         self.progress.reached += u64::from(reached);
         self.progress.subgoals[slot] = None;
+    }
+
+    /// The high level's hindsight goal transitions of environment `slot`'s ended episode: toward
+    /// the board its last attempt ended on and those of two more attempts drawn at random, each
+    /// attempt up to that one is stored again (the board it reached as its action), rewarded 1
+    /// and ending its return where it reached the goal.
+    fn relabel_episode(&mut self, slot: usize) {
+        let ended = std::mem::take(&mut self.progress.ended_attempts[slot]);
+        let Some(last) = ended.len().checked_sub(1) else {
+            return;
+        };
+        let mut goals = vec![last];
+        for _ in 1..HINDSIGHT_GOALS {
+            goals.push(self.progress.streams.collect.random_range(0..ended.len()));
+        }
+        let d = self.spec.symbolic_len;
+        let mut bits = vec![0.0; d];
+        let (mut from, mut to) = (Vec::new(), Vec::new());
+        for j in goals {
+            let goal = self.spec.phi(self.observation(slot, ended[j].end));
+            for attempt in &ended[..=j] {
+                let achieved = self.spec.phi(self.observation(slot, attempt.end));
+                achieved.write_f32(&mut bits);
+                from.clear();
+                to.clear();
+                with_board(self.observation(slot, attempt.start), goal, d, &mut from);
+                with_board(self.observation(slot, attempt.end), goal, d, &mut to);
+                let hit = achieved == goal;
+                let reward = if hit { 1.0 } else { 0.0 };
+                self.high_replay.push(&from, &bits, reward, &to, hit);
+            }
+        }
     }
 
     /// Task success of the deterministic policy on `boards` test boards of each depth 1–5.
@@ -446,7 +529,10 @@ impl Hac {
         let progress: Progress =
             serde_json::from_str(&text).map_err(|e| RlError::unreadable(&path, e))?;
         let n = self.envs.len();
-        if progress.open.len() != n || progress.subgoals.len() != n {
+        if progress.open.len() != n
+            || progress.subgoals.len() != n
+            || progress.ended_attempts.len() != n
+        {
             return Err(RlError::Checkpoint {
                 path: path.display().to_string(),
                 reason: format!(
@@ -471,9 +557,14 @@ impl Hac {
                 obs.resize(rows + o, 0.0);
                 env.observe(&mut obs[rows..]);
             }
-            if let Some(attempt) = &progress.subgoals[slot]
-                && attempt.start * a > open.actions.len()
-            {
+            let steps = open.actions.len() / a;
+            let late = progress.subgoals[slot]
+                .as_ref()
+                .is_some_and(|attempt| attempt.start > steps)
+                || progress.ended_attempts[slot]
+                    .iter()
+                    .any(|e| e.start > e.end || e.end > steps);
+            if late {
                 return Err(RlError::Checkpoint {
                     path: path.display().to_string(),
                     reason: format!("a subgoal of environment {slot} starts after its episode"),
@@ -501,18 +592,20 @@ enum Levels<'a> {
     Owned(Box<(Sac, Sac)>),
 }
 
-/// Where the symbolic state lies in an observation.
+/// Where the symbolic state lies in an observation, and the game's goal board.
 #[derive(Clone, Copy)]
 struct SymbolicSlice {
     start: usize,
     len: usize,
+    goal: SymbolicState,
 }
 
 impl SymbolicSlice {
-    fn of(spec: &EnvSpec) -> Self {
+    fn of(spec: &EnvSpec, goal: SymbolicState) -> Self {
         Self {
             start: spec.manipulator_dim,
             len: spec.symbolic_len,
+            goal,
         }
     }
 
@@ -522,10 +615,16 @@ impl SymbolicSlice {
 }
 
 impl<'a> HacPolicy<'a> {
-    fn new(high: &'a Sac, low: &'a Sac, spec: &EnvSpec, horizon: usize) -> Self {
+    fn new(
+        high: &'a Sac,
+        low: &'a Sac,
+        spec: &EnvSpec,
+        goal: SymbolicState,
+        horizon: usize,
+    ) -> Self {
         Self {
             levels: Levels::Borrowed(high, low),
-            symbolic: SymbolicSlice::of(spec),
+            symbolic: SymbolicSlice::of(spec, goal),
             horizon,
             subgoal: None,
             input: Vec::new(),
@@ -542,7 +641,7 @@ impl HacPolicy<'static> {
         low.load_as(checkpoint, LOW_PREFIX, true)?;
         Ok(Self {
             levels: Levels::Owned(Box::new((high, low))),
-            symbolic: SymbolicSlice::of(spec),
+            symbolic: SymbolicSlice::of(spec, game_goal(spec)?),
             horizon: config.hac.subgoal_horizon,
             subgoal: None,
             input: Vec::new(),
@@ -561,13 +660,18 @@ impl TaskPolicy for HacPolicy<'_> {
             Levels::Owned(levels) => (&levels.0, &levels.1),
         };
         let board = self.symbolic.phi(obs);
+        let d = self.symbolic.len;
         let subgoal = match self.subgoal {
             Some((z, steps)) if steps < self.horizon && !(steps > 0 && board == z) => (z, steps),
-            _ => (threshold(&high.act(obs, None)), 0),
+            _ => {
+                self.input.clear();
+                with_board(obs, self.symbolic.goal, d, &mut self.input);
+                (threshold(&high.act(&self.input, None)), 0)
+            }
         };
         self.subgoal = Some((subgoal.0, subgoal.1 + 1));
         self.input.clear();
-        low_input(obs, subgoal.0, self.symbolic.len, &mut self.input);
+        with_board(obs, subgoal.0, d, &mut self.input);
         low.act(&self.input, None)
     }
 }
@@ -681,21 +785,29 @@ mod tests {
                 "hindsight goals reward the boards reached"
             );
             let high = &hac.high_replay;
-            let mut penalties = 0;
+            let (mut penalties, mut relabelled) = (0, 0);
             for i in 0..high.len() {
+                let next = &high.next_obs[i * (o + d)..(i + 1) * (o + d)];
+                let goal = SymbolicState::from_observation(&next[o..]);
                 let action = threshold(&high.actions[i * d..(i + 1) * d]);
-                if action != phi(&high.next_obs[i * o..(i + 1) * o]) {
+                if action != phi(&next[..o]) {
                     assert_eq!((high.rewards[i], high.dones[i]), (-1.0, 1.0), "{i}");
                     penalties += 1;
+                    continue;
                 }
+                let hit = phi(&next[..o]) == goal;
+                assert_eq!(
+                    high.rewards[i],
+                    f32::from(u8::from(hit)),
+                    "high transition {i}"
+                );
+                assert!(high.dones[i] >= high.rewards[i]);
+                relabelled += usize::from(goal != hac.goal);
             }
+            assert!(relabelled > 0, "hindsight goals other than the game's");
             let p = &hac.progress;
             assert!(p.attempts > 20);
             let missed = (p.attempts - p.reached) as usize;
-            assert_eq!(
-                high.len(),
-                p.attempts as usize + if test_p > 0.0 { missed } else { 0 }
-            );
             assert_eq!(penalties, if test_p > 0.0 { missed } else { 0 });
         }
     }
