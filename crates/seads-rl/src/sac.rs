@@ -152,7 +152,7 @@ pub const RESUME_FILES: [&str; 4] = [
 ];
 
 /// The checkpoint files of a SAC agent saved under `prefix` ([`Sac::save_as`]), the actor first:
-/// `sac` gives [`ACTOR_FILE`] and [`RESUME_FILES`].
+/// `sac` gives the files of [`Sac::save`].
 pub fn checkpoint_files(prefix: &str) -> [String; 5] {
     ["actor", "critic", "target", "actor_adam", "critic_adam"]
         .map(|part| format!("{prefix}_{part}.safetensors"))
