@@ -1,7 +1,9 @@
 //! Reinforcement learning for SEADS: soft actor-critic on tch (SPEC §3.2) and the SEADS training
 //! loop of Algorithm 3 (SPEC §3.3, §3.7) — episode collection in lockstep with batched policy
 //! calls, long- and short-term episode buffers, relabelling with the skill model, skill-model and
-//! SAC updates, skill coverage, checkpoints and run directories.
+//! SAC updates, skill coverage, checkpoints and run directories. Beside SEADS, the two baselines
+//! trained with the task reward (SPEC §5): flat SAC ([`TaskSac`]) and two-level HAC ([`Hac`]),
+//! driven by the same [`Run`] and evaluated on the same protocol ([`task_success`]).
 //!
 //! Architecture invariant: with `seads-skillmodel`, the only crate that links libtorch. No
 //! printing; the binary shows progress from the values [`Run::step`] returns. Every random
