@@ -7,7 +7,8 @@ use anyhow::{Context, Result};
 use clap::Args;
 use indicatif::{ProgressBar, ProgressStyle};
 use seads_rl::{
-    Algorithm, Hac, Hook, Learner, Moment, Run, TaskMetrics, TaskSac, TrainConfig, Trainer,
+    Algorithm, Hac, Hook, Learner, Moment, Run, TaskEpochStats, TaskMetrics, TaskSac, TrainConfig,
+    Trainer,
 };
 
 use crate::BadInput;
@@ -211,7 +212,18 @@ impl Shown for Trainer {
     }
 }
 
-impl Shown for TaskSac {
+/// A task-reward baseline as `seads train` shows it: all report [`TaskEpochStats`] and
+/// [`TaskMetrics`], and differ only in what they add to the headline and in their phases.
+pub trait ShownBaseline: Learner<Stats = TaskEpochStats, Metrics = TaskMetrics> {
+    /// Environment steps so far.
+    fn env_steps(&self) -> u64;
+    /// What the baseline adds to an evaluation's headline ("" for none).
+    fn extra(&self) -> String;
+    /// The time per phase, one line.
+    fn phases(&self) -> String;
+}
+
+impl<B: ShownBaseline> Shown for B {
     fn steps(&self) -> u64 {
         self.env_steps()
     }
@@ -222,7 +234,19 @@ impl Shown for TaskSac {
         (m.epoch, m.env_steps, m.steps_per_s)
     }
     fn headline(&self, m: &Self::Metrics) -> String {
-        task_headline(m)
+        format!("{}{}", task_headline(m), self.extra())
+    }
+    fn phases(&self) -> String {
+        ShownBaseline::phases(self)
+    }
+}
+
+impl ShownBaseline for TaskSac {
+    fn env_steps(&self) -> u64 {
+        TaskSac::env_steps(self)
+    }
+    fn extra(&self) -> String {
+        String::new()
     }
     fn phases(&self) -> String {
         let t = self.timings();
@@ -233,20 +257,13 @@ impl Shown for TaskSac {
     }
 }
 
-impl Shown for Hac {
-    fn steps(&self) -> u64 {
-        self.env_steps()
+impl ShownBaseline for Hac {
+    fn env_steps(&self) -> u64 {
+        Hac::env_steps(self)
     }
-    fn stats_steps(stats: &Self::Stats) -> (u64, u64) {
-        (stats.epoch, stats.env_steps)
-    }
-    fn metrics_steps(m: &Self::Metrics) -> (u64, u64, f64) {
-        (m.epoch, m.env_steps, m.steps_per_s)
-    }
-    fn headline(&self, m: &Self::Metrics) -> String {
+    fn extra(&self) -> String {
         format!(
-            "{}  subgoals reached {:.1} %",
-            task_headline(m),
+            "  subgoals reached {:.1} %",
             100.0 * self.subgoals_reached()
         )
     }
