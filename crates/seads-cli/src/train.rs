@@ -218,7 +218,7 @@ pub trait ShownBaseline: Learner<Stats = TaskEpochStats, Metrics = TaskMetrics> 
     /// Environment steps so far.
     fn env_steps(&self) -> u64;
     /// What the baseline adds to an evaluation's headline ("" for none).
-    fn extra(&self) -> String;
+    fn extra(&self, m: &TaskMetrics) -> String;
     /// The time per phase, one line.
     fn phases(&self) -> String;
 }
@@ -234,7 +234,7 @@ impl<B: ShownBaseline> Shown for B {
         (m.epoch, m.env_steps, m.steps_per_s)
     }
     fn headline(&self, m: &Self::Metrics) -> String {
-        format!("{}{}", task_headline(m), self.extra())
+        format!("{}{}", task_headline(m), self.extra(m))
     }
     fn phases(&self) -> String {
         ShownBaseline::phases(self)
@@ -245,7 +245,7 @@ impl ShownBaseline for TaskSac {
     fn env_steps(&self) -> u64 {
         TaskSac::env_steps(self)
     }
-    fn extra(&self) -> String {
+    fn extra(&self, _: &TaskMetrics) -> String {
         String::new()
     }
     fn phases(&self) -> String {
@@ -261,10 +261,11 @@ impl ShownBaseline for Hac {
     fn env_steps(&self) -> u64 {
         Hac::env_steps(self)
     }
-    fn extra(&self) -> String {
+    fn extra(&self, m: &TaskMetrics) -> String {
+        let recent = m.subgoals_reached.unwrap_or_default();
         format!(
-            "  subgoals reached {:.1} %",
-            100.0 * self.subgoals_reached()
+            "  subgoals reached {:.1} % (since the last line)",
+            100.0 * recent
         )
     }
     fn phases(&self) -> String {

@@ -180,6 +180,13 @@ fn trains_resumes_evaluates_and_is_reported(algorithm: &str) {
         .map(|m| m["epoch"].as_u64().unwrap())
         .collect();
     assert_eq!(epochs, [1, 10, 20, 30]);
+    // HAC records the share of subgoals reached since the previous line; SAC has none.
+    for m in metrics(&run) {
+        match m.get("subgoals_reached").and_then(|v| v.as_f64()) {
+            Some(share) => assert!(algorithm == "hac" && (0.0..=1.0).contains(&share), "{m}"),
+            None => assert_eq!(algorithm, "sac", "{m}"),
+        }
+    }
     // More budget: the run continues from its last checkpoint.
     seads_ok(&[
         "train",

@@ -97,6 +97,9 @@ struct Progress {
     /// Subgoal attempts ended, and how many reached their subgoal.
     attempts: u64,
     reached: u64,
+    /// `attempts` and `reached` at the last metrics line.
+    #[serde(default)]
+    reported: (u64, u64),
     timings: TaskTimings,
     streams: Streams,
     open: Vec<OpenEpisode>,
@@ -193,6 +196,7 @@ impl Hac {
             solved: 0,
             attempts: 0,
             reached: 0,
+            reported: (0, 0),
             timings: TaskTimings::default(),
             streams: Streams::new(config.seed),
             open: Vec::new(),
@@ -702,15 +706,19 @@ impl Learner for Hac {
     }
     fn metrics(&mut self, stats: &TaskEpochStats, wall_s: f64) -> Result<TaskMetrics, RlError> {
         let results = self.task_success(self.config.baseline.eval_boards)?;
-        let p = &self.progress;
-        Ok(TaskMetrics::new(
+        let p = &mut self.progress;
+        let mut line = TaskMetrics::new(
             &results,
             (p.epoch, p.env_steps),
             wall_s,
             p.solved as f64 / p.ended.max(1) as f64,
             stats,
             p.timings,
-        ))
+        );
+        let (attempts, reached) = (p.attempts - p.reported.0, p.reached - p.reported.1);
+        line.subgoals_reached = Some(reached as f64 / attempts.max(1) as f64);
+        p.reported = (p.attempts, p.reached);
+        Ok(line)
     }
     fn save(&self, dir: &Path) -> Result<(), RlError> {
         Hac::save(self, dir)

@@ -132,6 +132,10 @@ pub struct TaskMetrics {
     pub steps_per_s: f64,
     /// Seconds per phase since the start of the run.
     pub timings: TaskTimings,
+    /// HAC: share of the subgoal attempts ended since the previous line that reached their
+    /// subgoal (absent for SAC).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub subgoals_reached: Option<f64>,
 }
 
 impl TaskMetrics {
@@ -159,6 +163,7 @@ impl TaskMetrics {
             actor_loss: stats.sac.actor,
             steps_per_s: env_steps as f64 / wall_s.max(1e-9),
             timings,
+            subgoals_reached: None,
         }
     }
 }
