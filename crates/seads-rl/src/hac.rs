@@ -123,6 +123,8 @@ pub struct Hac {
     progress: Progress,
     /// The game's goal board.
     goal: SymbolicState,
+    /// Reused buffers for a transition's two inputs (no allocation per environment step).
+    scratch: [Vec<f32>; 2],
 }
 
 /// An input of either level: the observation followed by a board's D bits (the low level's
@@ -207,6 +209,7 @@ impl Hac {
             observations: vec![Vec::new(); envs.len()],
             high_replay: Replay::new(capacity, spec.obs_dim + d, d),
             goal,
+            scratch: [Vec::new(), Vec::new()],
             low_replay: Replay::new(capacity, spec.obs_dim + d, spec.action_dim),
             config,
             spec,
@@ -355,7 +358,9 @@ impl Hac {
             self.progress.open[slot].actions.extend_from_slice(action);
             let reached = self.spec.phi(self.current(slot)) == attempt.subgoal;
             // The low level's transition toward its subgoal.
-            let (mut from, mut to) = (Vec::new(), Vec::new());
+            let [mut from, mut to] = std::mem::take(&mut self.scratch);
+            from.clear();
+            to.clear();
             let steps = self.progress.open[slot].actions.len() / a;
             with_board(
                 self.observation(slot, steps - 1),
@@ -366,6 +371,7 @@ impl Hac {
             with_board(self.current(slot), attempt.subgoal, d, &mut to);
             let reward = if reached { 1.0 } else { 0.0 };
             self.low_replay.push(&from, action, reward, &to, reached);
+            self.scratch = [from, to];
             let attempt = Attempt {
                 reward: attempt.reward + step.reward,
                 ..attempt
@@ -430,10 +436,12 @@ impl Hac {
         let end = actions.len() / a;
         let achieved = self.spec.phi(self.current(slot));
         // Hindsight goal transitions: the missed attempt as one toward the board it ended on.
+        let [mut from, mut to] = std::mem::take(&mut self.scratch);
         if !reached {
             for i in attempt.start..end {
                 let next = self.spec.phi(self.observation(slot, i + 1)) == achieved;
-                let (mut from, mut to) = (Vec::new(), Vec::new());
+                from.clear();
+                to.clear();
                 with_board(self.observation(slot, i), achieved, d, &mut from);
                 with_board(self.observation(slot, i + 1), achieved, d, &mut to);
                 let reward = if next { 1.0 } else { 0.0 };
@@ -444,7 +452,8 @@ impl Hac {
         // The hindsight action transition: the board reached as the subgoal proposed.
         let mut reached_bits = vec![0.0; d];
         achieved.write_f32(&mut reached_bits);
-        let (mut from, mut to) = (Vec::new(), Vec::new());
+        from.clear();
+        to.clear();
         with_board(
             self.observation(slot, attempt.start),
             self.goal,
@@ -461,6 +470,7 @@ impl Hac {
             self.high_replay
                 .push(&from, &proposed, MISSED_TEST_REWARD, &to, true);
         }
+        self.scratch = [from, to];
         self.progress.ended_attempts[slot].push(Ended {
             start: attempt.start,
             end,
