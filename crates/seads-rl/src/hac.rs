@@ -285,11 +285,6 @@ impl Hac {
         self.progress.timings
     }
 
-    /// Share of the subgoal attempts ended so far that reached their subgoal.
-    pub fn subgoals_reached(&self) -> f64 {
-        self.progress.reached as f64 / self.progress.attempts.max(1) as f64
-    }
-
     /// The deterministic two-level policy.
     pub fn policy(&self) -> HacPolicy<'_> {
         HacPolicy::new(
