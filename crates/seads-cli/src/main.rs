@@ -103,6 +103,51 @@ fn keep_freed_memory() {
     }
 }
 
+/// Whether `command` trains, where libtorch runs parallel regions on several threads.
+fn trains(command: &Command) -> bool {
+    matches!(
+        command,
+        Command::Run(_)
+            | Command::Train(_)
+            | Command::Sweep(sweep::SweepCommand::Run(_) | sweep::SweepCommand::Task(_))
+            | Command::Uarm(uarm::UarmCommand::Train(_))
+    )
+}
+
+/// The variable that bounds how long libtorch's OpenMP threads (libgomp) spin before they sleep.
+const SPIN: &str = "GOMP_SPINCOUNT";
+
+/// Makes libgomp's idle threads spin 1000 iterations before they sleep instead of its default
+/// 300000, by running this program again with `GOMP_SPINCOUNT=1000` (libgomp reads it when it is
+/// loaded, before `main`). On a machine whose cores are busy with other work (a second run, the
+/// other worker of a sweep), a thread spinning at a barrier holds the core that the thread it
+/// waits for needs. A 10⁴-step LightsOutCursor run with two SAC threads beside two or three busy
+/// single-threaded processes did not reach step 4473 in 150 s with the default, and finished in
+/// 33–50 s at 1000 (3000: 58 s, 10000: 60–84 s); alone on the machine it takes 5 % longer at
+/// 1000 (15.4 → 16.2 s, docs/RESULTS.md). The same numbers either way: only waiting changes. A
+/// user's own `GOMP_SPINCOUNT` or `OMP_WAIT_POLICY` is kept. If the program cannot be run again,
+/// it goes on as it is.
+fn spin_briefly_in_libgomp() {
+    #[cfg(unix)]
+    {
+        use std::os::unix::process::CommandExt;
+        if std::env::var_os(SPIN).is_some() || std::env::var_os("OMP_WAIT_POLICY").is_some() {
+            return;
+        }
+        let Ok(exe) = std::env::current_exe() else {
+            return;
+        };
+        let mut args = std::env::args_os();
+        let arg0 = args.next().unwrap_or_else(|| exe.clone().into_os_string());
+        // Returns only on failure; the process then runs with libgomp's defaults.
+        let _ = std::process::Command::new(exe)
+            .arg0(arg0)
+            .args(args)
+            .env(SPIN, "1000")
+            .exec();
+    }
+}
+
 /// Ends the process quietly when its output pipe closes (`seads sweep status | head`), as other
 /// Unix tools do: Rust ignores SIGPIPE, so a print to a closed pipe would panic instead.
 fn die_quietly_on_closed_pipes() {
@@ -119,6 +164,9 @@ fn main() -> ExitCode {
     keep_freed_memory();
     die_quietly_on_closed_pipes();
     let cli = Cli::parse();
+    if trains(&cli.command) {
+        spin_briefly_in_libgomp();
+    }
     let result = match cli.command {
         Command::Games(cmd) => games::run(cmd),
         Command::Run(args) => demo::run(args),
@@ -136,6 +184,7 @@ fn main() -> ExitCode {
         Command::Report(args) => report::report(args),
         Command::Uarm(uarm::UarmCommand::Calibrate(args)) => uarm::calibrate(args),
         Command::Uarm(uarm::UarmCommand::Train(args)) => uarm::train(args),
+        Command::Uarm(uarm::UarmCommand::Evaluate(args)) => uarm::evaluate_run(args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -8,10 +8,10 @@ use anyhow::{Context, Result};
 use clap::Args;
 use plotters::coord::Shift;
 use plotters::prelude::*;
-use seads_embodiment::{EnvConfig, SkillRun, execute_skill};
+use seads_embodiment::{EnvConfig, Environment, SkillRun, execute_skill};
 use seads_games::Split;
 use seads_planner::DepthResult;
-use seads_rl::{Agent, COVERAGE_SEED, read_metrics};
+use seads_rl::{Agent, AgentPolicy, COVERAGE_SEED, find_checkpoint, read_metrics};
 
 use crate::draw::{draw_paths, draw_scene, plot_err, render_to, skill_colour};
 use crate::envs::build_env;
@@ -71,19 +71,32 @@ pub fn write_figures(
     let metrics = read_metrics(run)?;
     let config = seads_rl::load_config(run)?;
     let title = format!("{} (seed {})", config.env, config.seed);
-    if !seads_embodiment::env_names().contains(&config.env.as_str()) {
-        // A robot run: its environment is the hardware (or its twin), so only what the run
-        // directory holds is drawn; `seads uarm train` evaluates and draws the rest itself.
-        let k = crate::envs::run_skills(&config);
+    if let Some(mut twin) = crate::uarm::twin_for_figures(&config)? {
+        // A robot run: its skills are shown on the twin, and its success is what `seads uarm
+        // train` measured (with re-planning only).
+        let spec = twin.spec().clone();
+        let agent = Agent::load_for(config, spec, &find_checkpoint(run, checkpoint)?)?;
+        let k = agent.policy_skills();
         both("coverage", &|p| coverage_figure(p, &metrics, k, &title))?;
+        let saved = run.join("evaluation-replan.json");
+        if saved.exists() {
+            let text = std::fs::read_to_string(&saved)
+                .with_context(|| format!("reading {}", saved.display()))?;
+            let replan = [(
+                true,
+                serde_json::from_str(&text)
+                    .with_context(|| format!("reading {}", saved.display()))?,
+            )];
+            both("success", &|p| success_figure(p, &replan, &title))?;
+        }
         if !quiet {
             eprintln!(
-                "seads: {} is a robot run ({}): skill coverage only; trajectories need the robot",
+                "seads: {} is a robot run ({}): its skills are drawn as the twin executes them",
                 run.display(),
-                config.env
+                agent.config.env
             );
         }
-        return Ok(written);
+        return skill_figures(&mut twin, &agent, &title, both).map(|()| written);
     }
     let mut agent = load_agent(run, checkpoint)?;
     let k = agent.policy_skills();
@@ -97,24 +110,33 @@ pub fn write_figures(
             run.display()
         );
     }
-    let runs = skill_runs(&agent)?;
-    let scene = {
-        let mut env = build_env(
-            &agent.config.env,
-            &EnvConfig {
-                reset_split: Split::Test,
-                ..agent.config.env_config.clone()
-            },
-        )?;
-        env.seed(COVERAGE_SEED);
-        env.reset()?;
-        env.scene()
-    };
-    both("trajectories", &|p| {
-        trajectories_figure(p, &scene, &runs, &title)
-    })?;
-    both("pushes", &|p| pushes_figure(p, &scene, &runs, &title))?;
+    let mut env = build_env(
+        &agent.config.env,
+        &EnvConfig {
+            reset_split: Split::Test,
+            ..agent.config.env_config.clone()
+        },
+    )?;
+    skill_figures(env.as_mut(), &agent, &title, both)?;
     Ok(written)
+}
+
+/// The trajectories and push points of every skill, executed in `env` from the 20 coverage
+/// initialisations.
+fn skill_figures(
+    env: &mut dyn Environment,
+    agent: &Agent,
+    title: &str,
+    mut both: impl FnMut(&str, &dyn Fn(&Path) -> Result<()>) -> Result<()>,
+) -> Result<()> {
+    let runs = skill_runs(env, &agent.policy)?;
+    env.seed(COVERAGE_SEED);
+    env.reset()?;
+    let scene = env.scene();
+    both("trajectories", &|p| {
+        trajectories_figure(p, &scene, &runs, title)
+    })?;
+    both("pushes", &|p| pushes_figure(p, &scene, &runs, title))
 }
 
 trait PolicySkills {
@@ -160,22 +182,18 @@ fn evaluations(
     Ok([(true, load(true)?), (false, load(false)?)])
 }
 
-/// Every skill executed from the 20 coverage initialisations (test boards, training reset
-/// distribution): `runs[k]` holds skill k's 20 executions.
-fn skill_runs(agent: &Agent) -> Result<Vec<Vec<SkillRun>>> {
-    let config = EnvConfig {
-        reset_split: Split::Test,
-        ..agent.config.env_config.clone()
-    };
-    let mut env = build_env(&agent.config.env, &config)?;
-    let k = seads_embodiment::SkillPolicy::num_skills(&agent.policy);
+/// Every skill executed from the 20 coverage initialisations of `env` (for registry
+/// environments, test boards under the training reset distribution): `runs[k]` holds skill k's 20
+/// executions.
+fn skill_runs(env: &mut dyn Environment, policy: &AgentPolicy) -> Result<Vec<Vec<SkillRun>>> {
+    let k = seads_embodiment::SkillPolicy::num_skills(policy);
     (0..k)
         .map(|skill| {
             (0..20)
                 .map(|i| {
                     env.seed(COVERAGE_SEED + i);
                     env.reset()?;
-                    Ok(execute_skill(env.as_mut(), &agent.policy, skill)?)
+                    Ok(execute_skill(env, policy, skill)?)
                 })
                 .collect()
         })
@@ -232,11 +250,7 @@ fn coverage_figure(out: &Path, metrics: &[seads_rl::Metrics], k: usize, title: &
     })
 }
 
-fn success_figure(
-    out: &Path,
-    evaluations: &[(bool, Vec<DepthResult>); 2],
-    title: &str,
-) -> Result<()> {
+fn success_figure(out: &Path, evaluations: &[(bool, Vec<DepthResult>)], title: &str) -> Result<()> {
     render_to!(out, (800, 500), |area: &DrawingArea<_, Shift>| {
         let max_depth = evaluations
             .iter()

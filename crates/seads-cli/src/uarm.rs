@@ -1,20 +1,24 @@
 //! `seads uarm …`: the real robot (uArm Swift Pro + LightsOut tablet) or its simulated twin.
 
+use std::collections::BTreeMap;
 use std::io::BufRead;
 use std::path::{Path, PathBuf};
 
 use anyhow::{Context, Result, bail};
 use clap::{Args, Subcommand};
+use indicatif::ProgressBar;
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 use seads_embodiment::Environment;
 use seads_games::{BoardDataset, BoardGame, Gf2Solver, LightsOut, Split};
-use seads_planner::{PlannerConfig, SolveConfig, solve};
-use seads_rl::{Agent, Run, TrainConfig, Trainer, latest_checkpoint, load_config};
+use seads_planner::{DepthResult, PlannerConfig, SolveConfig, solve};
+use seads_rl::{Agent, Run, TrainConfig, Trainer, find_checkpoint, latest_checkpoint, load_config};
 use seads_uarm::{
     ActionSpace, AdbTablet, Calibration, CalibrationFile, DriverConfig, SerialTransport, Swift,
     Tablet, Twin, UarmConfig, UarmEnv, twin_screen_corners,
 };
+
+use serde::{Deserialize, Serialize};
 
 use crate::BadInput;
 
@@ -25,6 +29,8 @@ pub enum UarmCommand {
     Calibrate(CalibrateArgs),
     /// Train SEADS on the robot (or its twin) and report success on test boards.
     Train(UarmTrainArgs),
+    /// Success on test boards of a robot run's checkpoint (the latest, or --checkpoint).
+    Evaluate(UarmEvaluateArgs),
 }
 
 /// Where the robot is.
@@ -88,7 +94,8 @@ pub struct CalibrateArgs {
 const CORNERS: [&str; 4] = ["top-left", "top-right", "bottom-right", "bottom-left"];
 
 /// Records the corners: a person places the pen on each (with the twin, a simulated person).
-fn record_corners(arm: &mut Swift, twin: Option<&Twin>) -> Result<[[f64; 3]; 4]> {
+/// Each is printed unless `quiet`.
+fn record_corners(arm: &mut Swift, twin: Option<&Twin>, quiet: bool) -> Result<[[f64; 3]; 4]> {
     arm.detach().context("detaching the servos")?;
     let mut corners = [[0.0; 3]; 4];
     let stdin = std::io::stdin();
@@ -106,10 +113,12 @@ fn record_corners(arm: &mut Swift, twin: Option<&Twin>) -> Result<[[f64; 3]; 4]>
         corners[i] = arm
             .position()
             .with_context(|| format!("reading the {name} corner"))?;
-        println!(
-            "{name}: X {:.1}  Y {:.1}  Z {:.1} mm",
-            corners[i][0], corners[i][1], corners[i][2]
-        );
+        if !quiet {
+            println!(
+                "{name}: X {:.1}  Y {:.1}  Z {:.1} mm",
+                corners[i][0], corners[i][1], corners[i][2]
+            );
+        }
     }
     arm.attach().context("attaching the servos")?;
     Ok(corners)
@@ -119,7 +128,7 @@ fn record_corners(arm: &mut Swift, twin: Option<&Twin>) -> Result<[[f64; 3]; 4]>
 pub fn calibrate(args: CalibrateArgs) -> Result<()> {
     let twin = args.connection.twin()?;
     let mut arm = args.connection.arm(twin.as_ref())?;
-    let corners = record_corners(&mut arm, twin.as_ref())?;
+    let corners = record_corners(&mut arm, twin.as_ref(), false)?;
     let calibration = Calibration::fit(CalibrationFile {
         corners,
         d_max_mm: args.d_max_mm,
@@ -166,6 +175,14 @@ pub struct UarmTrainArgs {
     /// One line per evaluation instead of a progress bar.
     #[arg(long)]
     quiet: bool,
+    /// Cores this run may use; its libtorch threads follow them (default: the preset's threads,
+    /// for a machine that runs nothing else).
+    #[arg(long, value_parser = clap::value_parser!(u64).range(1..=1024))]
+    cores: Option<u64>,
+    /// The twin only: draw a new board and pen position at the start of every training episode.
+    /// The paper's arm resets neither (seed S.5), and neither does the twin without this flag.
+    #[arg(long)]
+    reset_board: bool,
 }
 
 fn parse_space(text: &str) -> Result<ActionSpace, String> {
@@ -178,33 +195,78 @@ fn parse_space(text: &str) -> Result<ActionSpace, String> {
     }
 }
 
-fn build_env(args: &UarmTrainArgs, twin: Option<&Twin>) -> Result<UarmEnv> {
-    let calibration = match (&args.calibration, twin) {
+fn build_env(
+    connection: &Connection,
+    calibration: Option<&Path>,
+    action_space: ActionSpace,
+    reset_board: bool,
+    twin: Option<&Twin>,
+) -> Result<UarmEnv> {
+    if reset_board && twin.is_none() {
+        bail!(BadInput(anyhow::anyhow!(
+            "--reset-board needs the twin (--port sim): the real tablet's board cannot be set"
+        )));
+    }
+    let calibration = match (calibration, twin) {
         (Some(path), _) => Calibration::load(path).map_err(|e| BadInput(e.into()))?,
-        (None, Some(twin)) => {
-            let mut arm = args.connection.arm(Some(twin))?;
-            Calibration::fit(CalibrationFile {
-                corners: record_corners(&mut arm, Some(twin))?,
-                d_max_mm: 100.0,
-            })?
-        }
+        (None, Some(twin)) => calibrate_twin(connection, twin, false)?,
         (None, None) => bail!(BadInput(anyhow::anyhow!(
             "the real arm needs --calibration (see `seads uarm calibrate`)"
         ))),
     };
-    let step_limit = match args.action_space {
-        ActionSpace::Absolute => 1,
-        ActionSpace::Displacement => 10,
-    };
     let config = UarmConfig {
-        action_space: args.action_space,
-        step_limit,
-        reset_board: twin.is_some(),
+        action_space,
+        step_limit: step_limit(action_space),
+        reset_board,
         tap_timeout_s: if twin.is_some() { 0.0 } else { 2.0 },
     };
-    let arm = args.connection.arm(twin)?;
-    let tablet = args.connection.tablet(twin)?;
+    let arm = connection.arm(twin)?;
+    let tablet = connection.tablet(twin)?;
     Ok(UarmEnv::new(arm, tablet, calibration, config)?)
+}
+
+/// The twin calibrated on the spot, as a person would calibrate the arm.
+fn calibrate_twin(connection: &Connection, twin: &Twin, quiet: bool) -> Result<Calibration> {
+    let mut arm = connection.arm(Some(twin))?;
+    Ok(Calibration::fit(CalibrationFile {
+        corners: record_corners(&mut arm, Some(twin), quiet)?,
+        d_max_mm: 100.0,
+    })?)
+}
+
+/// Steps per skill: one press, or as many displacements as the Cursor's skills take.
+fn step_limit(space: ActionSpace) -> usize {
+    match space {
+        ActionSpace::Absolute => 1,
+        ActionSpace::Displacement => 10,
+    }
+}
+
+/// The twin acting as the robot run `config` did, to show its skills: every reset draws a new
+/// board and pen position, like the Cursor's coverage initialisations. `None` when `config` is not
+/// a robot run.
+pub fn twin_for_figures(config: &TrainConfig) -> Result<Option<UarmEnv>> {
+    let Some(space) = ActionSpace::of_env(&config.env) else {
+        return Ok(None);
+    };
+    let twin = Twin::new(0);
+    let connection = Connection {
+        port: "sim".into(),
+        adb: String::new(),
+    };
+    let calibration = calibrate_twin(&connection, &twin, true)?;
+    let config = UarmConfig {
+        action_space: space,
+        step_limit: step_limit(space),
+        reset_board: true,
+        tap_timeout_s: 0.0,
+    };
+    Ok(Some(UarmEnv::new(
+        connection.arm(Some(&twin))?,
+        connection.tablet(Some(&twin))?,
+        calibration,
+        config,
+    )?))
 }
 
 /// The training settings of the robot (seed S.5): the Cursor's, with SAC α = 0.1 and, for
@@ -230,33 +292,172 @@ pub fn train(args: UarmTrainArgs) -> Result<()> {
         TrainConfig::preset("lightsout-cursor")?.portable_numerics
     };
     crate::kernels::use_kernels(portable)?;
+    let mut args = args;
+    if args.resume {
+        adopt_run_settings(&mut args)?;
+    }
     let twin = args.connection.twin()?;
-    let env = build_env(&args, twin.as_ref())?;
-    let trainer =
-        |config: TrainConfig| Trainer::with_environments(config, env.box_clone(), env.box_clone());
+    let env = build_env(
+        &args.connection,
+        args.calibration.as_deref(),
+        args.action_space,
+        args.reset_board,
+        twin.as_ref(),
+    )?;
+    let cores = args.cores.map(|c| c as usize);
+    if let Some(cores) = cores {
+        seads_rl::set_threads(cores);
+    }
+    let trainer = |mut config: TrainConfig| {
+        if let Some(cores) = cores {
+            (config.threads, config.sac_threads_alone) = crate::sweep::task::thread_split(cores);
+        }
+        Trainer::with_environments(config, env.box_clone(), env.box_clone())
+    };
     let mut run = if args.resume {
         crate::train::resume(&args.out, Run::resume_with(&args.out, trainer))?
     } else {
-        Run::with_trainer(&args.out, trainer(robot_config(&env, &args)?)?)
-            .map_err(|e| BadInput(e.into()))?
+        let run = Run::with_trainer(&args.out, trainer(robot_config(&env, &args)?)?)
+            .map_err(|e| BadInput(e.into()))?;
+        let settings = RobotSettings {
+            action_space: args.action_space,
+            reset_board: args.reset_board,
+        };
+        seads_rl::write_atomic(
+            &args.out.join(ROBOT_SETTINGS),
+            toml::to_string(&settings)?.as_bytes(),
+        )?;
+        run
     };
     crate::train::drive(&mut run, args.quiet)?;
     drop(run);
-    evaluate(&args.out, env, twin.is_some(), args.boards, args.timeout)
+    let checkpoint = latest_checkpoint(&args.out)?.context("the run has no checkpoint")?;
+    evaluate(
+        &args.out,
+        &checkpoint,
+        "evaluation-replan.json",
+        env,
+        twin.is_some(),
+        args.boards,
+        args.timeout,
+        args.quiet,
+    )
+}
+
+/// What a robot run's `config.toml` does not hold: how the arm acts and whether the twin resets
+/// the board. A resumed run keeps them.
+#[derive(Debug, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RobotSettings {
+    action_space: ActionSpace,
+    reset_board: bool,
+}
+
+const ROBOT_SETTINGS: &str = "robot.toml";
+
+/// The settings `robot.toml` of the run in `run` records; `None` for a run from before it.
+fn run_settings(run: &Path) -> Result<Option<RobotSettings>> {
+    let path = run.join(ROBOT_SETTINGS);
+    let text = match std::fs::read_to_string(&path) {
+        Ok(text) => text,
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok(None),
+        Err(e) => return Err(e).with_context(|| format!("reading {}", path.display())),
+    };
+    toml::from_str(&text)
+        .map(Some)
+        .map_err(|e| BadInput(anyhow::anyhow!("{}: {}", path.display(), e.message())).into())
+}
+
+/// A resumed run acts as it was trained, whatever `--action-space` and `--reset-board` say. A run
+/// from before `robot.toml` keeps the flags given.
+fn adopt_run_settings(args: &mut UarmTrainArgs) -> Result<()> {
+    if let Some(settings) = run_settings(&args.out)? {
+        args.action_space = settings.action_space;
+        args.reset_board = settings.reset_board;
+    }
+    Ok(())
+}
+
+/// Arguments of `seads uarm evaluate`.
+#[derive(Debug, Args)]
+pub struct UarmEvaluateArgs {
+    #[command(flatten)]
+    connection: Connection,
+    /// Calibration file (default for the twin: calibrate it on the spot).
+    #[arg(long)]
+    calibration: Option<PathBuf>,
+    /// Run directory of a robot run (from `seads uarm train`).
+    #[arg(long)]
+    run: PathBuf,
+    /// Evaluate the checkpoint of this epoch instead of the latest; its results go to
+    /// `evaluation-replan-epoch-<EPOCH>.json`.
+    #[arg(long)]
+    checkpoint: Option<u64>,
+    /// Test boards per solution depth 1–5.
+    #[arg(long, default_value_t = 20)]
+    boards: usize,
+    /// Time limit per search, seconds.
+    #[arg(long, default_value_t = 60.0, value_parser = crate::positive_finite)]
+    timeout: f64,
+    /// No progress bar.
+    #[arg(long)]
+    quiet: bool,
+}
+
+/// `seads uarm evaluate`: success with re-planning of a robot run's checkpoint, as at the end of
+/// `seads uarm train`.
+pub fn evaluate_run(args: UarmEvaluateArgs) -> Result<()> {
+    let config =
+        load_config(&args.run).with_context(|| format!("loading run {}", args.run.display()))?;
+    crate::kernels::use_kernels(config.portable_numerics)?;
+    let action_space = ActionSpace::of_env(&config.env).ok_or_else(|| {
+        BadInput(anyhow::anyhow!(
+            "{} is a {} run, not a robot run (see `seads evaluate`)",
+            args.run.display(),
+            config.env
+        ))
+    })?;
+    let checkpoint = find_checkpoint(&args.run, args.checkpoint).map_err(|e| BadInput(e.into()))?;
+    let twin = args.connection.twin()?;
+    let env = build_env(
+        &args.connection,
+        args.calibration.as_deref(),
+        action_space,
+        false,
+        twin.as_ref(),
+    )?;
+    let file = match args.checkpoint {
+        Some(epoch) => format!("evaluation-replan-epoch-{epoch:06}.json"),
+        None => "evaluation-replan.json".to_owned(),
+    };
+    evaluate(
+        &args.run,
+        &checkpoint,
+        &file,
+        env,
+        twin.is_some(),
+        args.boards,
+        args.timeout,
+        args.quiet,
+    )
 }
 
 /// Success with re-planning on test boards of depth 1–5 (the twin's boards can be set), or on the
-/// boards the app shows (the real tablet's cannot).
+/// boards the app shows (the real tablet's cannot). Saved per depth as `evaluation-replan.json`,
+/// the file `seads plot` and `seads report` read.
+#[allow(clippy::too_many_arguments)]
 fn evaluate(
     run: &Path,
+    checkpoint: &Path,
+    file: &str,
     mut env: UarmEnv,
     settable: bool,
     boards: usize,
     timeout: f64,
+    quiet: bool,
 ) -> Result<()> {
     let config = load_config(run)?;
-    let checkpoint = latest_checkpoint(run)?.context("the run has no checkpoint")?;
-    let mut agent = Agent::load_for(config, env.spec().clone(), &checkpoint)?;
+    let mut agent = Agent::load_for(config, env.spec().clone(), checkpoint)?;
     let (policy, model) = agent.parts()?;
     let game = LightsOut::new(5)?;
     let solver = Gf2Solver::new(&game);
@@ -270,8 +471,14 @@ fn evaluate(
         },
         ..SolveConfig::default()
     };
-    let mut solved_per_depth = [0usize; 6];
-    let mut tasks_per_depth = [0usize; 6];
+    let bar = if quiet {
+        ProgressBar::hidden()
+    } else {
+        ProgressBar::new(5 * boards as u64)
+    };
+    // Keyed by the board's solution depth: the twin's are 1–5 by construction, the tablet's are
+    // whatever the app shows.
+    let mut results: BTreeMap<usize, DepthResult> = BTreeMap::new();
     for depth in 1..=5 {
         for _ in 0..boards {
             if settable {
@@ -280,18 +487,29 @@ fn evaluate(
                         .expect("boards of depth 1..5"),
                 )?;
             }
-            let d = solver.depth(env.board()).unwrap_or(0).min(5);
+            let d = solver.depth(env.board()).unwrap_or(0);
             let outcome = solve(&mut env, policy, model, game.goal(), &solve_config)?;
-            tasks_per_depth[d] += 1;
-            solved_per_depth[d] += outcome.solved as usize;
+            results
+                .entry(d)
+                .or_insert_with(|| DepthResult::new(d))
+                .record(&outcome);
+            bar.inc(1);
         }
     }
-    let (solved, tasks): (usize, usize) =
-        (solved_per_depth.iter().sum(), tasks_per_depth.iter().sum());
+    bar.finish_and_clear();
+    let results: Vec<DepthResult> = results.into_values().collect();
+    seads_rl::write_atomic(
+        &run.join(file),
+        serde_json::to_string_pretty(&results)?.as_bytes(),
+    )?;
+    let (solved, tasks) = results
+        .iter()
+        .fold((0, 0), |(s, t), r| (s + r.solved, t + r.tasks));
     println!(
-        "solved {solved} of {tasks} boards with re-planning (per depth 1–5: {})",
-        (1..=5)
-            .map(|d| format!("{}/{}", solved_per_depth[d], tasks_per_depth[d]))
+        "solved {solved} of {tasks} boards with re-planning (per depth: {})",
+        results
+            .iter()
+            .map(|r| format!("{}: {}/{}", r.depth, r.solved, r.tasks))
             .collect::<Vec<_>>()
             .join(", ")
     );

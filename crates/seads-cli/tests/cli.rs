@@ -663,14 +663,118 @@ fn uarm_twin_calibrates_and_trains() {
             .unwrap()
             .contains("uarm-lightsout-absolute")
     );
+    // The paper's protocol unless asked otherwise, recorded for a resume.
+    assert_eq!(
+        std::fs::read_to_string(run.join("robot.toml")).unwrap(),
+        "action_space = \"absolute\"\nreset_board = false\n"
+    );
     // A robot run has figures and a report too: what its directory holds.
     let figures = dir.path().join("figures");
     seads_ok(&["plot", "--run", s(&run), "--out", s(&figures)]);
-    assert!(figures.join("coverage.png").is_file());
+    // Success as `uarm train` measured it; the skills as the twin executes them.
+    for f in ["coverage", "success", "trajectories", "pushes"] {
+        assert!(figures.join(format!("{f}.png")).is_file(), "{f}");
+    }
+    let evaluation: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(run.join("evaluation-replan.json")).unwrap())
+            .unwrap();
+    let tasks: u64 = (0..5)
+        .map(|d| evaluation[d]["tasks"].as_u64().unwrap())
+        .sum();
+    assert_eq!(tasks, 5, "{evaluation}");
     let report = dir.path().join("report");
-    seads_ok(&["report", s(&run), "--out", s(&report)]);
+    seads_ok(&["report", s(&run), "--out", s(&report), "--copy-runs"]);
     let md = std::fs::read_to_string(report.join("report.md")).unwrap();
     assert!(md.contains("uarm-lightsout-absolute (of 25)"), "{md}");
+    for f in [
+        "config.toml",
+        "robot.toml",
+        "metrics.jsonl",
+        "evaluation-replan.json",
+    ] {
+        assert!(report.join("runs/run").join(f).is_file(), "{f}");
+    }
+}
+
+/// A resumed robot run acts as it was trained: resuming a displacement run without
+/// `--action-space` is not an absolute-push run refused as foreign.
+#[test]
+fn a_resumed_robot_run_keeps_its_action_space() {
+    let dir = tempfile::tempdir().unwrap();
+    let run = dir.path().join("run");
+    let train = |extra: &[&str]| {
+        let mut args = vec![
+            "uarm",
+            "train",
+            "--port",
+            "sim:2",
+            "--env-steps",
+            "12",
+            "--boards",
+            "1",
+            "--timeout",
+            "0.2",
+            "--out",
+            s(&run),
+            "--quiet",
+        ];
+        args.extend_from_slice(extra);
+        seads_ok(&args)
+    };
+    train(&["--action-space", "displacement", "--reset-board"]);
+    let out = train(&["--resume"]);
+    assert!(
+        String::from_utf8_lossy(&out.stdout).contains("of 5 boards with re-planning"),
+        "{out:?}"
+    );
+    let settings = std::fs::read_to_string(run.join("robot.toml")).unwrap();
+    assert!(settings.contains("displacement") && settings.contains("reset_board = true"));
+    assert!(
+        std::fs::read_to_string(run.join("config.toml"))
+            .unwrap()
+            .contains("uarm-lightsout-displacement")
+    );
+    // A chosen checkpoint evaluated on its own, beside the final evaluation.
+    let epoch: u64 = std::fs::read_dir(run.join("checkpoints"))
+        .unwrap()
+        .filter_map(|e| {
+            e.unwrap()
+                .file_name()
+                .to_str()?
+                .strip_prefix("epoch-")?
+                .parse()
+                .ok()
+        })
+        .min()
+        .unwrap();
+    let evaluate = |extra: &[&str]| {
+        let mut args = vec![
+            "uarm",
+            "evaluate",
+            "--port",
+            "sim:2",
+            "--run",
+            s(&run),
+            "--boards",
+            "1",
+            "--timeout",
+            "0.2",
+            "--quiet",
+        ];
+        args.extend_from_slice(extra);
+        args.iter().map(|a| a.to_string()).collect::<Vec<_>>()
+    };
+    let args = evaluate(&["--checkpoint", &epoch.to_string()]);
+    seads_ok(&args.iter().map(String::as_str).collect::<Vec<_>>());
+    assert!(
+        run.join(format!("evaluation-replan-epoch-{epoch:06}.json"))
+            .is_file()
+    );
+    let args = evaluate(&["--checkpoint", "999999"]);
+    check_bad_input(
+        &args.iter().map(String::as_str).collect::<Vec<_>>(),
+        "no checkpoint of epoch 999999",
+    );
 }
 
 #[test]
@@ -775,6 +879,21 @@ fn uarm_rejects_bad_input() {
             run.to_str().unwrap(),
         ],
         "needs --calibration",
+    );
+    // Only the twin's board can be set.
+    check_bad_input(
+        &[
+            "uarm",
+            "train",
+            "--port",
+            "/dev/ttyACM9",
+            "--calibration",
+            cal.to_str().unwrap(),
+            "--reset-board",
+            "--out",
+            run.to_str().unwrap(),
+        ],
+        "needs the twin",
     );
 }
 
@@ -903,4 +1022,48 @@ fn a_closed_output_pipe_is_not_a_panic() {
         "killed by SIGPIPE: {:?}",
         out.status
     );
+}
+
+/// Training commands run with libgomp's short spin (`GOMP_SPINCOUNT=1000`, see `main.rs`) unless
+/// the user chose a wait policy: read from the running process's environment.
+#[cfg(target_os = "linux")]
+#[test]
+fn training_runs_with_a_short_openmp_spin() {
+    let dir = tempfile::tempdir().unwrap();
+    let spin_of = |user: Option<(&str, &str)>, out: &str| -> Option<String> {
+        let mut command = std::process::Command::new(env!("CARGO_BIN_EXE_seads"));
+        command
+            .args(["train", "--env", "lightsout-cursor", "--quiet", "--out"])
+            .arg(dir.path().join(out))
+            .env_remove("GOMP_SPINCOUNT")
+            .env_remove("OMP_WAIT_POLICY")
+            .stdout(std::process::Stdio::null())
+            .stderr(std::process::Stdio::null());
+        if let Some((name, value)) = user {
+            command.env(name, value);
+        }
+        let mut child = command.spawn().unwrap();
+        let environ = format!("/proc/{}/environ", child.id());
+        let mut seen = None;
+        for _ in 0..300 {
+            let text = std::fs::read(&environ).unwrap_or_default();
+            seen = text
+                .split(|&b| b == 0)
+                .find_map(|v| v.strip_prefix(b"GOMP_SPINCOUNT="))
+                .map(|v| String::from_utf8_lossy(v).into_owned());
+            if seen.is_some() || child.try_wait().unwrap().is_some() {
+                break;
+            }
+            std::thread::sleep(std::time::Duration::from_millis(10));
+        }
+        let _ = child.kill();
+        let _ = child.wait();
+        seen
+    };
+    assert_eq!(spin_of(None, "a").as_deref(), Some("1000"));
+    assert_eq!(
+        spin_of(Some(("GOMP_SPINCOUNT", "7")), "b").as_deref(),
+        Some("7")
+    );
+    assert_eq!(spin_of(Some(("OMP_WAIT_POLICY", "active")), "c"), None);
 }

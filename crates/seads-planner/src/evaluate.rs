@@ -69,6 +69,19 @@ impl DepthResult {
             skill_steps: Vec::new(),
         }
     }
+
+    /// Counts one more task of this depth, which ended in `outcome`.
+    pub fn record(&mut self, outcome: &SolveOutcome) {
+        self.tasks += 1;
+        self.plan_found += outcome.plan_found as usize;
+        self.planning_s.push(outcome.planning_s);
+        self.timeouts += outcome.timed_out as usize;
+        if outcome.solved {
+            self.solved += 1;
+            self.solution_steps.push(outcome.manipulator_steps);
+            self.skill_steps.extend(&outcome.skill_steps);
+        }
+    }
 }
 
 /// What to evaluate on: an environment, the depths and seeds of its tasks.
@@ -113,15 +126,7 @@ pub fn evaluate(
             env.reset()?;
             let board = env.board();
             let outcome = solve(env.as_mut(), policy, successor, goal, &evaluation.solve)?;
-            result.tasks += 1;
-            result.plan_found += outcome.plan_found as usize;
-            result.planning_s.push(outcome.planning_s);
-            result.timeouts += outcome.timed_out as usize;
-            if outcome.solved {
-                result.solved += 1;
-                result.solution_steps.push(outcome.manipulator_steps);
-                result.skill_steps.extend(&outcome.skill_steps);
-            }
+            result.record(&outcome);
             each(&TaskRecord {
                 depth,
                 seed,

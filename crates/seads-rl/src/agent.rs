@@ -51,25 +51,29 @@ pub struct Agent {
     pub model: Option<ForwardModel>,
 }
 
+/// The checkpoint of epoch `epoch` of the run in `dir`, or its latest.
+pub fn find_checkpoint(dir: &Path, epoch: Option<u64>) -> Result<PathBuf, RlError> {
+    match epoch {
+        Some(e) => checkpoints(dir)?
+            .into_iter()
+            .find(|(ce, _)| *ce == e)
+            .map(|(_, p)| p)
+            .ok_or_else(|| RlError::Checkpoint {
+                path: dir.display().to_string(),
+                reason: format!("no checkpoint of epoch {e}"),
+            }),
+        None => latest_checkpoint(dir)?.ok_or_else(|| RlError::Checkpoint {
+            path: dir.display().to_string(),
+            reason: "the run has no checkpoint yet".into(),
+        }),
+    }
+}
+
 impl Agent {
     /// Loads the latest checkpoint of the run in `dir`, or the one of epoch `epoch`.
     pub fn load(dir: &Path, epoch: Option<u64>) -> Result<Self, RlError> {
         let config = load_config(dir)?;
-        let checkpoint = match epoch {
-            Some(e) => checkpoints(dir)?
-                .into_iter()
-                .find(|(ce, _)| *ce == e)
-                .map(|(_, p)| p)
-                .ok_or_else(|| RlError::Checkpoint {
-                    path: dir.display().to_string(),
-                    reason: format!("no checkpoint of epoch {e}"),
-                })?,
-            None => latest_checkpoint(dir)?.ok_or_else(|| RlError::Checkpoint {
-                path: dir.display().to_string(),
-                reason: "the run has no checkpoint yet".into(),
-            })?,
-        };
-        Self::load_checkpoint(config, &checkpoint)
+        Self::load_checkpoint(config, &find_checkpoint(dir, epoch)?)
     }
 
     /// Loads the agent saved in `checkpoint` by a run with `config`.

@@ -28,6 +28,23 @@ pub enum ActionSpace {
     Displacement,
 }
 
+impl ActionSpace {
+    /// The environment's name in run configs.
+    pub fn env_name(self) -> &'static str {
+        match self {
+            Self::Absolute => "uarm-lightsout-absolute",
+            Self::Displacement => "uarm-lightsout-displacement",
+        }
+    }
+
+    /// The action space of the environment called `name`, if it is the uArm's.
+    pub fn of_env(name: &str) -> Option<Self> {
+        [Self::Absolute, Self::Displacement]
+            .into_iter()
+            .find(|space| space.env_name() == name)
+    }
+}
+
 /// Settings of the uArm environment.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields, default)]
@@ -39,8 +56,9 @@ pub struct UarmConfig {
     pub step_limit: usize,
     /// How long to wait for the tablet to log a tap after a press, seconds.
     pub tap_timeout_s: f64,
-    /// Reset draws a new board and pen position (the twin only: the real tablet's boards are the
-    /// app's, and the paper resets neither board nor arm).
+    /// Reset draws a new board and pen position. The twin only: the real tablet's boards are the
+    /// app's. The paper's protocol resets neither board nor arm (SPEC §7.3, seed S.5), so an
+    /// episode starts where the previous one ended; that is the default.
     pub reset_board: bool,
 }
 
@@ -100,13 +118,10 @@ impl UarmEnv {
             ));
         }
         let game = LightsOut::new(crate::BOARD_SIZE).expect("5×5");
-        let (name, low, high) = match config.action_space {
-            ActionSpace::Absolute => ("uarm-lightsout-absolute", vec![0.0, 0.0], vec![1.0, 1.0]),
-            ActionSpace::Displacement => (
-                "uarm-lightsout-displacement",
-                vec![-0.2, -0.2, -1.0],
-                vec![0.2, 0.2, 1.0],
-            ),
+        let name = config.action_space.env_name();
+        let (low, high) = match config.action_space {
+            ActionSpace::Absolute => (vec![0.0, 0.0], vec![1.0, 1.0]),
+            ActionSpace::Displacement => (vec![-0.2, -0.2, -1.0], vec![0.2, 0.2, 1.0]),
         };
         let spec = EnvSpec {
             name: name.into(),

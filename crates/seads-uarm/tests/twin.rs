@@ -37,6 +37,10 @@ fn calibrate(twin: &Twin) -> Calibration {
 }
 
 fn env(twin: &Twin, space: ActionSpace) -> UarmEnv {
+    env_with(twin, space, true)
+}
+
+fn env_with(twin: &Twin, space: ActionSpace, reset_board: bool) -> UarmEnv {
     let config = UarmConfig {
         action_space: space,
         step_limit: if space == ActionSpace::Absolute {
@@ -45,7 +49,7 @@ fn env(twin: &Twin, space: ActionSpace) -> UarmEnv {
             10
         },
         tap_timeout_s: 0.0,
-        reset_board: true,
+        reset_board,
     };
     UarmEnv::new(driver(twin), twin.tablet(), calibrate(twin), config).unwrap()
 }
@@ -164,6 +168,41 @@ fn displacements_move_and_press_like_the_cursor() {
     let out = env.step(&[0.0, 0.0, 1.0]).unwrap();
     assert_eq!(out.push, Push::Move(13));
     assert_eq!(env.board(), LightsOut::new(5).unwrap().apply(before, 13));
+}
+
+/// The paper's protocol (SPEC §7.3): an episode starts where the previous one ended, board and
+/// pen alike; with `reset_board` the twin draws both anew.
+#[test]
+fn the_papers_protocol_resets_neither_board_nor_pen() {
+    let game = LightsOut::new(5).unwrap();
+    for reset_board in [false, true] {
+        let twin = Twin::new(8);
+        let mut env = env_with(&twin, ActionSpace::Displacement, reset_board);
+        env.seed(2);
+        env.reset().unwrap();
+        let (mut kept_board, mut kept_pen) = (0, 0);
+        for episode in 0..20 {
+            // Press somewhere new in every episode, so that the board and pen change.
+            let x = 0.1 + 0.2 * (episode % 5) as f32;
+            env.restore_manipulator(&[x, 0.5]).unwrap();
+            let pressed = game.apply(env.board(), 10 + episode % 5);
+            assert_eq!(
+                env.step(&[0.0, 0.0, 1.0]).unwrap().push,
+                Push::Move(10 + episode % 5)
+            );
+            assert_eq!(env.board(), pressed);
+            let (board, pen) = (env.board(), twin.pen());
+            env.reset().unwrap();
+            kept_board += usize::from(env.board() == board);
+            kept_pen += usize::from(twin.pen() == pen && env.observation()[0] == x);
+            assert_eq!(twin.board(), env.board());
+        }
+        if reset_board {
+            assert!(kept_board <= 2 && kept_pen == 0, "{kept_board} {kept_pen}");
+        } else {
+            assert_eq!((kept_board, kept_pen), (20, 20));
+        }
+    }
 }
 
 /// An error and its sources, as the CLI prints them.

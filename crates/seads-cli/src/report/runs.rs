@@ -199,8 +199,8 @@ pub fn group(runs: &[RunData]) -> Result<(Vec<Group<'_>>, Vec<&RunData>)> {
     Ok((groups, unfinished))
 }
 
-/// The files of a run that results rest on (small; never checkpoints): its configuration,
-/// metrics and evaluations.
+/// The files of a run that results rest on (small; never checkpoints): its configuration (with a
+/// robot run's `robot.toml`), metrics and evaluations.
 pub fn data_files(run: &Path) -> Result<Vec<PathBuf>> {
     let mut files = Vec::new();
     for entry in std::fs::read_dir(run).with_context(|| format!("reading {}", run.display()))? {
@@ -209,6 +209,7 @@ pub fn data_files(run: &Path) -> Result<Vec<PathBuf>> {
             .file_name()
             .map_or(String::new(), |n| n.to_string_lossy().into_owned());
         let wanted = name == "config.toml"
+            || name == "robot.toml"
             || name == "metrics.jsonl"
             || (name.starts_with("evaluation")
                 && (name.ends_with(".json") || name.ends_with(".jsonl")));

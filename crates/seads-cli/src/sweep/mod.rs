@@ -6,7 +6,7 @@ mod manifest;
 mod pool;
 mod slurm;
 mod state;
-mod task;
+pub(crate) mod task;
 
 use std::path::PathBuf;
 
