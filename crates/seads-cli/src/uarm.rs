@@ -284,7 +284,7 @@ fn robot_config(env: &UarmEnv, args: &UarmTrainArgs) -> Result<TrainConfig> {
 }
 
 /// `seads uarm train`.
-pub fn train(args: UarmTrainArgs) -> Result<()> {
+pub fn train(mut args: UarmTrainArgs) -> Result<()> {
     // Before the twin or the arm starts a thread: the kernels of the run (the preset's when new).
     let portable = if args.resume {
         load_config(&args.out)?.portable_numerics
@@ -292,7 +292,6 @@ pub fn train(args: UarmTrainArgs) -> Result<()> {
         TrainConfig::preset("lightsout-cursor")?.portable_numerics
     };
     crate::kernels::use_kernels(portable)?;
-    let mut args = args;
     if args.resume {
         adopt_run_settings(&mut args)?;
     }
