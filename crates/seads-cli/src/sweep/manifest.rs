@@ -414,6 +414,7 @@ env_overrides = { "lightsout-cursor" = { num_skills = 30 }, "tileswap-cursor" = 
                 4 * 7 * 5,
             ),
             (include_str!("../../../../experiments/vic.toml"), 4 * 3),
+            (include_str!("../../../../experiments/arms.toml"), 5 * 2),
             (
                 include_str!("../../../../experiments/board-size.toml"),
                 5 * 5,
