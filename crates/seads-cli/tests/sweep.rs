@@ -227,6 +227,26 @@ fn a_sweep_is_planned_once_run_to_the_end_and_reported() {
     );
     let md = std::fs::read_to_string(again.join("report.md")).unwrap();
     assert!(!md.contains("search time limit"), "{md}");
+    assert!(
+        md.contains("(lightsout-cursor / seads: 2 of 2 runs; lightsout-cursor / no-relabelling: 2 of 2 runs)"),
+        "{md}"
+    );
+    // A variant with one run not evaluated over training keeps its curve, over the other run.
+    std::fs::remove_file(
+        data.join("runs/lightsout-cursor/seads/seed-2/evaluation-over-training.jsonl"),
+    )
+    .unwrap();
+    seads_ok(&["report", s(&data), "--out", s(&again)]);
+    let md = std::fs::read_to_string(again.join("report.md")).unwrap();
+    assert!(
+        md.contains("lightsout-cursor / seads: 1 of 2 runs;"),
+        "{md}"
+    );
+    let svg = std::fs::read_to_string(again.join("success-lightsout-cursor.svg")).unwrap();
+    assert!(
+        svg.contains("seads (n = 1)") && svg.contains("no-relabelling (n = 2)"),
+        "the legend names each curve's runs"
+    );
     // Tasks that ended at the clock are named in the report.
     let evaluation = data.join("runs/lightsout-cursor/seads/seed-1/evaluation-replan.json");
     let mut v: serde_json::Value =

@@ -9,7 +9,7 @@ use anyhow::Result;
 use plotters::coord::Shift;
 use plotters::prelude::*;
 
-use super::runs::Group;
+use super::runs::{Group, RunData};
 use crate::draw::{plot_err, png_and_svg, render_to, skill_colour};
 
 /// A curve: x, mean, min, max.
@@ -144,9 +144,60 @@ pub fn coverage_figures(
     Ok(written)
 }
 
+/// A run's task success over training as (epoch, env steps, % solved): a baseline evaluates its
+/// policy as it trains (`metrics.jsonl`); a SEADS run has what `seads evaluate --checkpoints`
+/// added (with re-planning, depths pooled). Empty for a run not evaluated over training.
+fn success_series(run: &RunData) -> Vec<(u64, f64, f64)> {
+    if !run.task_metrics.is_empty() {
+        return run
+            .task_metrics
+            .iter()
+            .map(|m| (m.epoch, m.env_steps as f64, 100.0 * m.mean_success))
+            .collect();
+    }
+    run.over_training
+        .iter()
+        .filter(|l| l.replan)
+        .map(|l| {
+            let (solved, tasks) = l
+                .results
+                .iter()
+                .fold((0, 0), |(s, t), d| (s + d.solved, t + d.tasks));
+            (
+                l.epoch,
+                l.env_steps as f64,
+                100.0 * solved as f64 / tasks.max(1) as f64,
+            )
+        })
+        .collect()
+}
+
+/// Which runs the success-over-training figures rest on, one line per environment and variant
+/// that has any: "lightsout-cursor / seads: 1 of 5 runs". `None` when no run has such data.
+pub fn success_note(groups: &[Group<'_>]) -> Option<String> {
+    let lines: Vec<String> = groups
+        .iter()
+        .filter_map(|g| {
+            let with = g
+                .runs
+                .iter()
+                .filter(|r| !success_series(r).is_empty())
+                .count();
+            (with > 0)
+                .then(|| format!("{} / {}: {with} of {} runs", g.env, g.variant, g.runs.len()))
+        })
+        .collect();
+    (!lines.is_empty()).then(|| {
+        format!(
+            "Task success over training rests on the runs evaluated over training ({}).",
+            lines.join("; ")
+        )
+    })
+}
+
 /// Task success over training (SEADS with re-planning, a baseline's policy; mean over the depths)
-/// per environment, for the groups whose runs were evaluated over training; returns the files
-/// written.
+/// per environment, for the groups whose runs were evaluated over training (each curve over the
+/// runs that were, its n in the legend); returns the files written.
 pub fn success_figures(out: &Path, groups: &[Group<'_>]) -> Result<Vec<PathBuf>> {
     let mut written = Vec::new();
     for env in envs(groups) {
@@ -155,35 +206,12 @@ pub fn success_figures(out: &Path, groups: &[Group<'_>]) -> Result<Vec<PathBuf>>
             let series: Vec<Vec<(u64, f64, f64)>> = g
                 .runs
                 .iter()
-                .map(|r| {
-                    // A baseline evaluates its policy as it trains (metrics.jsonl).
-                    if !r.task_metrics.is_empty() {
-                        return r
-                            .task_metrics
-                            .iter()
-                            .map(|m| (m.epoch, m.env_steps as f64, 100.0 * m.mean_success))
-                            .collect();
-                    }
-                    r.over_training
-                        .iter()
-                        .filter(|l| l.replan)
-                        .map(|l| {
-                            let (solved, tasks) = l
-                                .results
-                                .iter()
-                                .fold((0, 0), |(s, t), d| (s + d.solved, t + d.tasks));
-                            (
-                                l.epoch,
-                                l.env_steps as f64,
-                                100.0 * solved as f64 / tasks.max(1) as f64,
-                            )
-                        })
-                        .collect()
-                })
+                .map(|r| success_series(r))
+                .filter(|s| !s.is_empty())
                 .collect();
             let band = band(&series);
             if !band.is_empty() {
-                curves.push((format!("{} (n = {})", g.variant, g.runs.len()), band));
+                curves.push((format!("{} (n = {})", g.variant, series.len()), band));
             }
         }
         if curves.is_empty() {

@@ -112,6 +112,9 @@ pub fn report(args: ReportArgs) -> Result<()> {
     md += &length_md;
     let _ = writeln!(md, "\nAs CSV: `lengths.csv`.\n");
     let _ = writeln!(md, "## Figures\n");
+    if let Some(note) = figures::success_note(&groups) {
+        let _ = writeln!(md, "{note}\n");
+    }
     for f in figures
         .iter()
         .filter(|f| f.extension().is_some_and(|e| e == "png"))
