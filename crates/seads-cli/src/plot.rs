@@ -78,15 +78,8 @@ pub fn write_figures(
         let agent = Agent::load_for(config, spec, &find_checkpoint(run, checkpoint)?)?;
         let k = agent.policy_skills();
         both("coverage", &|p| coverage_figure(p, &metrics, k, &title))?;
-        let saved = run.join("evaluation-replan.json");
-        if saved.exists() {
-            let text = std::fs::read_to_string(&saved)
-                .with_context(|| format!("reading {}", saved.display()))?;
-            let replan = [(
-                true,
-                serde_json::from_str(&text)
-                    .with_context(|| format!("reading {}", saved.display()))?,
-            )];
+        if let Some(results) = saved_evaluation(run, true)? {
+            let replan = [(true, results)];
             both("success", &|p| success_figure(p, &replan, &title))?;
         }
         if !quiet {
@@ -158,14 +151,8 @@ fn evaluations(
     quiet: bool,
 ) -> Result<[(bool, Vec<DepthResult>); 2]> {
     let mut load = |replan: bool| -> Result<Vec<DepthResult>> {
-        let path = run.join(if replan {
-            "evaluation-replan.json"
-        } else {
-            "evaluation-plan-once.json"
-        });
-        if let Ok(text) = std::fs::read_to_string(&path) {
-            return serde_json::from_str(&text)
-                .with_context(|| format!("reading {}", path.display()));
+        if let Some(results) = saved_evaluation(run, replan)? {
+            return Ok(results);
         }
         let tasks = Tasks {
             depths: (1..=5).collect(),
@@ -180,6 +167,23 @@ fn evaluations(
         run_evaluation(agent, run, tasks, quiet)
     };
     Ok([(true, load(true)?), (false, load(false)?)])
+}
+
+/// The run's saved evaluation with or without re-planning (`evaluation-replan.json`,
+/// `evaluation-plan-once.json`), if there is one.
+fn saved_evaluation(run: &Path, replan: bool) -> Result<Option<Vec<DepthResult>>> {
+    let path = run.join(if replan {
+        "evaluation-replan.json"
+    } else {
+        "evaluation-plan-once.json"
+    });
+    match std::fs::read_to_string(&path) {
+        Ok(text) => serde_json::from_str(&text)
+            .map(Some)
+            .with_context(|| format!("reading {}", path.display())),
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => Ok(None),
+        Err(e) => Err(e).with_context(|| format!("reading {}", path.display())),
+    }
 }
 
 /// Every skill executed from the 20 coverage initialisations of `env` (for registry

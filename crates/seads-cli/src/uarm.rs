@@ -12,7 +12,7 @@ use rand_chacha::ChaCha8Rng;
 use seads_embodiment::Environment;
 use seads_games::{BoardDataset, BoardGame, Gf2Solver, LightsOut, Split};
 use seads_planner::{DepthResult, PlannerConfig, SolveConfig, solve};
-use seads_rl::{Agent, Run, TrainConfig, Trainer, find_checkpoint, latest_checkpoint, load_config};
+use seads_rl::{Agent, Run, TrainConfig, Trainer, find_checkpoint, load_config};
 use seads_uarm::{
     ActionSpace, AdbTablet, Calibration, CalibrationFile, DriverConfig, SerialTransport, Swift,
     Tablet, Twin, UarmConfig, UarmEnv, twin_screen_corners,
@@ -209,7 +209,7 @@ fn build_env(
     }
     let calibration = match (calibration, twin) {
         (Some(path), _) => Calibration::load(path).map_err(|e| BadInput(e.into()))?,
-        (None, Some(twin)) => calibrate_twin(connection, twin, false)?,
+        (None, Some(twin)) => calibrate_twin(connection, twin)?,
         (None, None) => bail!(BadInput(anyhow::anyhow!(
             "the real arm needs --calibration (see `seads uarm calibrate`)"
         ))),
@@ -225,11 +225,12 @@ fn build_env(
     Ok(UarmEnv::new(arm, tablet, calibration, config)?)
 }
 
-/// The twin calibrated on the spot, as a person would calibrate the arm.
-fn calibrate_twin(connection: &Connection, twin: &Twin, quiet: bool) -> Result<Calibration> {
+/// The twin calibrated on the spot, as a person would calibrate the arm (silently: `seads uarm
+/// calibrate` is where corners are shown).
+fn calibrate_twin(connection: &Connection, twin: &Twin) -> Result<Calibration> {
     let mut arm = connection.arm(Some(twin))?;
     Ok(Calibration::fit(CalibrationFile {
-        corners: record_corners(&mut arm, Some(twin), quiet)?,
+        corners: record_corners(&mut arm, Some(twin), true)?,
         d_max_mm: 100.0,
     })?)
 }
@@ -254,19 +255,7 @@ pub fn twin_for_figures(config: &TrainConfig) -> Result<Option<UarmEnv>> {
         port: "sim".into(),
         adb: String::new(),
     };
-    let calibration = calibrate_twin(&connection, &twin, true)?;
-    let config = UarmConfig {
-        action_space: space,
-        step_limit: step_limit(space),
-        reset_board: true,
-        tap_timeout_s: 0.0,
-    };
-    Ok(Some(UarmEnv::new(
-        connection.arm(Some(&twin))?,
-        connection.tablet(Some(&twin))?,
-        calibration,
-        config,
-    )?))
+    build_env(&connection, None, space, true, Some(&twin)).map(Some)
 }
 
 /// The training settings of the robot (seed S.5): the Cursor's, with SAC α = 0.1 and, for
@@ -330,11 +319,9 @@ pub fn train(mut args: UarmTrainArgs) -> Result<()> {
     };
     crate::train::drive(&mut run, args.quiet)?;
     drop(run);
-    let checkpoint = latest_checkpoint(&args.out)?.context("the run has no checkpoint")?;
     evaluate(
         &args.out,
-        &checkpoint,
-        "evaluation-replan.json",
+        None,
         env,
         twin.is_some(),
         args.boards,
@@ -416,7 +403,6 @@ pub fn evaluate_run(args: UarmEvaluateArgs) -> Result<()> {
             config.env
         ))
     })?;
-    let checkpoint = find_checkpoint(&args.run, args.checkpoint).map_err(|e| BadInput(e.into()))?;
     let twin = args.connection.twin()?;
     let env = build_env(
         &args.connection,
@@ -425,14 +411,9 @@ pub fn evaluate_run(args: UarmEvaluateArgs) -> Result<()> {
         false,
         twin.as_ref(),
     )?;
-    let file = match args.checkpoint {
-        Some(epoch) => format!("evaluation-replan-epoch-{epoch:06}.json"),
-        None => "evaluation-replan.json".to_owned(),
-    };
     evaluate(
         &args.run,
-        &checkpoint,
-        &file,
+        args.checkpoint,
         env,
         twin.is_some(),
         args.boards,
@@ -442,21 +423,25 @@ pub fn evaluate_run(args: UarmEvaluateArgs) -> Result<()> {
 }
 
 /// Success with re-planning on test boards of depth 1–5 (the twin's boards can be set), or on the
-/// boards the app shows (the real tablet's cannot). Saved per depth as `evaluation-replan.json`,
-/// the file `seads plot` and `seads report` read.
-#[allow(clippy::too_many_arguments)]
+/// boards the app shows (the real tablet's cannot), of the checkpoint of `epoch` or the latest.
+/// Saved per depth as `evaluation-replan.json` (the file `seads plot` and `seads report` read),
+/// or `evaluation-replan-epoch-<EPOCH>.json` for a chosen checkpoint.
 fn evaluate(
     run: &Path,
-    checkpoint: &Path,
-    file: &str,
+    epoch: Option<u64>,
     mut env: UarmEnv,
     settable: bool,
     boards: usize,
     timeout: f64,
     quiet: bool,
 ) -> Result<()> {
+    let checkpoint = find_checkpoint(run, epoch).map_err(|e| BadInput(e.into()))?;
+    let file = match epoch {
+        Some(epoch) => format!("evaluation-replan-epoch-{epoch:06}.json"),
+        None => "evaluation-replan.json".to_owned(),
+    };
     let config = load_config(run)?;
-    let mut agent = Agent::load_for(config, env.spec().clone(), checkpoint)?;
+    let mut agent = Agent::load_for(config, env.spec().clone(), &checkpoint)?;
     let (policy, model) = agent.parts()?;
     let game = LightsOut::new(5)?;
     let solver = Gf2Solver::new(&game);
@@ -498,7 +483,7 @@ fn evaluate(
     bar.finish_and_clear();
     let results: Vec<DepthResult> = results.into_values().collect();
     seads_rl::write_atomic(
-        &run.join(file),
+        &run.join(&file),
         serde_json::to_string_pretty(&results)?.as_bytes(),
     )?;
     let (solved, tasks) = results
