@@ -103,14 +103,19 @@ fn keep_freed_memory() {
     }
 }
 
-/// Whether `command` trains, where libtorch runs parallel regions on several threads.
-fn trains(command: &Command) -> bool {
+/// Whether `command` trains or plans, where libtorch runs parallel regions on several threads
+/// (the planner's 8-bit products open one per batch).
+fn runs_libtorch_in_parallel(command: &Command) -> bool {
     matches!(
         command,
         Command::Run(_)
             | Command::Train(_)
+            | Command::Solve(_)
+            | Command::Evaluate(_)
+            | Command::Plot(_)
+            | Command::PlanBench(_)
             | Command::Sweep(sweep::SweepCommand::Run(_) | sweep::SweepCommand::Task(_))
-            | Command::Uarm(uarm::UarmCommand::Train(_))
+            | Command::Uarm(uarm::UarmCommand::Train(_) | uarm::UarmCommand::Evaluate(_))
     )
 }
 
@@ -164,7 +169,7 @@ fn main() -> ExitCode {
     keep_freed_memory();
     die_quietly_on_closed_pipes();
     let cli = Cli::parse();
-    if trains(&cli.command) {
+    if runs_libtorch_in_parallel(&cli.command) {
         spin_briefly_in_libgomp();
     }
     let result = match cli.command {

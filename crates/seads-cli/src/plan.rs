@@ -527,6 +527,10 @@ pub struct PlanBenchArgs {
     /// libtorch threads (1: the one-core figure).
     #[arg(long, default_value_t = 1)]
     threads: usize,
+    /// Compute every logit in float32, without the 8-bit screen (the same plans, more
+    /// arithmetic; for comparison).
+    #[arg(long)]
+    float32: bool,
     /// Print JSON.
     #[arg(long)]
     json: bool,
@@ -535,7 +539,11 @@ pub struct PlanBenchArgs {
 #[derive(Serialize)]
 struct PlanBenchReport {
     hidden: Vec<i64>,
+    float32: bool,
     model_agreement: f64,
+    /// (state, skill) pairs screened in 8-bit arithmetic, and those computed in float32 after all.
+    screened: u64,
+    recomputed: u64,
     depths: Vec<PlanBenchDepth>,
     peak_rss_mib: f64,
 }
@@ -581,12 +589,17 @@ pub fn plan_bench(args: PlanBenchArgs) -> Result<()> {
     };
     let mut model = fit_to_game(&game, &config, 1500, 1);
     let agreement = agreement_with_game(&mut model, &game, 2000, 2);
+    model.set_int8_screen(!args.float32);
+    let before = model.screen_counts();
     let max_depth = *args.depths.iter().max().expect("non-empty");
     let boards = BoardDataset::build(&game, max_depth)?;
     let mut rng = ChaCha8Rng::seed_from_u64(7);
     let mut report = PlanBenchReport {
         hidden: args.hidden.clone(),
+        float32: args.float32,
         model_agreement: agreement,
+        screened: 0,
+        recomputed: 0,
         depths: Vec::new(),
         peak_rss_mib: 0.0,
     };
@@ -623,6 +636,8 @@ pub fn plan_bench(args: PlanBenchArgs) -> Result<()> {
         report.depths.push(row);
     }
     report.peak_rss_mib = peak_rss_mib();
+    let after = model.screen_counts();
+    (report.screened, report.recomputed) = (after.0 - before.0, after.1 - before.1);
     if args.json {
         println!("{}", serde_json::to_string(&report)?);
     } else {
@@ -630,6 +645,12 @@ pub fn plan_bench(args: PlanBenchArgs) -> Result<()> {
             "model hidden {:?}, agreement with the move table {:.5}, peak memory {:.0} MiB",
             args.hidden, agreement, report.peak_rss_mib
         );
+        if !args.float32 {
+            println!(
+                "8-bit screen: {} (state, skill) pairs, {} of them computed again in float32",
+                report.screened, report.recomputed
+            );
+        }
     }
     Ok(())
 }

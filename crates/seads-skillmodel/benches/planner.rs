@@ -1,6 +1,8 @@
 //! Breadth-first planning with a learned forward model (fitted to the LightsOut 5×5 move table)
-//! on test boards of solution depth 5, 7 and 9, one libtorch thread. The model has hidden layers
-//! of 64; `seads plan-bench --hidden 256,256` measures the paper's size.
+//! on test boards of solution depth 5, 7 and 9, one libtorch thread, with the successor
+//! function's 8-bit screen (the default) and in float32 alone (`_float32`; the same plans). The
+//! model has hidden layers of 64; `seads plan-bench --hidden 256,256 [--float32]` measures the
+//! paper's size.
 
 use criterion::{Criterion, criterion_group};
 use rand::SeedableRng;
@@ -29,13 +31,16 @@ fn planner(c: &mut Criterion) {
         let board = boards
             .sample(depth, Split::Test, &mut rng)
             .expect("boards of this depth");
-        group.bench_function(format!("depth_{depth}"), |b| {
-            b.iter(|| {
-                let plan = bfs_plan(&mut model, board, game.goal(), &PlannerConfig::default())
-                    .expect("a plan");
-                assert_eq!(plan.skills.len(), depth);
-            })
-        });
+        for (suffix, screen) in [("", true), ("_float32", false)] {
+            model.set_int8_screen(screen);
+            group.bench_function(format!("depth_{depth}{suffix}"), |b| {
+                b.iter(|| {
+                    let plan = bfs_plan(&mut model, board, game.goal(), &PlannerConfig::default())
+                        .expect("a plan");
+                    assert_eq!(plan.skills.len(), depth);
+                })
+            });
+        }
     }
     group.finish();
 }

@@ -32,6 +32,7 @@ mod model;
 pub mod nn;
 mod relabel;
 mod reward;
+mod screen;
 
 pub use groundtruth::{agreement_with_game, fit_to_game};
 pub use model::{

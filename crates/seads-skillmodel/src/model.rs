@@ -12,6 +12,7 @@ use tch::{Device, Kind, Tensor};
 
 use crate::SkillModelError;
 use crate::nn::{Adam, Mlp, mean_f32};
+use crate::screen::{Int8Screen, MAX_WIDTH, MIN_ROWS};
 
 /// float32 machine epsilon: α is clamped to [ε, 1 − ε] as PyTorch's Bernoulli does.
 const EPS: f64 = 1.192_092_9e-7;
@@ -144,6 +145,12 @@ pub struct ForwardModel {
     k: usize,
     device: Device,
     network: Trainable,
+    /// Whether the successor function screens with 8-bit arithmetic (same successors).
+    int8_screen: bool,
+    /// The screen for the current weights (dropped when they change).
+    screen: Option<Int8Screen>,
+    /// States expanded through the screen, and those of them computed again in float32.
+    screen_counts: (u64, u64),
 }
 
 impl ForwardModel {
@@ -154,7 +161,17 @@ impl ForwardModel {
             k,
             device,
             network: Trainable::new("forward_model", d + k, d, config, device, seed),
+            int8_screen: true,
+            screen: None,
+            screen_counts: (0, 0),
         }
+    }
+
+    /// Whether the planner's successor function may compute with 8-bit integers first (on by
+    /// default). Either way the successors are those of float32 inference (`screen.rs`); off,
+    /// every logit is computed in float32, which the benches compare against.
+    pub fn set_int8_screen(&mut self, on: bool) {
+        self.int8_screen = on;
     }
 
     /// Length D of the symbolic state.
@@ -218,6 +235,95 @@ impl ForwardModel {
     pub fn flip_logits(&self, z0: &[SymbolicState], skills: &[usize]) -> Tensor {
         tch::no_grad(|| self.network.net.forward(&self.inputs(z0, skills)))
     }
+
+    /// How many (state, skill) pairs the successor function has screened in 8-bit arithmetic,
+    /// and how many of them it computed in float32 because a logit lay within the screen's bound.
+    pub fn screen_counts(&self) -> (u64, u64) {
+        self.screen_counts
+    }
+
+    /// The mode's flips (n × K × D, 1: the bit flips) in float32.
+    fn exact_flips(&self, z0: &Tensor) -> Vec<u8> {
+        let logits = self.flip_logits_all_skills(z0); // n × K × D
+        let ones = z0.unsqueeze(1).gt(0.5);
+        let flip = logits
+            .gt(0.0)
+            .logical_or(&ones.logical_and(&logits.eq(0.0)));
+        Vec::<u8>::try_from(flip.to_kind(Kind::Uint8).view([-1]).to_device(Device::Cpu))
+            .expect("flip table")
+    }
+
+    /// The same flips through the 8-bit screen (`screen.rs`), or `None` where it does not apply
+    /// (switched off, not on the CPU, not two hidden layers, a layer wider than 1,024, or a batch
+    /// too small to gain).
+    fn screened_flips(&mut self, z0: &Tensor) -> Option<Vec<u8>> {
+        let layers = self.network.net.layers();
+        let narrow = layers.iter().all(|l| l.ws.size()[1] <= MAX_WIDTH);
+        let rows = z0.size()[0] as usize * self.k;
+        if !self.int8_screen
+            || self.device != Device::Cpu
+            || layers.len() != 3
+            || !narrow
+            || rows < MIN_ROWS
+        {
+            return None;
+        }
+        let bias = |l: &nn::Linear| l.bs.as_ref().expect("layers have biases").shallow_clone();
+        let screen = self.screen.get_or_insert_with(|| {
+            Int8Screen::new(
+                &layers[1].ws,
+                &bias(&layers[1]),
+                &layers[2].ws,
+                &bias(&layers[2]),
+            )
+        });
+        // The first layer exactly as `flip_logits_all_skills` computes it.
+        let (d, k) = (self.d, self.k);
+        let first = &layers[0];
+        let per_state = z0.matmul(&first.ws.narrow(1, 0, d as i64).transpose(0, 1)) + bias(first);
+        let h1 = per_state.size()[1] as usize;
+        let per_state = Vec::<f32>::try_from(per_state.contiguous().view([-1])).ok()?;
+        let skill_cols = Vec::<f32>::try_from(
+            first
+                .ws
+                .narrow(1, d as i64, k as i64)
+                .transpose(0, 1)
+                .contiguous()
+                .view([-1]),
+        )
+        .ok()?;
+        let n = per_state.len() / h1;
+        let mut hidden = Vec::with_capacity(n * k * h1);
+        for state in per_state.chunks(h1) {
+            for col in skill_cols.chunks(h1) {
+                hidden.extend(state.iter().zip(col).map(|(&a, &b)| (a + b).max(0.0)));
+            }
+        }
+        let mut flips = vec![0u8; n * k * d];
+        let redo = screen.decide(&hidden, n * k, &mut flips);
+        if !redo.is_empty() {
+            // Those rows in float32, through the same layers as `flip_logits_all_skills`.
+            let rows: Vec<f32> = redo
+                .iter()
+                .flat_map(|&row| hidden[row * h1..(row + 1) * h1].iter().copied())
+                .collect();
+            let h = Tensor::from_slice(&rows).view([redo.len() as i64, h1 as i64]);
+            let logits = layers[2].forward(&layers[1].forward(&h).relu());
+            let logits = Vec::<f32>::try_from(logits.contiguous().view([-1])).ok()?;
+            let bits = Vec::<f32>::try_from(z0.contiguous().view([-1])).ok()?;
+            for (j, &row) in redo.iter().enumerate() {
+                let state = row / k;
+                for bit in 0..d {
+                    let logit = logits[j * d + bit];
+                    let one = bits[state * d + bit] > 0.5;
+                    flips[row * d + bit] = u8::from(logit > 0.0 || (one && logit == 0.0));
+                }
+            }
+        }
+        self.screen_counts.0 += (n * k) as u64;
+        self.screen_counts.1 += redo.len() as u64;
+        Some(flips)
+    }
 }
 
 impl SkillModel for ForwardModel {
@@ -254,6 +360,7 @@ impl SkillModel for ForwardModel {
         // The reference averages over the batch and the D bits.
         let loss = -Self::bit_log_likelihood(&logits, &flipped).mean(Kind::Float);
         self.network.opt.backward_step(&loss);
+        self.screen = None;
         mean_f32(&loss)
     }
 
@@ -262,6 +369,7 @@ impl SkillModel for ForwardModel {
     }
 
     fn load(&mut self, dir: &Path, optimiser: bool) -> Result<(), SkillModelError> {
+        self.screen = None;
         self.network.load(dir, optimiser)
     }
 }
@@ -493,13 +601,8 @@ impl seads_games::Successor for ForwardModel {
         }
         let flips = tch::no_grad(|| {
             let z0 = states_tensor(states.iter().copied(), self.d, self.device);
-            let logits = self.flip_logits_all_skills(&z0); // n × K × D
-            let ones = z0.unsqueeze(1).gt(0.5);
-            let flip = logits
-                .gt(0.0)
-                .logical_or(&ones.logical_and(&logits.eq(0.0)));
-            Vec::<u8>::try_from(flip.to_kind(Kind::Uint8).view([-1]).to_device(Device::Cpu))
-                .expect("flip table")
+            self.screened_flips(&z0)
+                .unwrap_or_else(|| self.exact_flips(&z0))
         });
         out.reserve(states.len() * self.k);
         for (i, &z) in states.iter().enumerate() {
@@ -521,6 +624,79 @@ impl seads_games::Successor for ForwardModel {
 mod successor_tests {
     use super::*;
     use seads_games::Successor;
+
+    /// Successors of `states` with the 8-bit screen and in float32 alone.
+    fn both_ways(
+        model: &mut ForwardModel,
+        states: &[SymbolicState],
+    ) -> (Vec<SymbolicState>, Vec<SymbolicState>) {
+        let (mut screened, mut exact) = (Vec::new(), Vec::new());
+        model.set_int8_screen(true);
+        model.successors(states, &mut screened);
+        model.set_int8_screen(false);
+        model.successors(states, &mut exact);
+        model.set_int8_screen(true);
+        (screened, exact)
+    }
+
+    fn random_states(n: usize, seed: u64) -> Vec<SymbolicState> {
+        use rand::RngExt;
+        let mut rng = ChaCha8Rng::seed_from_u64(seed);
+        (0..n)
+            .map(|_| SymbolicState::from_u64(rng.random_range(0..1u64 << 25)))
+            .collect()
+    }
+
+    /// An untrained model has many logits near 0: the screen must send those states to float32.
+    #[test]
+    fn the_int8_screen_gives_the_float_successors_of_an_untrained_model() {
+        let mut model = ForwardModel::new(25, 25, &SkillModelConfig::default(), Device::Cpu, 11);
+        let states = random_states(300, 1);
+        let (screened, exact) = both_ways(&mut model, &states);
+        assert_eq!(screened, exact);
+        let (seen, redone) = model.screen_counts();
+        assert_eq!(seen, 300 * 25);
+        assert!(redone > 0, "an untrained model has logits within the bound");
+        // A small batch goes straight to float32.
+        let _ = both_ways(&mut model, &states[..100]);
+        assert_eq!(model.screen_counts(), (seen, redone));
+    }
+
+    /// A model fitted to the LightsOut moves: the screen decides most states itself, and every
+    /// successor equals float32's, also after further training (the screen follows the weights).
+    #[test]
+    fn the_int8_screen_gives_the_float_successors_of_a_fitted_model() {
+        let game = seads_games::LightsOut::new(5).unwrap();
+        let config = SkillModelConfig {
+            hidden: vec![128, 128],
+            batch_size: 256,
+            ..SkillModelConfig::default()
+        };
+        let mut model = crate::fit_to_game(&game, &config, 400, 3);
+        let states = random_states(2000, 2);
+        let (screened, exact) = both_ways(&mut model, &states);
+        assert_eq!(screened, exact);
+        let (seen, redone) = model.screen_counts();
+        assert_eq!(seen, 2000 * 25);
+        assert!(
+            redone < seen / 20,
+            "{redone} of {seen} states computed again"
+        );
+        let batch: Vec<SkillTransition> = states
+            .iter()
+            .take(256)
+            .map(|&z0| SkillTransition {
+                z0,
+                skill: 3,
+                zt: z0,
+            })
+            .collect();
+        for _ in 0..20 {
+            model.train_step(&batch);
+        }
+        let (screened, exact) = both_ways(&mut model, &states);
+        assert_eq!(screened, exact);
+    }
 
     /// The batched successor agrees with the per-pair mode computed from `flip_logits`.
     #[test]
