@@ -415,6 +415,66 @@ fn a_failing_run_shows_as_failed_and_the_others_finish() {
     assert_eq!(status_json(&sweep)["done"].as_u64(), Some(2));
 }
 
+/// Two `sweep run`s on one sweep: a run that the other takes after this one has listed its
+/// work is left to it (before, this one started a task that waited for the run's lock for a
+/// minute and then counted as failed).
+#[test]
+fn a_run_taken_by_another_sweep_meanwhile_is_left_to_it() {
+    let tmp = tempfile::tempdir().unwrap();
+    let text = MANIFEST.replace("every = 2", "every = 0").replace(
+        "\n[[variant]]\nname = \"no-relabelling\"\noverrides = { relabel = { skill_model_p = 0.0, sac_p = 0.0 } }\n",
+        "",
+    );
+    let manifest = write_manifest(tmp.path(), &text);
+    let sweep = tmp.path().join("sweep");
+    seads_ok(&["sweep", "plan", s(&manifest), "--out", s(&sweep)]);
+    let first = sweep.join("runs/lightsout-cursor/seads/seed-1");
+    let second = sweep.join("runs/lightsout-cursor/seads/seed-2");
+    let started = Instant::now();
+    let child = Command::new(env!("CARGO_BIN_EXE_seads"))
+        .args(["sweep", "run", s(&sweep), "--workers", "1", "--quiet"])
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    // Once the worker trains seed 1, another task takes seed 2 (its lock, as a task holds it).
+    while !std::fs::read_to_string(first.join("task.json")).is_ok_and(|t| t.contains("running")) {
+        assert!(
+            started.elapsed() < Duration::from_secs(60),
+            "seed 1 never started"
+        );
+        std::thread::sleep(Duration::from_millis(20));
+    }
+    let lock = std::fs::File::create(second.join("task.lock")).unwrap();
+    lock.try_lock().unwrap();
+    let out = child.wait_with_output().unwrap();
+    let stdout = String::from_utf8_lossy(&out.stdout).into_owned();
+    assert!(
+        out.status.success(),
+        "{stdout}{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    assert!(
+        stdout.contains("elsewhere") && stdout.contains("seed-2"),
+        "{stdout}"
+    );
+    assert!(
+        !second.join("task.log").exists(),
+        "no task was started for seed 2"
+    );
+    assert!(
+        started.elapsed() < Duration::from_secs(55),
+        "it waited for the lock"
+    );
+    drop(lock);
+    let status = status_json(&sweep);
+    assert_eq!(
+        (status["done"].as_u64(), status["pending"].as_u64()),
+        (Some(1), Some(1)),
+        "{status}"
+    );
+}
+
 /// The metrics of a run without the wall-clock fields, and its evaluations without timings.
 fn results(run: &Path) -> (Vec<serde_json::Value>, Vec<serde_json::Value>) {
     let metrics = std::fs::read_to_string(run.join("metrics.jsonl"))

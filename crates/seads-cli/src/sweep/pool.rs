@@ -14,10 +14,11 @@ use indicatif::{ProgressBar, ProgressStyle};
 use super::index::Sweep;
 use super::state::{LOG, Status, status};
 
-/// What a worker reports for a run.
+/// What a worker reports for a run: whether its task succeeded, or `None` when another task
+/// had taken or finished the run by the time a worker came to it.
 struct Finished {
     index: usize,
-    ok: bool,
+    ok: Option<bool>,
 }
 
 /// The environment steps a run has trained so far (from its metrics; its budget when done).
@@ -80,6 +81,13 @@ pub fn run_sweep(dir: &Path, workers: usize, cores: usize, quiet: bool) -> Resul
                     let next = queue.lock().expect("queue lock").next();
                     let Some(index) = next else { return Ok(()) };
                     let run = dir.join(&sweep.runs[index].dir);
+                    // Another `sweep run` (or a Slurm task) may have taken or finished the run
+                    // since this one listed it: leave it to that one.
+                    if matches!(status(&run)?.0, Status::Running | Status::Done) {
+                        let mut finished = finished.lock().expect("finished lock");
+                        finished.push(Finished { index, ok: None });
+                        continue;
+                    }
                     let log = std::fs::OpenOptions::new()
                         .create(true)
                         .append(true)
@@ -96,10 +104,10 @@ pub fn run_sweep(dir: &Path, workers: usize, cores: usize, quiet: bool) -> Resul
                         .status()
                         .with_context(|| format!("starting the task of {}", run.display()))?
                         .success();
-                    finished
-                        .lock()
-                        .expect("finished lock")
-                        .push(Finished { index, ok });
+                    finished.lock().expect("finished lock").push(Finished {
+                        index,
+                        ok: Some(ok),
+                    });
                 }
             }));
         }
@@ -128,7 +136,12 @@ pub fn run_sweep(dir: &Path, workers: usize, cores: usize, quiet: bool) -> Resul
     bar.finish_and_clear();
     for f in finished.into_inner().expect("finished lock") {
         let run = dir.join(&sweep.runs[f.index].dir);
-        if f.ok {
+        if f.ok.is_none() {
+            println!(
+                "elsewhere {} (taken by another task meanwhile)",
+                run.display()
+            );
+        } else if f.ok == Some(true) {
             println!("done    {}", run.display());
         } else {
             println!(
