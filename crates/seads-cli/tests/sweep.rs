@@ -191,9 +191,20 @@ fn a_sweep_is_planned_once_run_to_the_end_and_reported() {
     assert!(md.contains("U = ") && md.contains("n = 2"), "{md}");
     let csv = std::fs::read_to_string(report.join("table1.csv")).unwrap();
     assert_eq!(csv.lines().count(), 3, "{csv}");
+    // Failed tasks and deviations, counted from the runs' per-task files: one row per variant,
+    // whose task count is every task of the final re-planning evaluations (2 runs × 5 depths ×
+    // 1 board).
+    assert!(md.contains("## Failed tasks and deviations"), "{md}");
+    let failures = std::fs::read_to_string(report.join("failures.csv")).unwrap();
+    assert_eq!(failures.lines().count(), 3, "{failures}");
+    for row in failures.lines().skip(1) {
+        let fields: Vec<&str> = row.split(',').collect();
+        assert_eq!((fields[2], fields[3]), ("2", "10"), "{failures}");
+    }
     for f in [
         "success.csv",
         "lengths.csv",
+        "deviations.csv",
         "coverage-lightsout-cursor.png",
         "coverage-lightsout-cursor.svg",
         "success-lightsout-cursor.png",

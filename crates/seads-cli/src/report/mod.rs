@@ -1,7 +1,9 @@
 //! `seads report`: tables, tests and figures over any set of sweeps and runs — the paper's
-//! Table 1 with its Mann–Whitney tests, task success and lengths, coverage and success curves
-//! and length box plots — written to `report.md`, CSV files and PNG + SVG figures.
+//! Table 1 with its Mann–Whitney tests, task success and lengths, failed tasks and the skills
+//! that deviated from the model's predictions, coverage and success curves and length box
+//! plots — written to `report.md`, CSV files and PNG + SVG figures.
 
+mod failures;
 mod figures;
 mod runs;
 mod stats;
@@ -58,6 +60,11 @@ pub fn report(args: ReportArgs) -> Result<()> {
     write("success.csv", &success_csv)?;
     let (length_md, length_csv) = tables::length_tables(&groups);
     write("lengths.csv", &length_csv)?;
+    let failures = failures::failure_tables(&groups)?;
+    if let Some((_, failures_csv, deviations_csv)) = &failures {
+        write("failures.csv", failures_csv)?;
+        write("deviations.csv", deviations_csv)?;
+    }
     let k_of = |g: &runs::Group<'_>| tables::skills(g.runs[0]);
     let mut figures = figures::coverage_figures(&args.out, &groups, &k_of)?;
     figures.extend(figures::success_figures(&args.out, &groups)?);
@@ -111,6 +118,14 @@ pub fn report(args: ReportArgs) -> Result<()> {
     let _ = writeln!(md, "## Skill and solution length\n");
     md += &length_md;
     let _ = writeln!(md, "\nAs CSV: `lengths.csv`.\n");
+    if let Some((failures_md, _, _)) = &failures {
+        let _ = writeln!(md, "## Failed tasks and deviations (re-planning)\n");
+        md += failures_md;
+        let _ = writeln!(
+            md,
+            "\nAs CSV: `failures.csv`, and per skill `deviations.csv`.\n"
+        );
+    }
     let _ = writeln!(md, "## Figures\n");
     if let Some(note) = figures::success_note(&groups) {
         let _ = writeln!(md, "{note}\n");
