@@ -5,7 +5,7 @@
 //! observation `[manipulator state, z, ρ]`, the ground-truth symbolic mapping Φ(s) = z, setting
 //! the board. [`Embodied`] implements it once for every [`Manipulator`]; the board side (reset
 //! distribution, push layout, step counter) is shared. Environments are built by name with
-//! [`make_env`], and [`VecEnv`] steps a batch of them.
+//! [`make_env`].
 //!
 //! Architecture invariant: pure simulation. No printing and no files; randomness only from the
 //! seeded streams of each environment (`seed`), so the same seed gives the same episode.
@@ -74,7 +74,7 @@ pub use record::{
     Comparison, EpisodeRecord, ReplayError, StepRecord, compare, record_episode, replay_episode,
 };
 pub use registry::{EnvInfo, env_names, list_envs, make_env};
-pub use runner::{VecEnv, random_rollout};
+pub use runner::random_rollout;
 pub use scene::{FieldView, Scene, Shape};
 pub use spec::{EnvSpec, Push, StepOutcome};
 pub use task::{TaskEnv, TaskStep};

@@ -1,8 +1,6 @@
 //! Behaviour shared by every environment: dimensions, bad input, determinism, termination.
 
-use seads_embodiment::{
-    EnvConfig, EnvError, Push, StepOutcome, VecEnv, env_names, list_envs, make_env,
-};
+use seads_embodiment::{EnvConfig, EnvError, Push, StepOutcome, env_names, list_envs, make_env};
 use seads_games::{BoardGame, LightsOut, Split, split_of};
 
 #[test]
@@ -240,45 +238,6 @@ fn spaced_boards_of_every_size_build() {
         assert_eq!(env.spec().obs_dim, 2 + n * n + 1);
         env.reset().unwrap();
         assert!(!env.board().is_zero());
-    }
-}
-
-#[test]
-fn vec_env_steps_like_single_environments() {
-    let config = EnvConfig::default();
-    let mut batch = VecEnv::new("lightsout-reacher", &config, 4, 100)
-        .unwrap()
-        .with_parallel(true);
-    let mut singles: Vec<_> = (0..4)
-        .map(|i| {
-            let mut e = make_env("lightsout-reacher", &config).unwrap();
-            e.seed(101 + i);
-            e.reset().unwrap();
-            e
-        })
-        .collect();
-    let (o, a) = (batch.obs_dim(), batch.action_dim());
-    let mut obs = vec![0.0; 4 * o];
-    let mut outcomes = vec![StepOutcome::default(); 4];
-    let active = [true, false, true, true];
-    let actions: Vec<f32> = (0..4 * a)
-        .map(|i| (i * 7 % 11) as f32 / 5.0 - 1.0)
-        .collect();
-    batch
-        .step(&active, &actions, &mut obs, &mut outcomes)
-        .unwrap();
-    for (i, env) in singles.iter_mut().enumerate() {
-        if active[i] {
-            let out = env.step(&actions[i * a..(i + 1) * a]).unwrap();
-            assert_eq!(out, outcomes[i]);
-            assert_eq!(env.observation(), obs[i * o..(i + 1) * o]);
-        } else {
-            assert_eq!(
-                batch.env(i).observation(),
-                env.observation(),
-                "inactive environments do not move"
-            );
-        }
     }
 }
 
