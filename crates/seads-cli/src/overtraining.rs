@@ -38,26 +38,39 @@ pub struct CheckpointEvaluation {
     pub results: Vec<DepthResult>,
 }
 
-/// Which checkpoints: `all`, or every N-th kept one (the last always).
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+/// Which checkpoints: `all`, every N-th kept one (the last always), or the listed epochs.
+#[derive(Debug, Clone, PartialEq, Eq)]
 pub enum Selection {
     /// Every kept checkpoint.
     All,
     /// Every N-th, counted from the first, and the last.
     Every(usize),
+    /// The checkpoints of these epochs (each must be kept).
+    Epochs(Vec<u64>),
 }
 
 impl std::str::FromStr for Selection {
     type Err = String;
     fn from_str(text: &str) -> Result<Self, String> {
-        match text {
-            "all" => Ok(Self::All),
-            n => match n.parse::<usize>() {
-                Ok(n) if n > 0 => Ok(Self::Every(n)),
-                _ => Err(format!(
-                    "--checkpoints takes `all` or a number N ≥ 1 (every N-th), got {text:?}"
-                )),
-            },
+        let bad = || {
+            format!(
+                "--checkpoints takes `all`, a number N ≥ 1 (every N-th), or epochs separated by \
+                 commas (`100,300,1000`), got {text:?}"
+            )
+        };
+        if text == "all" {
+            return Ok(Self::All);
+        }
+        if text.contains(',') {
+            return text
+                .split(',')
+                .map(|e| e.trim().parse::<u64>().map_err(|_| bad()))
+                .collect::<Result<Vec<_>, _>>()
+                .map(Self::Epochs);
+        }
+        match text.parse::<usize>() {
+            Ok(n) if n > 0 => Ok(Self::Every(n)),
+            _ => Err(bad()),
         }
     }
 }
@@ -118,6 +131,25 @@ pub fn evaluate_checkpoints(
             .filter(|(i, _)| i % n == 0 || *i + 1 == kept.len())
             .map(|(_, c)| c.clone())
             .collect(),
+        Selection::Epochs(epochs) => {
+            let missing: Vec<String> = epochs
+                .iter()
+                .filter(|e| !kept.iter().any(|(k, _)| k == *e))
+                .map(u64::to_string)
+                .collect();
+            if !missing.is_empty() {
+                return Err(BadInput(anyhow!(
+                    "{} keeps no checkpoint of epoch(s) {}",
+                    run.display(),
+                    missing.join(", ")
+                ))
+                .into());
+            }
+            kept.iter()
+                .filter(|(k, _)| epochs.contains(k))
+                .cloned()
+                .collect()
+        }
     };
     let done: BTreeSet<(u64, bool)> = read(run)?.iter().map(|l| (l.epoch, l.replan)).collect();
     let todo: Vec<(u64, &Path, bool)> = chosen

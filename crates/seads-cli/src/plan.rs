@@ -189,8 +189,8 @@ pub struct EvaluateArgs {
     /// Use the checkpoint of this epoch instead of the latest.
     #[arg(long)]
     checkpoint: Option<u64>,
-    /// Success over training: evaluate `all` kept checkpoints, or every N-th (and the last),
-    /// with and without re-planning, appending to evaluation-over-training.jsonl in the run
+    /// Success over training: evaluate `all` kept checkpoints, every N-th (and the last), or the
+    /// listed epochs (`100,300,1000`), with and without re-planning, appending to evaluation-over-training.jsonl in the run
     /// directory. Checkpoints already there are skipped.
     #[arg(long, conflicts_with_all = ["checkpoint", "replan", "seed"])]
     checkpoints: Option<crate::overtraining::Selection>,

@@ -153,6 +153,47 @@ fn a_sweep_is_planned_once_run_to_the_end_and_reported() {
         "2000",
     ]);
     assert!(String::from_utf8_lossy(&out.stdout).starts_with("0 new evaluation(s)"));
+    // Listed epochs: the second checkpoint (every 2nd skipped it), both modes; an epoch that
+    // was not kept is refused.
+    let mut epochs: Vec<u64> = std::fs::read_dir(run.join("checkpoints"))
+        .unwrap()
+        .filter_map(|e| {
+            let name = e.unwrap().file_name().to_string_lossy().into_owned();
+            name.strip_prefix("epoch-")?.parse().ok()
+        })
+        .collect();
+    epochs.sort_unstable();
+    let listed = format!("{},{}", epochs[0], epochs[1]);
+    let evaluate = |selection: &str| {
+        seads(&[
+            "evaluate",
+            "--run",
+            s(&run),
+            "--checkpoints",
+            selection,
+            "--boards",
+            "1",
+            "--timeout",
+            "600",
+            "--max-expanded",
+            "2000",
+        ])
+    };
+    let out = evaluate(&listed);
+    assert!(
+        String::from_utf8_lossy(&out.stdout).starts_with("2 new evaluation(s)"),
+        "{}{}",
+        String::from_utf8_lossy(&out.stdout),
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let lines = std::fs::read_to_string(run.join("evaluation-over-training.jsonl")).unwrap();
+    assert!(
+        lines.contains(&format!("\"epoch\":{}", epochs[1])),
+        "{lines}"
+    );
+    let out = evaluate(&format!("{},7777", epochs[0]));
+    assert_eq!(out.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("epoch(s) 7777"));
     let before = lines.lines().count();
     let out = seads_ok(&[
         "evaluate",
