@@ -49,24 +49,63 @@ pub enum Selection {
     Epochs(Vec<u64>),
 }
 
+impl Selection {
+    /// The chosen checkpoints among the `kept` ones (epoch, folder), in their order; for listed
+    /// epochs, the error names those that were not kept.
+    fn choose<T: Clone>(&self, kept: &[(u64, T)]) -> Result<Vec<(u64, T)>, String> {
+        Ok(match self {
+            Selection::All => kept.to_vec(),
+            Selection::Every(n) => kept
+                .iter()
+                .enumerate()
+                .filter(|(i, _)| i % n == 0 || *i + 1 == kept.len())
+                .map(|(_, c)| c.clone())
+                .collect(),
+            Selection::Epochs(epochs) => {
+                let missing: Vec<String> = epochs
+                    .iter()
+                    .filter(|e| !kept.iter().any(|(k, _)| k == *e))
+                    .map(u64::to_string)
+                    .collect();
+                if !missing.is_empty() {
+                    return Err(missing.join(", "));
+                }
+                kept.iter()
+                    .filter(|(k, _)| epochs.contains(k))
+                    .cloned()
+                    .collect()
+            }
+        })
+    }
+}
+
 impl std::str::FromStr for Selection {
     type Err = String;
     fn from_str(text: &str) -> Result<Self, String> {
         let bad = || {
             format!(
                 "--checkpoints takes `all`, a number N ≥ 1 (every N-th), or epochs separated by \
-                 commas (`100,300,1000`), got {text:?}"
+                 commas (`100,300,1000`; one epoch: `500,`), got {text:?}"
             )
         };
         if text == "all" {
             return Ok(Self::All);
         }
         if text.contains(',') {
+            // `500,` lists the one epoch 500 (a bare number is every N-th).
             return text
                 .split(',')
-                .map(|e| e.trim().parse::<u64>().map_err(|_| bad()))
+                .map(str::trim)
+                .filter(|e| !e.is_empty())
+                .map(|e| e.parse::<u64>().map_err(|_| bad()))
                 .collect::<Result<Vec<_>, _>>()
-                .map(Self::Epochs);
+                .and_then(|e| {
+                    if e.is_empty() {
+                        Err(bad())
+                    } else {
+                        Ok(Self::Epochs(e))
+                    }
+                });
         }
         match text.parse::<usize>() {
             Ok(n) if n > 0 => Ok(Self::Every(n)),
@@ -123,34 +162,12 @@ pub fn evaluate_checkpoints(
     if kept.is_empty() {
         return Err(BadInput(anyhow!("{} has no checkpoint to evaluate", run.display())).into());
     }
-    let chosen: Vec<_> = match selection {
-        Selection::All => kept.clone(),
-        Selection::Every(n) => kept
-            .iter()
-            .enumerate()
-            .filter(|(i, _)| i % n == 0 || *i + 1 == kept.len())
-            .map(|(_, c)| c.clone())
-            .collect(),
-        Selection::Epochs(epochs) => {
-            let missing: Vec<String> = epochs
-                .iter()
-                .filter(|e| !kept.iter().any(|(k, _)| k == *e))
-                .map(u64::to_string)
-                .collect();
-            if !missing.is_empty() {
-                return Err(BadInput(anyhow!(
-                    "{} keeps no checkpoint of epoch(s) {}",
-                    run.display(),
-                    missing.join(", ")
-                ))
-                .into());
-            }
-            kept.iter()
-                .filter(|(k, _)| epochs.contains(k))
-                .cloned()
-                .collect()
-        }
-    };
+    let chosen = selection.choose(&kept).map_err(|e| {
+        BadInput(anyhow!(
+            "{} keeps no checkpoint of epoch(s) {e}",
+            run.display()
+        ))
+    })?;
     let done: BTreeSet<(u64, bool)> = read(run)?.iter().map(|l| (l.epoch, l.replan)).collect();
     let todo: Vec<(u64, &Path, bool)> = chosen
         .iter()
@@ -201,4 +218,31 @@ pub fn evaluate_checkpoints(
     }
     bar.finish_and_clear();
     Ok(todo.len())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn checkpoints_are_chosen_all_every_nth_with_the_last_or_by_epoch() {
+        let kept: Vec<(u64, ())> = [100, 200, 300, 400, 500].map(|e| (e, ())).to_vec();
+        let epochs = |s: &Selection| -> Vec<u64> {
+            s.choose(&kept)
+                .unwrap()
+                .into_iter()
+                .map(|(e, _)| e)
+                .collect()
+        };
+        assert_eq!(epochs(&"all".parse().unwrap()), [100, 200, 300, 400, 500]);
+        assert_eq!(epochs(&"2".parse().unwrap()), [100, 300, 500]);
+        assert_eq!(epochs(&"3".parse().unwrap()), [100, 400, 500]);
+        assert_eq!(epochs(&"500, 200".parse().unwrap()), [200, 500]);
+        assert_eq!(epochs(&"300,".parse().unwrap()), [300]);
+        let missing = "100,250,600".parse::<Selection>().unwrap().choose(&kept);
+        assert_eq!(missing.unwrap_err(), "250, 600");
+        for bad in ["0", "x", "1,x", "-1", ","] {
+            assert!(bad.parse::<Selection>().is_err(), "{bad}");
+        }
+    }
 }

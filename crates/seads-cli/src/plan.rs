@@ -190,8 +190,9 @@ pub struct EvaluateArgs {
     #[arg(long)]
     checkpoint: Option<u64>,
     /// Success over training: evaluate `all` kept checkpoints, every N-th (and the last), or the
-    /// listed epochs (`100,300,1000`), with and without re-planning, appending to evaluation-over-training.jsonl in the run
-    /// directory. Checkpoints already there are skipped.
+    /// listed epochs (`100,300,1000`; one epoch: `500,`), with and without re-planning,
+    /// appending to evaluation-over-training.jsonl in the run directory. Checkpoints already
+    /// there are skipped.
     #[arg(long, conflicts_with_all = ["checkpoint", "replan", "seed"])]
     checkpoints: Option<crate::overtraining::Selection>,
     /// Time limit per search, seconds (the authors' evaluation used 60).
