@@ -149,7 +149,7 @@ pub struct ForwardModel {
     int8_screen: bool,
     /// The screen for the current weights (dropped when they change).
     screen: Option<Int8Screen>,
-    /// States expanded through the screen, and those of them computed again in float32.
+    /// (State, skill) rows screened in 8 bits, and those of them computed in float32.
     screen_counts: (u64, u64),
 }
 
