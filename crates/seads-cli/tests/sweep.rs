@@ -47,6 +47,14 @@ fn write_manifest(dir: &Path, text: &str) -> PathBuf {
     path
 }
 
+/// `MANIFEST` with SEADS alone (two seeds) and no evaluation over training.
+fn seads_only_without_evaluation_over_training() -> String {
+    MANIFEST.replace("every = 2", "every = 0").replace(
+        "\n[[variant]]\nname = \"no-relabelling\"\noverrides = { relabel = { skill_model_p = 0.0, sac_p = 0.0 } }\n",
+        "",
+    )
+}
+
 fn status_json(sweep: &Path) -> serde_json::Value {
     serde_json::from_slice(&seads_ok(&["sweep", "status", s(sweep), "--json"]).stdout).unwrap()
 }
@@ -465,11 +473,7 @@ fn a_failing_run_shows_as_failed_and_the_others_finish() {
 #[test]
 fn a_run_taken_by_another_sweep_meanwhile_is_left_to_it() {
     let tmp = tempfile::tempdir().unwrap();
-    let text = MANIFEST.replace("every = 2", "every = 0").replace(
-        "\n[[variant]]\nname = \"no-relabelling\"\noverrides = { relabel = { skill_model_p = 0.0, sac_p = 0.0 } }\n",
-        "",
-    );
-    let manifest = write_manifest(tmp.path(), &text);
+    let manifest = write_manifest(tmp.path(), &seads_only_without_evaluation_over_training());
     let sweep = tmp.path().join("sweep");
     seads_ok(&["sweep", "plan", s(&manifest), "--out", s(&sweep)]);
     let first = sweep.join("runs/lightsout-cursor/seads/seed-1");
@@ -551,11 +555,7 @@ fn results(run: &Path) -> (Vec<serde_json::Value>, Vec<serde_json::Value>) {
 #[test]
 fn killing_sweep_run_at_any_point_loses_nothing() {
     let tmp = tempfile::tempdir().unwrap();
-    let text = MANIFEST.replace("every = 2", "every = 0").replace(
-        "\n[[variant]]\nname = \"no-relabelling\"\noverrides = { relabel = { skill_model_p = 0.0, sac_p = 0.0 } }\n",
-        "",
-    );
-    let manifest = write_manifest(tmp.path(), &text);
+    let manifest = write_manifest(tmp.path(), &seads_only_without_evaluation_over_training());
     let reference = tmp.path().join("reference");
     seads_ok(&["sweep", "plan", s(&manifest), "--out", s(&reference)]);
     seads_ok(&["sweep", "run", s(&reference), "--workers", "2", "--quiet"]);

@@ -209,26 +209,34 @@ impl ForwardModel {
             .clamp(EPS.ln(), (1.0 - EPS).ln())
     }
 
-    /// Flip logits of every state under every skill (n × K × D). The first layer is split into
-    /// its z_0 part, computed once per state, and the skill's column, added per skill.
-    pub fn flip_logits_all_skills(&self, z0: &Tensor) -> Tensor {
-        let layers = self.network.net.layers();
-        let first = &layers[0];
+    /// The first layer split into its z_0 part, computed once per state with the bias (n × H),
+    /// and each skill's column (K × H), added per skill.
+    fn first_layer_parts(&self, z0: &Tensor) -> (Tensor, Tensor) {
+        let first = &self.network.net.layers()[0];
         let (d, k) = (self.d as i64, self.k as i64);
         let w_state = first.ws.narrow(1, 0, d);
-        let w_skill = first.ws.narrow(1, d, k).transpose(0, 1); // K × H
         let bias = first.bs.as_ref().expect("layers have biases");
-        let per_state = z0.matmul(&w_state.transpose(0, 1)) + bias; // n × H
+        let per_state = z0.matmul(&w_state.transpose(0, 1)) + bias;
+        (per_state, first.ws.narrow(1, d, k).transpose(0, 1))
+    }
+
+    /// The layers after the first, on rectified first-layer activations (rows × H → rows × D).
+    fn after_first_layer(&self, hidden: Tensor) -> Tensor {
+        let layers = &self.network.net.layers()[1..];
+        layers.iter().enumerate().fold(hidden, |h, (i, layer)| {
+            let h = layer.forward(&h);
+            if i + 1 < layers.len() { h.relu() } else { h }
+        })
+    }
+
+    /// Flip logits of every state under every skill (n × K × D), the first layer factorised
+    /// (`first_layer_parts`).
+    pub fn flip_logits_all_skills(&self, z0: &Tensor) -> Tensor {
+        let (per_state, w_skill) = self.first_layer_parts(z0);
         let hidden = (per_state.unsqueeze(1) + w_skill.unsqueeze(0)).relu(); // n × K × H
-        let n = z0.size()[0];
-        let mut h = hidden.reshape([n * k, -1]);
-        for (i, layer) in layers[1..].iter().enumerate() {
-            h = layer.forward(&h);
-            if i + 2 < layers.len() {
-                h = h.relu();
-            }
-        }
-        h.view([n, k, d])
+        let (n, k) = (z0.size()[0], self.k as i64);
+        self.after_first_layer(hidden.reshape([n * k, -1]))
+            .view([n, k, self.d as i64])
     }
 
     /// Flip logits for each `(z_0, k)` (n × D): bit d flips in the mode iff its logit > 0.
@@ -268,6 +276,19 @@ impl ForwardModel {
         {
             return None;
         }
+        // The first layer exactly as `flip_logits_all_skills` computes it.
+        let (d, k) = (self.d, self.k);
+        let (per_state, skill_cols) = self.first_layer_parts(z0);
+        let h1 = per_state.size()[1] as usize;
+        let per_state = Vec::<f32>::try_from(per_state.contiguous().view([-1])).ok()?;
+        let skill_cols = Vec::<f32>::try_from(skill_cols.contiguous().view([-1])).ok()?;
+        let n = per_state.len() / h1;
+        let mut hidden = Vec::with_capacity(n * k * h1);
+        for state in per_state.chunks(h1) {
+            for col in skill_cols.chunks(h1) {
+                hidden.extend(state.iter().zip(col).map(|(&a, &b)| (a + b).max(0.0)));
+            }
+        }
         let bias = |l: &nn::Linear| l.bs.as_ref().expect("layers have biases").shallow_clone();
         let screen = self.screen.get_or_insert_with(|| {
             Int8Screen::new(
@@ -277,28 +298,6 @@ impl ForwardModel {
                 &bias(&layers[2]),
             )
         });
-        // The first layer exactly as `flip_logits_all_skills` computes it.
-        let (d, k) = (self.d, self.k);
-        let first = &layers[0];
-        let per_state = z0.matmul(&first.ws.narrow(1, 0, d as i64).transpose(0, 1)) + bias(first);
-        let h1 = per_state.size()[1] as usize;
-        let per_state = Vec::<f32>::try_from(per_state.contiguous().view([-1])).ok()?;
-        let skill_cols = Vec::<f32>::try_from(
-            first
-                .ws
-                .narrow(1, d as i64, k as i64)
-                .transpose(0, 1)
-                .contiguous()
-                .view([-1]),
-        )
-        .ok()?;
-        let n = per_state.len() / h1;
-        let mut hidden = Vec::with_capacity(n * k * h1);
-        for state in per_state.chunks(h1) {
-            for col in skill_cols.chunks(h1) {
-                hidden.extend(state.iter().zip(col).map(|(&a, &b)| (a + b).max(0.0)));
-            }
-        }
         let mut flips = vec![0u8; n * k * d];
         let redo = screen.decide(&hidden, n * k, &mut flips);
         if !redo.is_empty() {
@@ -308,7 +307,7 @@ impl ForwardModel {
                 .flat_map(|&row| hidden[row * h1..(row + 1) * h1].iter().copied())
                 .collect();
             let h = Tensor::from_slice(&rows).view([redo.len() as i64, h1 as i64]);
-            let logits = layers[2].forward(&layers[1].forward(&h).relu());
+            let logits = self.after_first_layer(h);
             let logits = Vec::<f32>::try_from(logits.contiguous().view([-1])).ok()?;
             let bits = Vec::<f32>::try_from(z0.contiguous().view([-1])).ok()?;
             for (j, &row) in redo.iter().enumerate() {

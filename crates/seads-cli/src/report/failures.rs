@@ -6,7 +6,7 @@ use std::collections::BTreeMap;
 use std::fmt::Write as _;
 use std::path::Path;
 
-use anyhow::{Context, Result};
+use anyhow::Result;
 use serde::Deserialize;
 
 use super::runs::Group;
@@ -93,19 +93,10 @@ impl Summary {
 /// The per-task lines of a run, or `None` if it has no per-task file.
 fn read_tasks(run: &Path) -> Result<Option<Vec<TaskLine>>> {
     let path = run.join(TASKS);
-    let text = match std::fs::read_to_string(&path) {
-        Ok(text) => text,
-        Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok(None),
-        Err(e) => return Err(e).with_context(|| format!("reading {}", path.display())),
-    };
-    text.lines()
-        .filter(|l| !l.trim().is_empty())
-        .enumerate()
-        .map(|(i, l)| {
-            serde_json::from_str(l).with_context(|| format!("{} line {}", path.display(), i + 1))
-        })
-        .collect::<Result<Vec<_>>>()
-        .map(Some)
+    if !path.exists() {
+        return Ok(None);
+    }
+    Ok(Some(seads_rl::read_json_lines(&path)?.0))
 }
 
 /// The markdown section (without its heading) and two CSV tables (`failures.csv` per group,
@@ -226,6 +217,6 @@ mod tests {
         assert!(read_tasks(dir.path()).unwrap().is_none());
         std::fs::write(dir.path().join(TASKS), "{\"solved\": true}\n").unwrap();
         let err = read_tasks(dir.path()).unwrap_err();
-        assert!(format!("{err:#}").contains("line 1"), "{err:#}");
+        assert!(format!("{err:#}").contains("tasks.jsonl:1"), "{err:#}");
     }
 }

@@ -136,20 +136,20 @@ pub fn run_sweep(dir: &Path, workers: usize, cores: usize, quiet: bool) -> Resul
     bar.finish_and_clear();
     for f in finished.into_inner().expect("finished lock") {
         let run = dir.join(&sweep.runs[f.index].dir);
-        if f.ok.is_none() {
-            println!(
+        match f.ok {
+            None => println!(
                 "elsewhere {} (taken by another task meanwhile)",
                 run.display()
-            );
-        } else if f.ok == Some(true) {
-            println!("done    {}", run.display());
-        } else {
-            println!(
-                "failed  {} (see {})",
-                run.display(),
-                run.join(LOG).display()
-            );
-            failures.push(run);
+            ),
+            Some(true) => println!("done    {}", run.display()),
+            Some(false) => {
+                println!(
+                    "failed  {} (see {})",
+                    run.display(),
+                    run.join(LOG).display()
+                );
+                failures.push(run);
+            }
         }
     }
     if !failures.is_empty() {
