@@ -147,28 +147,6 @@ fn a_sweep_is_planned_once_run_to_the_end_and_reported() {
         lines.lines().count(),
         2 * checkpoints.div_ceil(2).max(1) + 2 * usize::from(checkpoints % 2 == 0)
     );
-    let out = seads_ok(&[
-        "evaluate",
-        "--run",
-        s(&run),
-        "--checkpoints",
-        "2",
-        "--boards",
-        "1",
-        "--timeout",
-        "600",
-        "--max-expanded",
-        "2000",
-    ]);
-    assert!(String::from_utf8_lossy(&out.stdout).starts_with("0 new evaluation(s)"));
-    // Listed epochs (the selection itself is unit-tested): one that is evaluated adds nothing,
-    // and an epoch that was not kept is refused, by its number.
-    let last: u64 = std::fs::read_to_string(run.join("checkpoints/latest"))
-        .unwrap()
-        .trim()
-        .trim_start_matches("epoch-")
-        .parse()
-        .unwrap();
     let evaluate = |selection: &str| {
         seads(&[
             "evaluate",
@@ -184,6 +162,17 @@ fn a_sweep_is_planned_once_run_to_the_end_and_reported() {
             "2000",
         ])
     };
+    let out = evaluate("2");
+    assert!(out.status.success());
+    assert!(String::from_utf8_lossy(&out.stdout).starts_with("0 new evaluation(s)"));
+    // Listed epochs (the selection itself is unit-tested): one that is evaluated adds nothing,
+    // and an epoch that was not kept is refused, by its number.
+    let last: u64 = std::fs::read_to_string(run.join("checkpoints/latest"))
+        .unwrap()
+        .trim()
+        .trim_start_matches("epoch-")
+        .parse()
+        .unwrap();
     let out = evaluate(&format!("{last},"));
     assert!(
         String::from_utf8_lossy(&out.stdout).starts_with("0 new evaluation(s)"),
@@ -195,19 +184,8 @@ fn a_sweep_is_planned_once_run_to_the_end_and_reported() {
     assert_eq!(out.status.code(), Some(2));
     assert!(String::from_utf8_lossy(&out.stderr).contains("epoch(s) 7777"));
     let before = lines.lines().count();
-    let out = seads_ok(&[
-        "evaluate",
-        "--run",
-        s(&run),
-        "--checkpoints",
-        "all",
-        "--boards",
-        "1",
-        "--timeout",
-        "600",
-        "--max-expanded",
-        "2000",
-    ]);
+    let out = evaluate("all");
+    assert!(out.status.success());
     assert!(
         String::from_utf8_lossy(&out.stdout)
             .starts_with(&format!("{} new", 2 * checkpoints - before)),
