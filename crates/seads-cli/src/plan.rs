@@ -220,10 +220,54 @@ pub fn task_seeds(boards: usize, seed: Option<u64>) -> Vec<u64> {
     }
 }
 
-/// Where a baseline's final task success is saved in its run directory: its policy acting
-/// alone, no planning (the SEADS runs' counterparts are `evaluation-replan.json` and
-/// `evaluation-plan-once.json`).
-pub const POLICY_EVALUATION: &str = "evaluation-policy.json";
+/// How an evaluation acts, as its files in the run directory name it.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum EvaluationKind {
+    /// Plan, and plan again after every skill that deviated from the forward model.
+    Replan,
+    /// Plan once and execute the whole plan.
+    PlanOnce,
+    /// A baseline's policy acting alone, no planning.
+    Policy,
+}
+
+impl EvaluationKind {
+    /// The planning evaluation, with or without re-planning.
+    pub fn planning(replan: bool) -> Self {
+        if replan { Self::Replan } else { Self::PlanOnce }
+    }
+
+    fn name(self) -> &'static str {
+        match self {
+            Self::Replan => "replan",
+            Self::PlanOnce => "plan-once",
+            Self::Policy => "policy",
+        }
+    }
+
+    /// The stem of this evaluation's files for these depths: `evaluation-replan` for the
+    /// standard depths 1–5, which plots and reports read; `evaluation-replan-depths-6-12` for
+    /// other studies, kept beside them.
+    pub fn stem(self, depths: &[usize]) -> String {
+        match (depths.first(), depths.last()) {
+            (Some(a), Some(b)) if depths != [1, 2, 3, 4, 5] => {
+                format!("evaluation-{}-depths-{a}-{b}", self.name())
+            }
+            _ => format!("evaluation-{}", self.name()),
+        }
+    }
+
+    /// The per-depth results of the standard evaluation (`evaluation-replan.json`).
+    pub fn results_file(self) -> String {
+        format!("evaluation-{}.json", self.name())
+    }
+
+    /// Every task of the standard evaluation, one JSON line each
+    /// (`evaluation-replan-tasks.jsonl`).
+    pub fn tasks_file(self) -> String {
+        format!("evaluation-{}-tasks.jsonl", self.name())
+    }
+}
 
 /// Limits of each search of an evaluation.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -312,14 +356,7 @@ pub fn run_evaluation(
         lines.push('\n');
     })?;
     bar.finish_and_clear();
-    // The standard depths 1–5 are what `seads plot` draws; other studies are kept beside them.
-    let depths = &tasks.depths;
-    let mode = if tasks.replan { "replan" } else { "plan-once" };
-    let stem = match (depths.first(), depths.last()) {
-        (Some(1), Some(5)) if depths.len() == 5 => format!("evaluation-{mode}"),
-        (Some(a), Some(b)) => format!("evaluation-{mode}-depths-{a}-{b}"),
-        _ => format!("evaluation-{mode}"),
-    };
+    let stem = EvaluationKind::planning(tasks.replan).stem(&tasks.depths);
     seads_rl::write_atomic(
         &run.join(format!("{stem}.json")),
         serde_json::to_string_pretty(&results)?.as_bytes(),
@@ -487,11 +524,7 @@ fn evaluate_policy(
     let mut policy = seads_rl::load_policy(config, &checkpoint)
         .with_context(|| format!("loading the policy of run {}", args.run.display()))?;
     let results = seads_rl::task_success(config, policy.as_mut(), depths, args.boards)?;
-    let name = match (depths.first(), depths.last()) {
-        (Some(1), Some(5)) if depths.len() == 5 => POLICY_EVALUATION.to_owned(),
-        (Some(a), Some(b)) => format!("evaluation-policy-depths-{a}-{b}.json"),
-        _ => POLICY_EVALUATION.to_owned(),
-    };
+    let name = format!("{}.json", EvaluationKind::Policy.stem(depths));
     seads_rl::write_atomic(
         &args.run.join(name),
         serde_json::to_string_pretty(&results)?.as_bytes(),
@@ -654,4 +687,29 @@ pub fn plan_bench(args: PlanBenchArgs) -> Result<()> {
         }
     }
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn evaluation_files_name_the_standard_depths_plainly_and_other_studies_by_range() {
+        let replan = EvaluationKind::planning(true);
+        assert_eq!(replan.stem(&[1, 2, 3, 4, 5]), "evaluation-replan");
+        assert_eq!(
+            EvaluationKind::planning(false).stem(&[6, 7, 8, 9, 10, 11, 12]),
+            "evaluation-plan-once-depths-6-12"
+        );
+        assert_eq!(
+            EvaluationKind::Policy.stem(&[1, 2, 3]),
+            "evaluation-policy-depths-1-3"
+        );
+        assert_eq!(replan.results_file(), "evaluation-replan.json");
+        assert_eq!(replan.tasks_file(), "evaluation-replan-tasks.jsonl");
+        assert_eq!(
+            EvaluationKind::Policy.results_file(),
+            "evaluation-policy.json"
+        );
+    }
 }

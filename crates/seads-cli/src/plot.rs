@@ -15,7 +15,7 @@ use seads_rl::{Agent, AgentPolicy, COVERAGE_SEED, find_checkpoint, read_metrics}
 
 use crate::draw::{draw_paths, draw_scene, plot_err, render_to, skill_colour};
 use crate::envs::build_env;
-use crate::plan::{Tasks, load_agent, run_evaluation, task_seeds};
+use crate::plan::{EvaluationKind, Tasks, load_agent, run_evaluation, task_seeds};
 
 /// Arguments of `seads plot`.
 #[derive(Debug, Args)]
@@ -172,11 +172,7 @@ fn evaluations(
 /// The run's saved evaluation with or without re-planning (`evaluation-replan.json`,
 /// `evaluation-plan-once.json`), if there is one.
 fn saved_evaluation(run: &Path, replan: bool) -> Result<Option<Vec<DepthResult>>> {
-    let path = run.join(if replan {
-        "evaluation-replan.json"
-    } else {
-        "evaluation-plan-once.json"
-    });
+    let path = run.join(EvaluationKind::planning(replan).results_file());
     match std::fs::read_to_string(&path) {
         Ok(text) => serde_json::from_str(&text)
             .map(Some)

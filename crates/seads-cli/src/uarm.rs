@@ -438,7 +438,7 @@ fn evaluate(
     let checkpoint = find_checkpoint(run, epoch).map_err(|e| BadInput(e.into()))?;
     let file = match epoch {
         Some(epoch) => format!("evaluation-replan-epoch-{epoch:06}.json"),
-        None => "evaluation-replan.json".to_owned(),
+        None => crate::plan::EvaluationKind::Replan.results_file(),
     };
     let config = load_config(run)?;
     let mut agent = Agent::load_for(config, env.spec().clone(), &checkpoint)?;

@@ -10,9 +10,7 @@ use anyhow::Result;
 use serde::Deserialize;
 
 use super::runs::Group;
-
-/// The per-task file of the final evaluation with re-planning.
-const TASKS: &str = "evaluation-replan-tasks.jsonl";
+use crate::plan::EvaluationKind;
 
 /// What the summary needs of one line of the per-task file.
 #[derive(Debug, Deserialize)]
@@ -92,7 +90,7 @@ impl Summary {
 
 /// The per-task lines of a run, or `None` if it has no per-task file.
 fn read_tasks(run: &Path) -> Result<Option<Vec<TaskLine>>> {
-    let path = run.join(TASKS);
+    let path = run.join(EvaluationKind::Replan.tasks_file());
     if !path.exists() {
         return Ok(None);
     }
@@ -215,7 +213,11 @@ mod tests {
     fn a_run_without_a_per_task_file_is_skipped_and_a_broken_line_is_an_error() {
         let dir = tempfile::tempdir().unwrap();
         assert!(read_tasks(dir.path()).unwrap().is_none());
-        std::fs::write(dir.path().join(TASKS), "{\"solved\": true}\n").unwrap();
+        std::fs::write(
+            dir.path().join(EvaluationKind::Replan.tasks_file()),
+            "{\"solved\": true}\n",
+        )
+        .unwrap();
         let err = read_tasks(dir.path()).unwrap_err();
         assert!(format!("{err:#}").contains("tasks.jsonl:1"), "{err:#}");
     }

@@ -9,6 +9,7 @@ use seads_planner::DepthResult;
 use seads_rl::{Algorithm, Metrics, TaskMetrics, TrainConfig};
 
 use crate::overtraining::CheckpointEvaluation;
+use crate::plan::EvaluationKind;
 use crate::sweep::Sweep;
 
 /// One run, as read from its directory.
@@ -64,8 +65,8 @@ impl RunData {
                 seads_rl::read_metrics_as::<TaskMetrics>(dir).unwrap_or_default(),
             ),
         };
-        let evaluation = |name: &str| -> Result<Option<Vec<DepthResult>>> {
-            let path = dir.join(name);
+        let evaluation = |kind: EvaluationKind| -> Result<Option<Vec<DepthResult>>> {
+            let path = dir.join(kind.results_file());
             match std::fs::read_to_string(&path) {
                 Ok(text) => Ok(Some(
                     serde_json::from_str(&text)
@@ -78,9 +79,9 @@ impl RunData {
             dir: dir.to_path_buf(),
             copy_to,
             variant,
-            replan: evaluation("evaluation-replan.json")?,
-            plan_once: evaluation("evaluation-plan-once.json")?,
-            policy: evaluation(crate::plan::POLICY_EVALUATION)?,
+            replan: evaluation(EvaluationKind::Replan)?,
+            plan_once: evaluation(EvaluationKind::PlanOnce)?,
+            policy: evaluation(EvaluationKind::Policy)?,
             over_training: crate::overtraining::read(dir)?,
             config,
             metrics,

@@ -159,7 +159,7 @@ fn train_and_evaluate_baseline<L: Shown>(sweep: &Sweep, run: &Path, cores: usize
             sweep.evaluation.boards,
         )?;
         seads_rl::write_atomic(
-            &run.join(crate::plan::POLICY_EVALUATION),
+            &run.join(crate::plan::EvaluationKind::Policy.results_file()),
             serde_json::to_string_pretty(&results)?.as_bytes(),
         )?;
         let solved: usize = results.iter().map(|r| r.solved).sum();
