@@ -197,6 +197,8 @@ fn main() -> ExitCode {
             eprintln!("error: {err:#}");
             if err.is::<BadInput>() {
                 ExitCode::from(2)
+            } else if err.is::<sweep::Taken>() {
+                ExitCode::from(sweep::TAKEN_EXIT)
             } else {
                 ExitCode::FAILURE
             }

@@ -501,6 +501,34 @@ fn a_run_taken_by_another_sweep_meanwhile_is_left_to_it() {
     );
 }
 
+/// The other half of that race: another task takes the run between `sweep run`'s look and its
+/// child's claim. The child leaves the run at once with status 3 (taken elsewhere), which
+/// `sweep run` does not count as failed; a task started by hand or by Slurm still waits.
+#[test]
+fn a_child_task_whose_run_is_held_by_another_says_so_at_once() {
+    let tmp = tempfile::tempdir().unwrap();
+    let manifest = write_manifest(tmp.path(), &seads_only_without_evaluation_over_training());
+    let sweep = tmp.path().join("sweep");
+    seads_ok(&["sweep", "plan", s(&manifest), "--out", s(&sweep)]);
+    let run = sweep.join("runs/lightsout-cursor/seads/seed-1");
+    let lock = std::fs::File::create(run.join("task.lock")).unwrap();
+    lock.try_lock().unwrap();
+    let started = Instant::now();
+    let out = seads(&["sweep", "task", s(&sweep), "--index", "0", "--child"]);
+    assert_eq!(out.status.code(), Some(3), "{out:?}");
+    assert!(
+        String::from_utf8_lossy(&out.stderr).contains("already being trained by another task"),
+        "{out:?}"
+    );
+    assert!(
+        started.elapsed() < Duration::from_secs(30),
+        "it waited for the lock"
+    );
+    drop(lock);
+    let status = status_json(&sweep);
+    assert_eq!(status["runs"][0]["status"], "pending", "{status}");
+}
+
 /// The metrics of a run without the wall-clock fields, and its evaluations without timings.
 fn results(run: &Path) -> (Vec<serde_json::Value>, Vec<serde_json::Value>) {
     let metrics = std::fs::read_to_string(run.join("metrics.jsonl"))

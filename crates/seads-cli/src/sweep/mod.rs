@@ -9,6 +9,7 @@ mod state;
 pub(crate) mod task;
 
 use std::path::PathBuf;
+use std::time::Duration;
 
 use anyhow::{Context, Result, anyhow};
 use clap::{Args, Subcommand};
@@ -16,7 +17,7 @@ use serde::Serialize;
 
 pub use index::{INDEX, MANIFEST, Sweep};
 pub use manifest::Manifest;
-pub use state::Status;
+pub use state::{Status, TAKEN_EXIT, Taken};
 
 use crate::BadInput;
 
@@ -91,7 +92,8 @@ pub struct TaskArgs {
     /// Cores of this task; its libtorch threads follow them (Slurm: $SLURM_CPUS_PER_TASK).
     #[arg(long, default_value_t = 2)]
     cores: u64,
-    /// Started by `seads sweep run`: die with the parent.
+    /// Started by `seads sweep run`: die with the parent, and if another task holds the run,
+    /// exit with status 3 (taken elsewhere) after two seconds instead of a minute.
     #[arg(long, hide = true)]
     child: bool,
 }
@@ -147,10 +149,16 @@ pub fn run(command: SweepCommand) -> Result<()> {
             pool::run_sweep(&args.dir, workers, cores, args.quiet)
         }
         SweepCommand::Task(args) => {
-            if args.child {
+            // `seads sweep run` looked at the run an instant ago and found it free: if another
+            // task holds it now, it took it meanwhile, and the child leaves it to that one.
+            let patience = if args.child {
                 die_with_parent();
-            }
-            task::run_task(&args.dir, args.index, at_least_one("--cores", args.cores)?)
+                Duration::from_secs(2)
+            } else {
+                state::PATIENCE
+            };
+            let cores = at_least_one("--cores", args.cores)?;
+            task::run_task(&args.dir, args.index, cores, patience)
         }
         SweepCommand::Slurm(args) => slurm(args),
         SweepCommand::Status(args) => status(args),

@@ -12,7 +12,7 @@ use anyhow::{Context, Result, bail};
 use indicatif::{ProgressBar, ProgressStyle};
 
 use super::index::Sweep;
-use super::state::{LOG, Status, status};
+use super::state::{LOG, Status, TAKEN_EXIT, status};
 
 /// What a worker reports for a run: whether its task succeeded, or `None` when another task
 /// had taken or finished the run by the time a worker came to it.
@@ -93,7 +93,7 @@ pub fn run_sweep(dir: &Path, workers: usize, cores: usize, quiet: bool) -> Resul
                         .append(true)
                         .open(run.join(LOG))
                         .with_context(|| format!("opening {}", run.join(LOG).display()))?;
-                    let ok = Command::new(&exe)
+                    let exit = Command::new(&exe)
                         .args(["sweep", "task"])
                         .arg(dir)
                         .args(["--index", &index.to_string()])
@@ -102,12 +102,15 @@ pub fn run_sweep(dir: &Path, workers: usize, cores: usize, quiet: bool) -> Resul
                         .stdout(log.try_clone()?)
                         .stderr(log)
                         .status()
-                        .with_context(|| format!("starting the task of {}", run.display()))?
-                        .success();
-                    finished.lock().expect("finished lock").push(Finished {
-                        index,
-                        ok: Some(ok),
-                    });
+                        .with_context(|| format!("starting the task of {}", run.display()))?;
+                    let ok = match exit.code() {
+                        Some(code) if code == i32::from(TAKEN_EXIT) => None,
+                        _ => Some(exit.success()),
+                    };
+                    finished
+                        .lock()
+                        .expect("finished lock")
+                        .push(Finished { index, ok });
                 }
             }));
         }

@@ -5,9 +5,10 @@
 //! - `task.json` records the last task's outcome: running, done or failed (with the error).
 
 use std::fs::File;
-use std::path::Path;
+use std::path::{Path, PathBuf};
+use std::time::{Duration, Instant};
 
-use anyhow::{Context, Result, bail};
+use anyhow::{Context, Result};
 use serde::{Deserialize, Serialize};
 
 /// The lock file of a run directory.
@@ -95,9 +96,34 @@ pub struct Claim {
     _file: File,
 }
 
+/// How long a Slurm task or a task started by hand waits for a run that another task holds:
+/// a task that was just killed (a Slurm re-queue) may take a few seconds to die.
+pub const PATIENCE: Duration = Duration::from_secs(60);
+
+/// The exit status of a `seads sweep task` that found its run held by another task, so that
+/// `seads sweep run` can tell "taken elsewhere" from "failed".
+pub const TAKEN_EXIT: u8 = 3;
+
+/// The error of a claim on a run that another task holds.
+#[derive(Debug)]
+pub struct Taken(pub PathBuf);
+
+impl std::fmt::Display for Taken {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(
+            f,
+            "{} is already being trained by another task",
+            self.0.display()
+        )
+    }
+}
+
+impl std::error::Error for Taken {}
+
 impl Claim {
-    /// Claims `run`; an error if another task holds it.
-    pub fn take(run: &Path) -> Result<Self> {
+    /// Claims `run`, waiting up to `patience` for another task to release it; [`Taken`] if it
+    /// does not.
+    pub fn take(run: &Path, patience: Duration) -> Result<Self> {
         let path = run.join(LOCK);
         let file = File::options()
             .create(true)
@@ -105,20 +131,22 @@ impl Claim {
             .write(true)
             .open(&path)
             .with_context(|| format!("opening {}", path.display()))?;
-        // `sweep status` holds the lock for an instant while it looks, and a task that was
-        // just killed (a Slurm re-queue) may take a few seconds to die: wait up to a minute.
-        for _ in 0..600 {
+        // `sweep status` holds the lock for an instant while it looks.
+        let start = Instant::now();
+        loop {
             match file.try_lock() {
                 Ok(()) => return Ok(Self { _file: file }),
+                Err(std::fs::TryLockError::WouldBlock) if start.elapsed() < patience => {
+                    std::thread::sleep(Duration::from_millis(100));
+                }
                 Err(std::fs::TryLockError::WouldBlock) => {
-                    std::thread::sleep(std::time::Duration::from_millis(100));
+                    return Err(Taken(run.to_path_buf()).into());
                 }
                 Err(std::fs::TryLockError::Error(e)) => {
                     return Err(e).with_context(|| format!("locking {}", path.display()));
                 }
             }
         }
-        bail!("{} is already being trained by another task", run.display())
     }
 }
 
@@ -182,13 +210,15 @@ mod tests {
     fn a_claim_shows_as_running_and_excludes_a_second_task() {
         let dir = tempfile::tempdir().unwrap();
         assert_eq!(status(dir.path()).unwrap().0, Status::Pending);
-        let claim = Claim::take(dir.path()).unwrap();
+        let claim = Claim::take(dir.path(), PATIENCE).unwrap();
         Record::write(dir.path(), Outcome::Running, 1, None).unwrap();
         assert_eq!(status(dir.path()).unwrap().0, Status::Running);
         // A second claim waits for the first, and gets it once it is released.
         let path = dir.path().to_path_buf();
-        let waiter = std::thread::spawn(move || Claim::take(&path).map(|_| ()));
-        std::thread::sleep(std::time::Duration::from_millis(300));
+        let impatient = Claim::take(dir.path(), Duration::from_millis(200)).unwrap_err();
+        assert!(impatient.is::<Taken>(), "{impatient:#}");
+        let waiter = std::thread::spawn(move || Claim::take(&path, PATIENCE).map(|_| ()));
+        std::thread::sleep(Duration::from_millis(300));
         assert!(!waiter.is_finished());
         drop(claim);
         waiter.join().unwrap().unwrap();

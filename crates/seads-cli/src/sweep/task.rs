@@ -3,6 +3,7 @@
 //! worker of `seads sweep run` both come here, so the two behave alike.
 
 use std::path::Path;
+use std::time::Duration;
 
 use anyhow::{Context, Result};
 use seads_rl::{Algorithm, Hac, Run, TaskSac, Trainer};
@@ -22,12 +23,13 @@ pub fn thread_split(cores: usize) -> (usize, usize) {
     ((cores / 2).max(1), if cores >= 2 { cores } else { 0 })
 }
 
-/// Runs task `index` of the sweep in `dir` with `cores` cores. A run already done is left as it
-/// is. Errors are recorded in the run's `task.json` before they are returned.
-pub fn run_task(dir: &Path, index: usize, cores: usize) -> Result<()> {
+/// Runs task `index` of the sweep in `dir` with `cores` cores, waiting up to `patience` for
+/// another task that holds the run. A run already done is left as it is. Errors are recorded in
+/// the run's `task.json` before they are returned.
+pub fn run_task(dir: &Path, index: usize, cores: usize, patience: Duration) -> Result<()> {
     let sweep = Sweep::load(dir).map_err(crate::BadInput)?;
     let run = sweep.run_dir(dir, index).map_err(crate::BadInput)?;
-    let claim = Claim::take(&run)?;
+    let claim = Claim::take(&run, patience)?;
     let previous = Record::read(&run)?;
     if previous
         .as_ref()
