@@ -1,13 +1,14 @@
 //! `seads report`: tables, tests and figures over any set of sweeps and runs — the paper's
 //! Table 1 with its Mann–Whitney tests, task success and lengths, failed tasks and the skills
-//! that deviated from the model's predictions, coverage and success curves and length box
-//! plots — written to `report.md`, CSV files and PNG + SVG figures.
+//! that deviated from the model's predictions, where the training time went, coverage and
+//! success curves and length box plots — written to `report.md`, CSV files and PNG + SVG figures.
 
 mod failures;
 mod figures;
 mod runs;
 mod stats;
 mod tables;
+mod walltime;
 
 use std::fmt::Write as _;
 use std::path::PathBuf;
@@ -60,6 +61,8 @@ pub fn report(args: ReportArgs) -> Result<()> {
     write("success.csv", &success_csv)?;
     let (length_md, length_csv) = tables::length_tables(&groups);
     write("lengths.csv", &length_csv)?;
+    let (walltime_md, walltime_csv) = walltime::walltime_tables(&groups);
+    write("walltime.csv", &walltime_csv)?;
     let failures = failures::failure_tables(&groups)?;
     if let Some((_, failures_csv, deviations_csv)) = &failures {
         write("failures.csv", failures_csv)?;
@@ -126,6 +129,9 @@ pub fn report(args: ReportArgs) -> Result<()> {
             "\nAs CSV: `failures.csv`, and per skill `deviations.csv`.\n"
         );
     }
+    let _ = writeln!(md, "## Where the training time went\n");
+    md += &walltime_md;
+    let _ = writeln!(md, "\nAs CSV, per run: `walltime.csv`.\n");
     let _ = writeln!(md, "## Figures\n");
     if let Some(note) = figures::success_note(&groups) {
         let _ = writeln!(md, "{note}\n");

@@ -1,0 +1,184 @@
+//! Where the runs' training time went: each run's wall time and the seconds of each phase, as
+//! its last metrics line records them.
+
+use std::fmt::Write as _;
+
+use seads_rl::Algorithm;
+
+use super::runs::{Group, RunData};
+
+/// The phases a metrics line times, in table order.
+const PHASES: [&str; 5] = [
+    "collect",
+    "relabel",
+    "skill model",
+    "SAC updates",
+    "evaluate",
+];
+
+/// One run's training time.
+#[derive(Debug, Clone, PartialEq)]
+struct Spent {
+    wall_s: f64,
+    env_steps: u64,
+    /// Seconds per phase of `PHASES`; `None` where the algorithm has no such phase.
+    phases: [Option<f64>; 5],
+}
+
+/// What the run's last metrics line says, if it has one.
+fn spent(run: &RunData) -> Option<Spent> {
+    match run.config.algorithm {
+        Algorithm::Seads => run.metrics.last().map(|m| {
+            let t = &m.timings;
+            Spent {
+                wall_s: m.wall_s,
+                env_steps: m.env_steps,
+                phases: [
+                    Some(t.collect),
+                    Some(t.relabel),
+                    Some(t.skill_model),
+                    Some(t.sac),
+                    Some(t.evaluate),
+                ],
+            }
+        }),
+        Algorithm::Sac | Algorithm::Hac => run.task_metrics.last().map(|m| {
+            let t = &m.timings;
+            Spent {
+                wall_s: m.wall_s,
+                env_steps: m.env_steps,
+                phases: [Some(t.collect), None, None, Some(t.sac), Some(t.evaluate)],
+            }
+        }),
+    }
+}
+
+fn mean(values: impl Iterator<Item = f64>) -> Option<f64> {
+    let (sum, n) = values.fold((0.0, 0usize), |(s, n), v| (s + v, n + 1));
+    (n > 0).then(|| sum / n as f64)
+}
+
+/// The wall-time table (markdown, one row per group) and its CSV (one row per run).
+pub fn walltime_tables(groups: &[Group<'_>]) -> (String, String) {
+    let mut md = String::from(
+        "| environment | variant | runs | wall time (min): mean [min, max] | env steps/s |",
+    );
+    for p in PHASES {
+        let _ = write!(md, " {p} (min) |");
+    }
+    md += "\n|---|---|---|---|---|";
+    md += &"---|".repeat(PHASES.len());
+    md.push('\n');
+    let mut csv = String::from("env,variant,run,wall_s,env_steps");
+    for p in PHASES {
+        let _ = write!(csv, ",{}_s", p.replace(' ', "_").to_lowercase());
+    }
+    csv.push('\n');
+    let minutes = |s: Option<f64>| s.map_or("–".to_owned(), |s| format!("{:.1}", s / 60.0));
+    for g in groups {
+        let spent: Vec<(&RunData, Spent)> = g
+            .runs
+            .iter()
+            .filter_map(|r| spent(r).map(|s| (*r, s)))
+            .collect();
+        if spent.is_empty() {
+            continue;
+        }
+        for (run, s) in &spent {
+            let _ = write!(
+                csv,
+                "{},{},{},{},{}",
+                g.env,
+                g.variant,
+                run.dir.display(),
+                s.wall_s,
+                s.env_steps
+            );
+            for p in s.phases {
+                let _ = write!(csv, ",{}", p.map_or(String::new(), |v| v.to_string()));
+            }
+            csv.push('\n');
+        }
+        let walls = || spent.iter().map(|(_, s)| s.wall_s);
+        let lo = walls().fold(f64::INFINITY, f64::min);
+        let hi = walls().fold(f64::NEG_INFINITY, f64::max);
+        let rate = mean(
+            spent
+                .iter()
+                .map(|(_, s)| s.env_steps as f64 / s.wall_s.max(1e-9)),
+        );
+        let _ = write!(
+            md,
+            "| {} | {} | {} | {} [{}, {}] | {} |",
+            g.env,
+            g.variant,
+            spent.len(),
+            minutes(mean(walls())),
+            minutes(Some(lo)),
+            minutes(Some(hi)),
+            rate.map_or("–".to_owned(), |r| format!("{r:.0}"))
+        );
+        for i in 0..PHASES.len() {
+            let _ = write!(
+                md,
+                " {} |",
+                minutes(mean(spent.iter().filter_map(|(_, s)| s.phases[i])))
+            );
+        }
+        md.push('\n');
+    }
+    md += "\nTraining only (the final evaluations are not included), from each run's last metrics \
+           line; a resumed run counts its sessions from where each resumed. Phases are the seconds \
+           spent in each, summed over the run: relabelling runs on its own thread beside the SAC \
+           updates, so the phases may add up to more than the wall time. Runs that shared their \
+           cores took longer than they would alone.\n";
+    (md, csv)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn run(seed: u32, wall: f64) -> RunData {
+        let line = serde_json::json!({
+            "epoch": 9, "env_steps": 1000, "skill_coverage": 20.0, "wall_s": wall,
+            "mean_reward": 1.0, "changed": 1.0, "skill_model_loss": 0.1,
+            "critic_loss": 0.1, "actor_loss": 0.1, "steps_per_s": 1000.0 / wall,
+            "timings": {"collect": 60.0, "relabel": 120.0, "skill_model": 30.0,
+                        "sac": wall - 90.0, "evaluate": 6.0},
+        });
+        RunData {
+            dir: format!("seed-{seed}").into(),
+            copy_to: format!("seed-{seed}").into(),
+            variant: "seads".into(),
+            config: seads_rl::TrainConfig::default(),
+            metrics: vec![serde_json::from_value(line).unwrap()],
+            task_metrics: Vec::new(),
+            policy: None,
+            replan: None,
+            plan_once: None,
+            over_training: Vec::new(),
+        }
+    }
+
+    #[test]
+    fn the_table_averages_hand_made_runs_and_lists_each_in_the_csv() {
+        let runs = [run(1, 600.0), run(2, 1200.0)];
+        let group = Group {
+            env: "lightsout-cursor".into(),
+            variant: "seads".into(),
+            runs: runs.iter().collect(),
+        };
+        let (md, csv) = walltime_tables(&[group]);
+        // Mean of 10 and 20 minutes; rates 1000/600 and 1000/1200 steps/s average to 1.25; SAC
+        // 510 and 1110 s average to 13.5 min.
+        assert!(
+            md.contains("| lightsout-cursor | seads | 2 | 15.0 [10.0, 20.0] | 1 | 1.0 | 2.0 | 0.5 | 13.5 | 0.1 |"),
+            "{md}"
+        );
+        let lines: Vec<&str> = csv.lines().collect();
+        assert_eq!(lines.len(), 3, "{csv}");
+        assert!(lines[1].ends_with(",600,1000,60,120,30,510,6"), "{csv}");
+        assert!(lines[2].ends_with(",1200,1000,60,120,30,1110,6"), "{csv}");
+    }
+}
