@@ -220,6 +220,10 @@ fn a_sweep_is_planned_once_run_to_the_end_and_reported() {
         let fields: Vec<&str> = row.split(',').collect();
         assert_eq!((fields[2], fields[3]), ("2", "10"), "{failures}");
     }
+    // Where the training time went: one row per variant, one CSV line per run.
+    assert!(md.contains("## Where the training time went"), "{md}");
+    let walltime = std::fs::read_to_string(report.join("walltime.csv")).unwrap();
+    assert_eq!(walltime.lines().count(), 5, "{walltime}");
     for f in [
         "success.csv",
         "lengths.csv",
