@@ -8,6 +8,7 @@ use seads_planner::DepthResult;
 
 use super::runs::{Group, RunData};
 use super::stats::{Summary, Test, median, summary, worse_than};
+use crate::plan::EvaluationKind as Mode;
 
 /// One cell of Table 1.
 pub struct CoverageCell {
@@ -134,24 +135,12 @@ pub fn coverage_csv(cells: &[CoverageCell]) -> String {
     csv
 }
 
-/// How a final evaluation solved its tasks.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-enum Mode {
-    /// SEADS, planning again on a deviation (Algorithm 2).
-    Replan,
-    /// SEADS, one plan (Algorithm 1).
-    PlanOnce,
-    /// A baseline's policy acting alone.
-    Policy,
-}
-
-impl Mode {
-    fn label(self) -> &'static str {
-        match self {
-            Mode::Replan => "re-planning",
-            Mode::PlanOnce => "plan once",
-            Mode::Policy => "policy",
-        }
+/// How a table names an evaluation.
+fn label(mode: Mode) -> &'static str {
+    match mode {
+        Mode::Replan => "re-planning",
+        Mode::PlanOnce => "plan once",
+        Mode::Policy => "policy",
     }
 }
 
@@ -195,7 +184,7 @@ pub fn success_tables(groups: &[Group<'_>]) -> (String, String) {
             if evaluated.is_empty() {
                 continue;
             }
-            let mode = mode.label();
+            let mode = label(mode);
             let _ = write!(
                 md,
                 "| {} | {} | {mode} | {} |",
@@ -299,7 +288,7 @@ pub fn success_comparison(groups: &[Group<'_>], reference: Option<&str>) -> Opti
             "| {} | {} | {} | {} | {value} | {test} |",
             g.env,
             g.variant,
-            mode.label(),
+            label(mode),
             s.n
         );
     }

@@ -54,8 +54,7 @@ fn spent(run: &RunData) -> Option<Spent> {
 }
 
 fn mean(values: impl Iterator<Item = f64>) -> Option<f64> {
-    let (sum, n) = values.fold((0.0, 0usize), |(s, n), v| (s + v, n + 1));
-    (n > 0).then(|| sum / n as f64)
+    super::stats::summary(&values.collect::<Vec<_>>()).map(|s| s.mean)
 }
 
 /// The wall-time table (markdown, one row per group) and its CSV (one row per run).
