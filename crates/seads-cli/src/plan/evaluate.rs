@@ -1,0 +1,247 @@
+//! `seads evaluate`: task success of a trained agent (planning, with or without re-planning),
+//! of its checkpoints over training, or of a baseline's policy.
+
+use std::path::PathBuf;
+
+use anyhow::{Context, Result, bail};
+use clap::Args;
+use seads_games::Split;
+use seads_planner::summarise;
+
+use super::{EvaluationKind, SearchLimits, Tasks, load_agent, run_evaluation, task_seeds};
+use crate::BadInput;
+
+/// Parses "1-5", "6,8,10" or "3".
+fn parse_depths(text: &str) -> Result<Vec<usize>> {
+    let bad = || {
+        BadInput(anyhow::anyhow!(
+            "--depths takes a range like 1-5 or a list like 1,3,5, got {text:?}"
+        ))
+    };
+    let depths: Vec<usize> = if let Some((a, b)) = text.split_once('-') {
+        let (a, b): (usize, usize) = (
+            a.trim().parse().map_err(|_| bad())?,
+            b.trim().parse().map_err(|_| bad())?,
+        );
+        (a..=b).collect()
+    } else {
+        text.split(',')
+            .map(|d| d.trim().parse().map_err(|_| bad()))
+            .collect::<Result<_, _>>()?
+    };
+    if depths.is_empty() || depths.contains(&0) {
+        return Err(bad().into());
+    }
+    let mut depths = depths;
+    depths.sort_unstable();
+    depths.dedup();
+    Ok(depths)
+}
+
+/// Arguments of `seads evaluate`.
+#[derive(Debug, Args)]
+pub struct EvaluateArgs {
+    /// Run directory of a trained agent.
+    #[arg(long)]
+    run: PathBuf,
+    /// Solution depths of the boards: a range (1-5; 6-12 for the deep study) or a list.
+    #[arg(long, default_value = "1-5")]
+    depths: String,
+    /// Boards per depth.
+    #[arg(long, default_value_t = 20)]
+    boards: usize,
+    /// Board split.
+    #[arg(long, default_value = "test")]
+    split: Split,
+    /// Re-plan when the board deviates from the prediction (Algorithm 2).
+    #[arg(long)]
+    replan: bool,
+    /// Seed of the task list (default: the 20 seeds of the authors' evaluation).
+    #[arg(long)]
+    seed: Option<u64>,
+    /// Use the checkpoint of this epoch instead of the latest.
+    #[arg(long)]
+    checkpoint: Option<u64>,
+    /// Success over training: evaluate `all` kept checkpoints, every N-th (and the last), or the
+    /// listed epochs (`100,300,1000`; one epoch: `500,`), with and without re-planning,
+    /// appending to evaluation-over-training.jsonl in the run directory. Checkpoints already
+    /// there are skipped.
+    #[arg(long, conflicts_with_all = ["checkpoint", "replan", "seed"])]
+    checkpoints: Option<crate::overtraining::Selection>,
+    /// Time limit per search, seconds (the authors' evaluation used 60).
+    #[arg(long, default_value_t = 60.0, value_parser = crate::positive_finite)]
+    timeout: f64,
+    /// Also stop each search after expanding this many states: a limit that, unlike the clock,
+    /// gives the same results on every machine.
+    #[arg(long, value_parser = clap::value_parser!(u64).range(1..))]
+    max_expanded: Option<u64>,
+    /// No progress bar.
+    #[arg(long)]
+    quiet: bool,
+    /// Print JSON (implies --quiet).
+    #[arg(long)]
+    json: bool,
+}
+
+/// `seads evaluate`.
+pub fn evaluate_run(args: EvaluateArgs) -> Result<()> {
+    let depths = parse_depths(&args.depths)?;
+    let limits = SearchLimits {
+        timeout: args.timeout,
+        max_expanded: args
+            .max_expanded
+            .map(|m| m.try_into().unwrap_or(usize::MAX)),
+    };
+    if args.boards == 0 {
+        bail!(BadInput(anyhow::anyhow!("--boards must be at least 1")));
+    }
+    let config = seads_rl::load_config(&args.run)
+        .with_context(|| format!("loading run {}", args.run.display()))?;
+    if config.algorithm.is_baseline() {
+        if args.checkpoints.is_some() {
+            bail!(BadInput(anyhow::anyhow!(
+                "{}: a baseline's task success over training is in its metrics.jsonl; \
+                 --checkpoints is for SEADS runs",
+                args.run.display()
+            )));
+        }
+        return evaluate_policy(&args, &config, &depths);
+    }
+    if let Some(selection) = args.checkpoints {
+        let added = crate::overtraining::evaluate_checkpoints(
+            &args.run,
+            selection,
+            &depths,
+            args.boards,
+            limits,
+            args.quiet || args.json,
+        )?;
+        let lines = crate::overtraining::read(&args.run)?;
+        if args.json {
+            println!("{}", serde_json::to_string(&lines)?);
+        } else {
+            println!(
+                "{added} new evaluation(s); {} in {}",
+                lines.len(),
+                args.run.join(crate::overtraining::FILE).display()
+            );
+            println!("     epoch   env steps  mode            success per depth");
+            for l in &lines {
+                let rates: Vec<String> = l
+                    .results
+                    .iter()
+                    .map(|r| format!("{:.0}%", 100.0 * r.solved as f64 / r.tasks.max(1) as f64))
+                    .collect();
+                println!(
+                    "{:>10}  {:>10}  {:<14}  {}",
+                    l.epoch,
+                    l.env_steps,
+                    if l.replan { "re-planning" } else { "plan once" },
+                    rates.join(" ")
+                );
+            }
+        }
+        return Ok(());
+    }
+    let mut agent = load_agent(&args.run, args.checkpoint)?;
+    let seeds = task_seeds(args.boards, args.seed);
+    let tasks = Tasks {
+        depths,
+        seeds,
+        split: args.split,
+        replan: args.replan,
+        limits,
+    };
+    let results = run_evaluation(&mut agent, &args.run, tasks, args.quiet || args.json)?;
+    let summary = summarise(&results);
+    if args.json {
+        println!("{}", serde_json::to_string(&summary)?);
+    } else {
+        println!(
+            "{} (epoch {}), {}, {} boards per depth",
+            agent.config.env,
+            agent.epoch,
+            if args.replan {
+                "with re-planning"
+            } else {
+                "plan once"
+            },
+            args.boards
+        );
+        println!(" depth  success  plan found  search s  median steps  median skill steps");
+        for r in &results {
+            let key = r.depth;
+            let fmt = |v: Option<f64>| v.map_or("-".to_owned(), |x| format!("{x:.1}"));
+            println!(
+                "{:>6}  {:>6.0}%  {:>9.0}%  {:>8.3}  {:>12}  {:>18}",
+                r.depth,
+                summary.success_rate[&key] * 100.0,
+                summary.plan_found[&key] * 100.0,
+                summary.planning_s[&key],
+                fmt(summary.solution_steps[&key]),
+                fmt(summary.skill_steps[&key])
+            );
+        }
+    }
+    Ok(())
+}
+
+/// `seads evaluate` on a baseline run: its policy alone on the test boards of each depth, saved
+/// as `evaluation-policy.json` (depths 1–5) or `evaluation-policy-depths-A-B.json`.
+fn evaluate_policy(
+    args: &EvaluateArgs,
+    config: &seads_rl::TrainConfig,
+    depths: &[usize],
+) -> Result<()> {
+    crate::kernels::use_kernels(config.portable_numerics)?;
+    let checkpoint = match args.checkpoint {
+        Some(epoch) => args
+            .run
+            .join("checkpoints")
+            .join(seads_rl::checkpoint_name(epoch)),
+        None => seads_rl::latest_checkpoint(&args.run)?.ok_or_else(|| {
+            BadInput(anyhow::anyhow!(
+                "{} has no checkpoint yet",
+                args.run.display()
+            ))
+        })?,
+    };
+    let mut policy = seads_rl::load_policy(config, &checkpoint)
+        .with_context(|| format!("loading the policy of run {}", args.run.display()))?;
+    let results = seads_rl::task_success(config, policy.as_mut(), depths, args.boards)?;
+    let name = format!("{}.json", EvaluationKind::Policy.stem(depths));
+    seads_rl::write_atomic(
+        &args.run.join(name),
+        serde_json::to_string_pretty(&results)?.as_bytes(),
+    )?;
+    let summary = summarise(&results);
+    if args.json {
+        println!("{}", serde_json::to_string(&summary)?);
+    } else {
+        println!(
+            "{} ({}), its policy alone, {} boards per depth",
+            args.run.display(),
+            checkpoint.display(),
+            args.boards
+        );
+        for r in &results {
+            println!("depth {}: {}/{} solved", r.depth, r.solved, r.tasks);
+        }
+    }
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::parse_depths;
+
+    #[test]
+    fn depths_are_a_range_or_a_list_sorted_once_each_and_never_zero() {
+        assert_eq!(parse_depths("1-5").unwrap(), vec![1, 2, 3, 4, 5]);
+        assert_eq!(parse_depths("6-6").unwrap(), vec![6]);
+        assert_eq!(parse_depths("5, 1,3,3").unwrap(), vec![1, 3, 5]);
+        for bad in ["", "0-3", "0", "5-1", "a", "1,,2", "-3", "1-x"] {
+            assert!(parse_depths(bad).is_err(), "{bad:?} was accepted");
+        }
+    }
+}

@@ -1,0 +1,38 @@
+//! Planning with a trained agent: `seads solve` (one board), `seads evaluate` (task success over
+//! many boards) and `seads plan-bench` (the planner's speed on a fitted model).
+
+mod bench;
+mod evaluate;
+mod evaluation;
+mod solve;
+
+use std::path::Path;
+
+use anyhow::{Context, Result, bail};
+use seads_rl::Agent;
+
+pub use bench::{PlanBenchArgs, plan_bench};
+pub use evaluate::{EvaluateArgs, evaluate_run};
+pub use evaluation::{
+    EvaluationKind, SearchLimits, Tasks, evaluate_agent, run_evaluation, task_seeds,
+};
+pub use solve::{SolveArgs, solve_board};
+
+use crate::BadInput;
+
+/// Loads the agent of a run, turning a missing or foreign directory into a clear error.
+pub fn load_agent(run: &Path, checkpoint: Option<u64>) -> Result<Agent> {
+    let config = seads_rl::load_config(run)
+        .with_context(|| format!("loading the agent of run {}", run.display()))?;
+    crate::kernels::use_kernels(config.portable_numerics)?;
+    if config.algorithm != seads_rl::Algorithm::Seads {
+        bail!(BadInput(anyhow::anyhow!(
+            "{} is a {} baseline run: it has no skills to plan with (`seads evaluate --run` \
+             measures its policy's task success)",
+            run.display(),
+            config.algorithm.name()
+        )));
+    }
+    Agent::load(run, checkpoint)
+        .with_context(|| format!("loading the agent of run {}", run.display()))
+}
