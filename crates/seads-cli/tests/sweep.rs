@@ -395,6 +395,11 @@ fn sweep_commands_reject_bad_input_and_write_nothing() {
         "--max-parallel must be at least 1",
     );
     check_bad_input(&["sweep", "task", s(&out), "--index", "4"], "out of range");
+    check_bad_input(
+        &["sweep", "run", s(&out), "--seeds", "2,7"],
+        "has no seed 7 (its seeds: 1, 2)",
+    );
+    check_bad_input(&["sweep", "run", s(&out), "--seeds", "two"], "--seeds");
     // A different manifest into the same folder.
     let other = write_manifest(
         tmp.path(),
@@ -405,6 +410,31 @@ fn sweep_commands_reject_bad_input_and_write_nothing() {
         "different sweep",
     );
     assert_eq!(snapshot(&out), planned, "nothing written");
+}
+
+#[test]
+fn sweep_run_with_seeds_trains_those_seeds_only() {
+    let tmp = tempfile::tempdir().unwrap();
+    let manifest = write_manifest(tmp.path(), &seads_only_without_evaluation_over_training());
+    let sweep = tmp.path().join("sweep");
+    seads_ok(&["sweep", "plan", s(&manifest), "--out", s(&sweep)]);
+    let out = seads_ok(&["sweep", "run", s(&sweep), "--seeds", "2", "--quiet"]);
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        text.contains("2 runs, 1 with the chosen seeds, 1 to train or resume"),
+        "{text}"
+    );
+    let status = status_json(&sweep);
+    let of_seed = |seed: u64| {
+        status["runs"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .find(|r| r["seed"].as_u64() == Some(seed))
+            .unwrap()["status"]
+            .clone()
+    };
+    assert_eq!((of_seed(1), of_seed(2)), ("pending".into(), "done".into()));
 }
 
 #[test]

@@ -11,31 +11,21 @@ use seads_planner::summarise;
 use super::{EvaluationKind, SearchLimits, Tasks, load_agent, run_evaluation, task_seeds};
 use crate::BadInput;
 
-/// Parses "1-5", "6,8,10" or "3".
+/// Parses "1-5", "6,8,10" or "3": sorted, each once, none zero.
 fn parse_depths(text: &str) -> Result<Vec<usize>> {
     let bad = || {
         BadInput(anyhow::anyhow!(
-            "--depths takes a range like 1-5 or a list like 1,3,5, got {text:?}"
+            "--depths takes a range like 1-5 or a list like 1,3,5 of depths from 1, got {text:?}"
         ))
     };
-    let depths: Vec<usize> = if let Some((a, b)) = text.split_once('-') {
-        let (a, b): (usize, usize) = (
-            a.trim().parse().map_err(|_| bad())?,
-            b.trim().parse().map_err(|_| bad())?,
-        );
-        (a..=b).collect()
-    } else {
-        text.split(',')
-            .map(|d| d.trim().parse().map_err(|_| bad()))
-            .collect::<Result<_, _>>()?
-    };
-    if depths.is_empty() || depths.contains(&0) {
+    let numbers = crate::NumberList::parse(text).map_err(|_| bad())?.0;
+    if numbers.contains(&0) {
         return Err(bad().into());
     }
-    let mut depths = depths;
-    depths.sort_unstable();
-    depths.dedup();
-    Ok(depths)
+    numbers
+        .into_iter()
+        .map(|d| usize::try_from(d).map_err(|_| bad().into()))
+        .collect()
 }
 
 /// Arguments of `seads evaluate`.

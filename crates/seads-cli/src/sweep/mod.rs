@@ -76,6 +76,10 @@ pub struct RunArgs {
     /// Cores to share among the workers (default: all of this machine's).
     #[arg(long)]
     cores: Option<u64>,
+    /// Only the runs of these seeds, a list (1,2,3) or a range (1-3): finish a few seeds of every
+    /// variant before starting more.
+    #[arg(long, value_parser = crate::NumberList::parse)]
+    seeds: Option<crate::NumberList>,
     /// No progress bar.
     #[arg(long)]
     quiet: bool,
@@ -146,7 +150,13 @@ pub fn run(command: SweepCommand) -> Result<()> {
                 Some(w) => at_least_one("--workers", w)?,
                 None => (cores / 2).max(1),
             };
-            pool::run_sweep(&args.dir, workers, cores, args.quiet)
+            pool::run_sweep(
+                &args.dir,
+                args.seeds.as_ref().map(|s| s.0.as_slice()),
+                workers,
+                cores,
+                args.quiet,
+            )
         }
         SweepCommand::Task(args) => {
             // `seads sweep run` looked at the run an instant ago and found it free: if another

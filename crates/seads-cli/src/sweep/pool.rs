@@ -30,12 +30,45 @@ fn progress(run: &Path, done: bool) -> u64 {
     seads_rl::last_env_steps(run).unwrap_or(0).min(budget)
 }
 
-/// Runs the sweep in `dir` with `workers` parallel tasks sharing `cores` cores.
-pub fn run_sweep(dir: &Path, workers: usize, cores: usize, quiet: bool) -> Result<()> {
+/// The runs of `sweep` with one of `seeds` (all runs for `None`), in index order; a seed the
+/// sweep does not have is a usage error.
+fn selected(sweep: &Sweep, seeds: Option<&[u64]>) -> Result<Vec<usize>> {
+    let Some(seeds) = seeds else {
+        return Ok((0..sweep.runs.len()).collect());
+    };
+    if let Some(missing) = seeds
+        .iter()
+        .find(|s| !sweep.runs.iter().any(|r| r.seed == **s))
+    {
+        let mut have: Vec<u64> = sweep.runs.iter().map(|r| r.seed).collect();
+        have.sort_unstable();
+        have.dedup();
+        let have: Vec<String> = have.iter().map(u64::to_string).collect();
+        bail!(crate::BadInput(anyhow::anyhow!(
+            "sweep {:?} has no seed {missing} (its seeds: {})",
+            sweep.name,
+            have.join(", ")
+        )));
+    }
+    Ok((0..sweep.runs.len())
+        .filter(|&i| seeds.contains(&sweep.runs[i].seed))
+        .collect())
+}
+
+/// Runs the sweep in `dir` (only the runs of `seeds`, if given) with `workers` parallel tasks
+/// sharing `cores` cores.
+pub fn run_sweep(
+    dir: &Path,
+    seeds: Option<&[u64]>,
+    workers: usize,
+    cores: usize,
+    quiet: bool,
+) -> Result<()> {
     let sweep = Sweep::load(dir).map_err(crate::BadInput)?;
+    let chosen = selected(&sweep, seeds)?;
     let mut todo = Vec::new();
     let mut skipped_running = 0;
-    for i in 0..sweep.runs.len() {
+    for &i in &chosen {
         let run = sweep.run_dir(dir, i)?;
         match status(&run)?.0 {
             Status::Done => {}
@@ -45,14 +78,18 @@ pub fn run_sweep(dir: &Path, workers: usize, cores: usize, quiet: bool) -> Resul
     }
     let workers = workers.max(1);
     let per_task = (cores / workers).max(1);
+    let of_seeds = seeds.map_or(String::new(), |_| {
+        format!(", {} with the chosen seeds", chosen.len())
+    });
     println!(
-        "sweep {:?}: {} runs, {} to train or resume, {skipped_running} running elsewhere; {workers} worker(s) × {per_task} core(s)",
+        "sweep {:?}: {} runs{of_seeds}, {} to train or resume, {skipped_running} running elsewhere; {workers} worker(s) × {per_task} core(s)",
         sweep.name,
         sweep.runs.len(),
         todo.len()
     );
-    let total: u64 = (0..sweep.runs.len())
-        .map(|i| {
+    let total: u64 = chosen
+        .iter()
+        .map(|&i| {
             let run = dir.join(&sweep.runs[i].dir);
             seads_rl::load_config(&run).map_or(0, |c| c.env_steps)
         })
@@ -118,8 +155,8 @@ pub fn run_sweep(dir: &Path, workers: usize, cores: usize, quiet: bool) -> Resul
         while handles.iter().any(|h| !h.is_finished()) {
             let mut position = 0;
             let mut counts = [0usize; 4];
-            for run in &sweep.runs {
-                let run = dir.join(&run.dir);
+            for &i in &chosen {
+                let run = dir.join(&sweep.runs[i].dir);
                 let s = status(&run).map_or(Status::Pending, |s| s.0);
                 counts[Status::ALL.iter().position(|x| *x == s).unwrap_or(3)] += 1;
                 position += progress(&run, s == Status::Done);
@@ -162,6 +199,9 @@ pub fn run_sweep(dir: &Path, workers: usize, cores: usize, quiet: bool) -> Resul
             dir.display()
         );
     }
-    println!("sweep {:?} complete", sweep.name);
+    match seeds {
+        None => println!("sweep {:?} complete", sweep.name),
+        Some(_) => println!("sweep {:?}: the chosen seeds are complete", sweep.name),
+    }
     Ok(())
 }
