@@ -88,6 +88,29 @@ fn positive_finite(text: &str) -> Result<f64, String> {
     }
 }
 
+/// Ends the process on a command line that clap refused: `--help` and `--version` print as
+/// usual; a usage error becomes one `error:` line naming `--help`, exit code 2, as every other
+/// bad input does.
+fn usage_error(e: clap::Error) -> ! {
+    if !e.use_stderr() {
+        e.exit();
+    }
+    // The first paragraph: the message, and any arguments it lists on the lines below it.
+    let text = e.to_string();
+    let message: Vec<&str> = text
+        .lines()
+        .map(str::trim)
+        .skip_while(|l| l.is_empty())
+        .take_while(|l| !l.is_empty())
+        .collect();
+    if message.is_empty() {
+        eprintln!("error: invalid arguments (see --help)");
+    } else {
+        eprintln!("{} (see --help)", message.join(" "));
+    }
+    std::process::exit(2)
+}
+
 /// A command-line list of whole numbers, written as a range (`1-5`) or a list (`1,3,5`):
 /// sorted, each once, never empty.
 #[derive(Debug, Clone, PartialEq, Eq)]
@@ -203,7 +226,10 @@ fn die_quietly_on_closed_pipes() {
 fn main() -> ExitCode {
     keep_freed_memory();
     die_quietly_on_closed_pipes();
-    let cli = Cli::parse();
+    let cli = match Cli::try_parse() {
+        Ok(cli) => cli,
+        Err(e) => usage_error(e),
+    };
     if runs_libtorch_in_parallel(&cli.command) {
         spin_briefly_in_libgomp();
     }

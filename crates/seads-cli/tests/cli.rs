@@ -132,10 +132,19 @@ fn bad_boards_get_one_line_and_exit_code_2() {
 }
 
 #[test]
-fn unknown_game_is_a_usage_error() {
-    let out = seads(&["games", "depths", "--game", "chess"]);
-    assert_eq!(out.status.code(), Some(2));
-    assert!(String::from_utf8_lossy(&out.stderr).contains("unknown game"));
+fn usage_errors_are_one_line_with_exit_code_2() {
+    check_bad_input(&["games", "depths", "--game", "chess"], "unknown game");
+    check_bad_input(&["trian"], "unrecognized subcommand 'trian'");
+    // A message that lists what is missing keeps the list on its line.
+    check_bad_input(
+        &["evaluate"],
+        "required arguments were not provided: --run <RUN>",
+    );
+    check_bad_input(&["evaluate", "--run", "r", "--boards", "x"], "--boards");
+    // Help is not an error.
+    let out = seads(&["evaluate", "--help"]);
+    assert_eq!(out.status.code(), Some(0));
+    assert!(String::from_utf8_lossy(&out.stdout).contains("--replan"));
 }
 
 #[test]
@@ -992,7 +1001,9 @@ fn numeric_options_reject_negative_nan_and_infinite_values() {
                         let stderr = String::from_utf8_lossy(&out.stderr);
                         assert_eq!(out.status.code(), Some(2), "seads {args:?}: {stderr}");
                         assert!(
-                            stderr.contains("error") && !stderr.contains("panicked"),
+                            stderr.starts_with("error")
+                                && stderr.lines().count() == 1
+                                && !stderr.contains("panicked"),
                             "seads {args:?}: {stderr}"
                         );
                     }
