@@ -40,6 +40,33 @@ fn band(series: &[Vec<(u64, f64, f64)>]) -> Band {
         .collect()
 }
 
+/// The corner of the plot where the legend hides the least: of the lower right, middle right and
+/// upper left (in that order of preference), the one over the fewest drawn points (the means
+/// and the bands' edges), each corner a box of 35 % of the width and 30 % of the height.
+fn legend_corner(curves: &[(String, Band)], x_max: f64, y_max: f64) -> SeriesLabelPosition {
+    let corners = [
+        (SeriesLabelPosition::LowerRight, (0.65, 1.0), (0.0, 0.3)),
+        (SeriesLabelPosition::MiddleRight, (0.65, 1.0), (0.35, 0.65)),
+        (SeriesLabelPosition::UpperLeft, (0.0, 0.35), (0.7, 1.0)),
+    ];
+    let points: Vec<(f64, f64)> = curves
+        .iter()
+        .flat_map(|(_, band)| band.iter())
+        .flat_map(|&(x, mean, min, max)| [(x, mean), (x, min), (x, max)])
+        .map(|(x, y)| (x / x_max, y / y_max))
+        .collect();
+    let covered = |(x0, x1): (f64, f64), (y0, y1): (f64, f64)| {
+        points
+            .iter()
+            .filter(|(x, y)| (x0..=x1).contains(x) && (y0..=y1).contains(y))
+            .count()
+    };
+    corners
+        .into_iter()
+        .min_by_key(|&(_, xs, ys)| covered(xs, ys))
+        .map_or(SeriesLabelPosition::LowerRight, |c| c.0)
+}
+
 /// Draws one band per variant into `out`.
 fn band_figure(
     out: &Path,
@@ -90,7 +117,7 @@ fn band_figure(
         }
         chart
             .configure_series_labels()
-            .position(SeriesLabelPosition::LowerRight)
+            .position(legend_corner(curves, x_max, y_max))
             .border_style(BLACK)
             .background_style(WHITE.mix(0.9))
             .draw()
@@ -312,4 +339,38 @@ fn envs<'a>(groups: &'a [Group<'_>]) -> Vec<&'a str> {
         }
     }
     envs
+}
+
+#[cfg(test)]
+mod tests {
+    use plotters::prelude::SeriesLabelPosition;
+
+    use super::legend_corner;
+
+    fn flat(y: f64) -> super::Band {
+        (0..=10).map(|i| (i as f64 * 10.0, y, y, y)).collect()
+    }
+
+    #[test]
+    fn the_legend_goes_where_no_curve_runs() {
+        let name = String::new;
+        // Curves near the top (coverage): the lower right is free.
+        let high = [(name(), flat(24.0))];
+        assert!(matches!(
+            legend_corner(&high, 100.0, 25.0),
+            SeriesLabelPosition::LowerRight
+        ));
+        // One curve at the top, one along the bottom (baselines' success): the middle right.
+        let split = [(name(), flat(100.0)), (name(), flat(5.0))];
+        assert!(matches!(
+            legend_corner(&split, 100.0, 100.0),
+            SeriesLabelPosition::MiddleRight
+        ));
+        // Curves at the bottom and the middle: the upper left.
+        let low = [(name(), flat(5.0)), (name(), flat(50.0))];
+        assert!(matches!(
+            legend_corner(&low, 100.0, 100.0),
+            SeriesLabelPosition::UpperLeft
+        ));
+    }
 }
