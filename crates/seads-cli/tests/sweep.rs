@@ -220,6 +220,19 @@ fn a_sweep_is_planned_once_run_to_the_end_and_reported() {
         let fields: Vec<&str> = row.split(',').collect();
         assert_eq!((fields[2], fields[3]), ("2", "10"), "{failures}");
     }
+    // Each failed task is listed once in failed-tasks.csv (which exists only if one failed).
+    let failed: usize = failures
+        .lines()
+        .skip(1)
+        .map(|row| row.split(',').nth(4).unwrap().parse::<usize>().unwrap())
+        .sum();
+    match std::fs::read_to_string(report.join("failed-tasks.csv")) {
+        Ok(listed) => {
+            assert_eq!(listed.lines().count(), failed + 1, "{listed}");
+            assert!(md.contains("## The failed tasks, one by one"), "{md}");
+        }
+        Err(_) => assert_eq!(failed, 0, "{failures}"),
+    }
     // Where the training time went: one row per variant, one CSV line per run.
     assert!(md.contains("## Where the training time went"), "{md}");
     let walltime = std::fs::read_to_string(report.join("walltime.csv")).unwrap();

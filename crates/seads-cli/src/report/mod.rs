@@ -1,8 +1,10 @@
 //! `seads report`: tables, tests and figures over any set of sweeps and runs — the paper's
 //! Table 1 with its Mann–Whitney tests, task success and lengths, failed tasks and the skills
-//! that deviated from the model's predictions, where the training time went, coverage and
-//! success curves and length box plots — written to `report.md`, CSV files and PNG + SVG figures.
+//! that deviated from the model's predictions (each failed task's wrong moves too), where the
+//! training time went, coverage and success curves and length box plots — written to
+//! `report.md`, CSV files and PNG + SVG figures.
 
+mod failed_tasks;
 mod failures;
 mod figures;
 mod runs;
@@ -68,6 +70,10 @@ pub fn report(args: ReportArgs) -> Result<()> {
         write("failures.csv", failures_csv)?;
         write("deviations.csv", deviations_csv)?;
     }
+    let failed_tasks = failed_tasks::failed_task_tables(&groups)?;
+    if let Some((_, csv)) = &failed_tasks {
+        write("failed-tasks.csv", csv)?;
+    }
     let k_of = |g: &runs::Group<'_>| tables::skills(g.runs[0]);
     let mut figures = figures::coverage_figures(&args.out, &groups, &k_of)?;
     figures.extend(figures::success_figures(&args.out, &groups)?);
@@ -128,6 +134,11 @@ pub fn report(args: ReportArgs) -> Result<()> {
             md,
             "\nAs CSV: `failures.csv`, and per skill `deviations.csv`.\n"
         );
+    }
+    if let Some((failed_md, _)) = &failed_tasks {
+        let _ = writeln!(md, "## The failed tasks, one by one (re-planning)\n");
+        md += failed_md;
+        let _ = writeln!(md, "\nAs CSV: `failed-tasks.csv`.\n");
     }
     let _ = writeln!(md, "## Where the training time went\n");
     md += &walltime_md;
