@@ -26,6 +26,15 @@ pub fn run_skills(config: &seads_rl::TrainConfig) -> usize {
         })
 }
 
+/// The board game of a run's environment (for a robot run, the tablet's LightsOut 5×5).
+pub fn run_game(config: &seads_rl::TrainConfig) -> Result<Box<dyn seads_games::BoardGame>> {
+    let game = match make_env(&config.env, &config.env_config) {
+        Ok(env) => env.spec().game.build(env.spec().board_size),
+        Err(_) => seads_games::GameKind::LightsOut.build(seads_uarm::BOARD_SIZE),
+    };
+    game.with_context(|| format!("building the game of {}", config.env))
+}
+
 /// `seads envs`: every registered environment with its dimensions.
 pub fn envs(json: bool) -> Result<()> {
     let envs = list_envs();

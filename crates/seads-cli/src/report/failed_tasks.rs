@@ -6,35 +6,14 @@
 use std::fmt::Write as _;
 
 use anyhow::{Context, Result};
-use seads_embodiment::make_env;
-use seads_games::{BoardGame, GameKind, MoveId};
-use serde::Deserialize;
+use seads_games::{BoardGame, MoveId};
 
+use super::failures::{TaskLine, read_tasks};
 use super::runs::Group;
-use crate::plan::EvaluationKind;
+use crate::envs::run_game;
 
 /// The rows shown in report.md; `failed-tasks.csv` has them all.
 const SHOWN: usize = 40;
-
-/// What the listing needs of one line of the per-task file.
-#[derive(Debug, Deserialize)]
-struct TaskLine {
-    depth: usize,
-    solved: bool,
-    plan_found: bool,
-    timed_out: bool,
-    executed: Vec<usize>,
-    deviations: Vec<DeviationLine>,
-}
-
-/// A skill that left another board than predicted.
-#[derive(Debug, Deserialize)]
-struct DeviationLine {
-    skill: usize,
-    before: String,
-    predicted: String,
-    reached: String,
-}
 
 /// What a skill did to the board, or what the model said it would do.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -147,31 +126,27 @@ impl FailedTask {
     }
 }
 
-/// The game of a run's environment (a robot run, not in the registry: the tablet's LightsOut).
-fn game_of(config: &seads_rl::TrainConfig) -> Result<Box<dyn BoardGame>> {
-    let game = match make_env(&config.env, &config.env_config) {
-        Ok(env) => env.spec().game.build(env.spec().board_size),
-        Err(_) => GameKind::LightsOut.build(seads_uarm::BOARD_SIZE),
-    };
-    game.with_context(|| format!("building the game of {}", config.env))
-}
-
 /// The markdown table (without heading; at most [`SHOWN`] rows) and `failed-tasks.csv`, or
 /// `None` if no run has a failed task in its per-task file.
 pub fn failed_task_tables(groups: &[Group<'_>]) -> Result<Option<(String, String)>> {
     let mut rows: Vec<[String; 7]> = Vec::new();
     for g in groups {
+        let mut tasks = Vec::new();
         for run in &g.runs {
-            let path = run.dir.join(EvaluationKind::Replan.tasks_file());
-            if !path.exists() {
-                continue;
+            if let Some(lines) = read_tasks(&run.dir)? {
+                tasks.push((run, lines));
             }
-            let lines: Vec<TaskLine> = seads_rl::read_json_lines(&path)?.0;
-            let game = game_of(&run.config)?;
-            for line in &lines {
-                if let Some(task) = FailedTask::of(game.as_ref(), line)
-                    .with_context(|| format!("reading {}", path.display()))?
-                {
+        }
+        // The runs of a group share their environment's options, so its game too.
+        let Some((first, _)) = tasks.first() else {
+            continue;
+        };
+        let game = run_game(&first.config)?;
+        for (run, lines) in &tasks {
+            for line in lines {
+                if let Some(task) = FailedTask::of(game.as_ref(), line).with_context(|| {
+                    format!("reading the per-task file of {}", run.dir.display())
+                })? {
                     rows.push([
                         g.env.clone(),
                         g.variant.clone(),
@@ -223,6 +198,8 @@ fn csv_field(text: &str) -> String {
 
 #[cfg(test)]
 mod tests {
+    use seads_games::GameKind;
+
     use super::*;
 
     fn line(text: &str) -> TaskLine {

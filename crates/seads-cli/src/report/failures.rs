@@ -12,21 +12,26 @@ use serde::Deserialize;
 use super::runs::Group;
 use crate::plan::EvaluationKind;
 
-/// What the summary needs of one line of the per-task file.
+/// What the report reads of one line of a per-task file (`failed_tasks.rs` lists the failed
+/// ones).
 #[derive(Debug, Deserialize)]
-struct TaskLine {
-    solved: bool,
-    plan_found: bool,
-    timed_out: bool,
-    deviations: Vec<DeviationLine>,
+pub(super) struct TaskLine {
+    pub depth: usize,
+    pub solved: bool,
+    pub plan_found: bool,
+    pub timed_out: bool,
+    /// The skills executed, in order.
+    pub executed: Vec<usize>,
+    pub deviations: Vec<DeviationLine>,
 }
 
 /// A skill that left another board than predicted (boards as `seads solve --board` takes them).
 #[derive(Debug, Deserialize)]
-struct DeviationLine {
-    skill: usize,
-    before: String,
-    reached: String,
+pub(super) struct DeviationLine {
+    pub skill: usize,
+    pub before: String,
+    pub predicted: String,
+    pub reached: String,
 }
 
 /// The failures and deviations of one group's tasks.
@@ -89,7 +94,7 @@ impl Summary {
 }
 
 /// The per-task lines of a run, or `None` if it has no per-task file.
-fn read_tasks(run: &Path) -> Result<Option<Vec<TaskLine>>> {
+pub(super) fn read_tasks(run: &Path) -> Result<Option<Vec<TaskLine>>> {
     let path = run.join(EvaluationKind::Replan.tasks_file());
     if !path.exists() {
         return Ok(None);
@@ -179,14 +184,14 @@ mod tests {
     fn failures_and_deviations_are_counted_by_kind_and_skill() {
         let tasks = [
             line(
-                r#"{"depth":2,"solved":true,"plan_found":true,"timed_out":false,"failure":null,
+                r#"{"depth":2,"solved":true,"plan_found":true,"timed_out":false,"failure":null,"executed":[4,1],
                 "deviations":[{"step":0,"skill":4,"before":"1,0","predicted":"0,0","reached":"1,1"}]}"#,
             ),
             line(
-                r#"{"depth":5,"solved":false,"plan_found":false,"timed_out":true,"failure":"no plan","deviations":[]}"#,
+                r#"{"depth":5,"solved":false,"plan_found":false,"timed_out":true,"failure":"no plan","executed":[],"deviations":[]}"#,
             ),
             line(
-                r#"{"depth":5,"solved":false,"plan_found":true,"timed_out":false,"failure":null,
+                r#"{"depth":5,"solved":false,"plan_found":true,"timed_out":false,"failure":null,"executed":[4,2],
                 "deviations":[{"step":1,"skill":4,"before":"0,1","predicted":"0,0","reached":"0,1"},
                               {"step":2,"skill":2,"before":"0,1","predicted":"0,0","reached":"1,0"}]}"#,
             ),
