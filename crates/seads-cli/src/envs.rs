@@ -75,7 +75,8 @@ pub struct RenderArgs {
     spacing: Option<f64>,
 }
 
-/// `seads render`: a top view of a freshly reset environment.
+/// `seads render`: a top view of a freshly reset environment (and a side view where fields
+/// differ in height).
 pub fn render(args: RenderArgs) -> Result<()> {
     let config = EnvConfig {
         board_size: args.board_size,

@@ -41,7 +41,8 @@ enum Command {
         #[arg(long)]
         json: bool,
     },
-    /// Draw a top view of an environment after reset (board, tile numbers, manipulator).
+    /// Draw a top view of an environment after reset (board, tile numbers, manipulator), with a
+    /// side view of the middle row below it where fields differ in height (lightsout3d-jaco).
     Render(envs::RenderArgs),
     /// Measure environment steps per second with random actions.
     EnvBench(envs::BenchArgs),
