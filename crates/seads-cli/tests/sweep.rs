@@ -326,6 +326,20 @@ fn a_sweep_is_planned_once_run_to_the_end_and_reported() {
         "mixes different lightsout-cursor environments",
     );
     assert!(!nowhere.exists(), "nothing written");
+
+    // The copy has no checkpoints: its tasks refuse to train again over its data.
+    let metrics = |dir: &Path| -> Vec<(PathBuf, Vec<u8>)> {
+        snapshot(dir)
+            .into_iter()
+            .filter(|(p, _)| p.ends_with("metrics.jsonl"))
+            .collect()
+    };
+    let kept = metrics(&data);
+    let out = seads(&["sweep", "task", s(&data), "--index", "0", "--cores", "1"]);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(!out.status.success(), "{stderr}");
+    assert!(stderr.contains("no checkpoints folder"), "{stderr}");
+    assert_eq!(metrics(&data), kept, "the copied metrics are untouched");
 }
 
 #[test]

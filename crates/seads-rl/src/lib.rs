@@ -116,6 +116,19 @@ pub enum RlError {
         #[source]
         source: BoxError,
     },
+    /// A run with evaluation lines has no checkpoints folder: its checkpoints were removed (a
+    /// run copied without them, as `seads report --copy-runs` does). Training it again from
+    /// scratch would replace the metrics it holds, so resuming refuses.
+    #[error(
+        "{dir} holds {lines} evaluation line(s) but no checkpoints folder (copied without its \
+         checkpoints?): it cannot be resumed, and training it again would overwrite its metrics"
+    )]
+    CheckpointsMissing {
+        /// The run directory.
+        dir: String,
+        /// Lines in its metrics file.
+        lines: usize,
+    },
     /// A run that has written checkpoints has none that can be loaded.
     #[error("{dir}: none of its {tried} checkpoint(s) can be loaded; the newest")]
     NoCheckpoint {

@@ -192,13 +192,15 @@ impl<L: Learner> Run<L> {
     /// Repairs what a crash can leave: leftover temporary files and folders are removed; a
     /// checkpoint that cannot be loaded (the latest included) is passed over for the newest one
     /// that can; evaluation lines after that checkpoint, and a torn last line, are dropped.
-    /// Each repair is described in [`Run::repairs`]. It is an error only when no checkpoint can
-    /// be loaded although the run has written one.
+    /// Each repair is described in [`Run::repairs`]. It is an error when no checkpoint can be
+    /// loaded although the run has written one, and when a run with metrics has no checkpoints
+    /// folder at all.
     pub fn resume_with(
         dir: &Path,
         mut build: impl FnMut(TrainConfig) -> Result<L, RlError>,
     ) -> Result<Self, RlError> {
         let config = load_config(dir)?;
+        let had_folder = dir.join(CHECKPOINTS).is_dir();
         // A directory planned by a sweep holds only its config: the run starts here.
         if !dir.join(METRICS).exists() {
             fs::create_dir_all(dir.join(CHECKPOINTS)).map_err(|e| RlError::io(dir, e))?;
@@ -243,6 +245,14 @@ impl<L: Learner> Run<L> {
             }
         }
         let (mut metrics, torn) = read_metrics_text::<L::Metrics>(dir)?;
+        // Every run makes its checkpoints folder before its first metrics line, and nothing
+        // removes it: without it, the run's checkpoints were taken away, not lost in a crash.
+        if !had_folder && !metrics.is_empty() {
+            return Err(RlError::CheckpointsMissing {
+                dir: dir.display().to_string(),
+                lines: metrics.len(),
+            });
+        }
         if torn {
             repairs.push(format!("dropped a torn last line of {METRICS}"));
         }

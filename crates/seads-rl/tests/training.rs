@@ -309,6 +309,19 @@ fn corrupt_checkpoints_are_errors_not_panics() {
         ),
         "checkpoints were written, none that resuming can load is left"
     );
+    // Without its checkpoints folder (a run copied without checkpoints), resuming refuses
+    // instead of training again over the metrics, which stay as they were.
+    let metrics = std::fs::read(path.join("metrics.jsonl")).unwrap();
+    std::fs::remove_dir_all(path.join("checkpoints")).unwrap();
+    let err = Run::<Trainer>::resume(&path)
+        .err()
+        .expect("a run with metrics and no checkpoints folder");
+    assert!(
+        matches!(err, RlError::CheckpointsMissing { lines, .. } if lines > 0),
+        "{err}"
+    );
+    assert_eq!(std::fs::read(path.join("metrics.jsonl")).unwrap(), metrics);
+    assert!(!path.join("checkpoints").exists());
 }
 
 /// The same run killed after a checkpoint and resumed equals the run that was never killed, in
