@@ -337,8 +337,20 @@ fn a_sweep_is_planned_once_run_to_the_end_and_reported() {
     let kept = metrics(&data);
     let out = seads(&["sweep", "task", s(&data), "--index", "0", "--cores", "1"]);
     let stderr = String::from_utf8_lossy(&out.stderr);
-    assert!(!out.status.success(), "{stderr}");
+    assert_eq!(out.status.code(), Some(2), "{stderr}");
     assert!(stderr.contains("no checkpoints folder"), "{stderr}");
+    assert_eq!(metrics(&data), kept, "the copied metrics are untouched");
+    // Its runs are "copied" (not pending, not failed: the refused task recorded nothing), and
+    // running the copied sweep trains none of them and succeeds.
+    let st = status_json(&data);
+    assert_eq!(st["copied"], st["total"], "{st}");
+    assert_eq!(st["runs"][0]["status"], "copied", "{st}");
+    let out = seads_ok(&["sweep", "run", s(&data), "--workers", "2", "--quiet"]);
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        stdout.contains("0 to train or resume") && stdout.contains("copied in without checkpoints"),
+        "{stdout}"
+    );
     assert_eq!(metrics(&data), kept, "the copied metrics are untouched");
 }
 

@@ -230,6 +230,15 @@ pub fn last_env_steps(dir: &Path) -> Result<u64, RlError> {
     Ok(lines.last().map_or(0, |l| l.env_steps))
 }
 
+/// Whether `dir` holds a run's metrics but no checkpoints folder: a run copied without its
+/// checkpoints (as `seads report --copy-runs` copies), whose data can be reported but which can
+/// never be trained further. Every run makes its checkpoints folder before its first metrics
+/// line, and nothing removes it, so a crash never leaves a run in this state.
+pub fn is_copy_without_checkpoints(dir: &Path) -> bool {
+    !dir.join(CHECKPOINTS).is_dir()
+        && fs::metadata(dir.join(METRICS)).is_ok_and(|m| m.is_file() && m.len() > 0)
+}
+
 /// The whole lines of `dir/metrics.jsonl`, and whether a torn last line was left out.
 pub(crate) fn read_metrics_text<M: MetricsLine>(dir: &Path) -> Result<(Vec<M>, bool), RlError> {
     read_json_lines(&dir.join(METRICS))

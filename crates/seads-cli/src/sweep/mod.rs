@@ -293,6 +293,7 @@ fn status(args: StatusArgs) -> Result<()> {
             running: usize,
             failed: usize,
             pending: usize,
+            copied: usize,
             runs: &'a [RunStatus],
         }
         let report = Report {
@@ -302,6 +303,7 @@ fn status(args: StatusArgs) -> Result<()> {
             running: count(Status::Running),
             failed: count(Status::Failed),
             pending: count(Status::Pending),
+            copied: count(Status::Copied),
             runs: &rows,
         };
         println!("{}", serde_json::to_string(&report)?);
@@ -327,14 +329,20 @@ fn status(args: StatusArgs) -> Result<()> {
             )),
         );
     }
+    let copied = count(Status::Copied);
     println!(
-        "sweep {:?}: {} runs: {} done, {} running, {} failed, {} pending",
+        "sweep {:?}: {} runs: {} done, {} running, {} failed, {} pending{}",
         sweep.name,
         rows.len(),
         count(Status::Done),
         count(Status::Running),
         count(Status::Failed),
-        count(Status::Pending)
+        count(Status::Pending),
+        if copied > 0 {
+            format!(", {copied} copied in without checkpoints")
+        } else {
+            String::new()
+        }
     );
     Ok(())
 }

@@ -68,10 +68,12 @@ pub fn run_sweep(
     let chosen = selected(&sweep, seeds)?;
     let mut todo = Vec::new();
     let mut skipped_running = 0;
+    let mut copied = 0;
     for &i in &chosen {
         let run = sweep.run_dir(dir, i)?;
         match status(&run)?.0 {
             Status::Done => {}
+            Status::Copied => copied += 1,
             Status::Running => skipped_running += 1,
             Status::Failed | Status::Pending => todo.push(i),
         }
@@ -81,8 +83,13 @@ pub fn run_sweep(
     let of_seeds = seeds.map_or(String::new(), |_| {
         format!(", {} with the chosen seeds", chosen.len())
     });
+    let of_copied = if copied > 0 {
+        format!(", {copied} copied in without checkpoints (reported as they are)")
+    } else {
+        String::new()
+    };
     println!(
-        "sweep {:?}: {} runs{of_seeds}, {} to train or resume, {skipped_running} running elsewhere; {workers} worker(s) × {per_task} core(s)",
+        "sweep {:?}: {} runs{of_seeds}, {} to train or resume, {skipped_running} running elsewhere{of_copied}; {workers} worker(s) × {per_task} core(s)",
         sweep.name,
         sweep.runs.len(),
         todo.len()
@@ -120,7 +127,10 @@ pub fn run_sweep(
                     let run = dir.join(&sweep.runs[index].dir);
                     // Another `sweep run` (or a Slurm task) may have taken or finished the run
                     // since this one listed it: leave it to that one.
-                    if matches!(status(&run)?.0, Status::Running | Status::Done) {
+                    if matches!(
+                        status(&run)?.0,
+                        Status::Running | Status::Done | Status::Copied
+                    ) {
                         let mut finished = finished.lock().expect("finished lock");
                         finished.push(Finished { index, ok: None });
                         continue;
@@ -154,7 +164,7 @@ pub fn run_sweep(
         // The bar follows the runs' own files until every worker has finished.
         while handles.iter().any(|h| !h.is_finished()) {
             let mut position = 0;
-            let mut counts = [0usize; 4];
+            let mut counts = [0usize; Status::ALL.len()];
             for &i in &chosen {
                 let run = dir.join(&sweep.runs[i].dir);
                 let s = status(&run).map_or(Status::Pending, |s| s.0);
@@ -162,10 +172,13 @@ pub fn run_sweep(
                 position += progress(&run, s == Status::Done);
             }
             bar.set_position(position);
-            bar.set_message(format!(
-                "done {} running {} failed {} pending {}",
-                counts[0], counts[1], counts[2], counts[3]
-            ));
+            let message: Vec<String> = Status::ALL
+                .iter()
+                .zip(counts)
+                .filter(|&(s, n)| n > 0 || *s != Status::Copied)
+                .map(|(s, n)| format!("{} {n}", s.name()))
+                .collect();
+            bar.set_message(message.join(" "));
             std::thread::sleep(Duration::from_millis(if quiet { 5000 } else { 1000 }));
         }
         for handle in handles {

@@ -170,11 +170,20 @@ pub enum Status {
     Failed,
     /// Not started, or interrupted (killed) and waiting to be resumed.
     Pending,
+    /// Its data was copied in without checkpoints (`seads report --copy-runs`, copied back into
+    /// a sweep): reported as it is, never trained further.
+    Copied,
 }
 
 impl Status {
     /// Every status, in the order of the summary.
-    pub const ALL: [Status; 4] = [Self::Done, Self::Running, Self::Failed, Self::Pending];
+    pub const ALL: [Status; 5] = [
+        Self::Done,
+        Self::Running,
+        Self::Failed,
+        Self::Pending,
+        Self::Copied,
+    ];
 
     /// Lower-case name.
     pub fn name(self) -> &'static str {
@@ -183,11 +192,14 @@ impl Status {
             Self::Running => "running",
             Self::Failed => "failed",
             Self::Pending => "pending",
+            Self::Copied => "copied",
         }
     }
 }
 
-/// The status of `run` and its record.
+/// The status of `run` and its record. A run that a task finished stays done when its
+/// checkpoints are removed; one whose data was copied in without them, with no record of a
+/// finished task, is [`Status::Copied`].
 pub fn status(run: &Path) -> Result<(Status, Option<Record>)> {
     let record = Record::read(run)?;
     let status = if is_claimed(run) {
@@ -195,6 +207,7 @@ pub fn status(run: &Path) -> Result<(Status, Option<Record>)> {
     } else {
         match record.as_ref().map(|r| r.outcome) {
             Some(Outcome::Done) => Status::Done,
+            _ if seads_rl::is_copy_without_checkpoints(run) => Status::Copied,
             Some(Outcome::Failed) => Status::Failed,
             Some(Outcome::Running) | None => Status::Pending,
         }
@@ -228,5 +241,30 @@ mod tests {
         let (s, r) = status(dir.path()).unwrap();
         assert_eq!(s, Status::Failed);
         assert_eq!(r.unwrap().error.as_deref(), Some("boom"));
+    }
+
+    #[test]
+    fn data_copied_without_checkpoints_is_copied_unless_a_task_finished_it() {
+        let dir = tempfile::tempdir().unwrap();
+        let run = dir.path();
+        std::fs::create_dir(run.join("checkpoints")).unwrap();
+        std::fs::write(run.join("metrics.jsonl"), "{\"epoch\":1}\n").unwrap();
+        // A run that trained (checkpoints folder present) and was killed: to be resumed.
+        assert_eq!(status(run).unwrap().0, Status::Pending);
+        std::fs::remove_dir(run.join("checkpoints")).unwrap();
+        assert_eq!(status(run).unwrap().0, Status::Copied);
+        // A failed record does not make copied data trainable.
+        Record::write(run, Outcome::Failed, 1, Some("no checkpoints".into())).unwrap();
+        assert_eq!(status(run).unwrap().0, Status::Copied);
+        // A run a task finished is done, with or without its checkpoints.
+        Record::write(run, Outcome::Done, 1, None).unwrap();
+        assert_eq!(status(run).unwrap().0, Status::Done);
+        // An empty metrics file is no data: a planned run.
+        let planned = tempfile::tempdir().unwrap();
+        std::fs::write(planned.path().join("metrics.jsonl"), "").unwrap();
+        assert_eq!(status(planned.path()).unwrap().0, Status::Pending);
+        // Held by a task, it is running whatever its files say.
+        let _claim = Claim::take(run, PATIENCE).unwrap();
+        assert_eq!(status(run).unwrap().0, Status::Running);
     }
 }

@@ -5,7 +5,7 @@
 use std::path::Path;
 use std::time::Duration;
 
-use anyhow::{Context, Result};
+use anyhow::{Context, Result, bail};
 use seads_rl::{Algorithm, Hac, Run, TaskSac, Trainer};
 
 use crate::train::Shown;
@@ -37,6 +37,15 @@ pub fn run_task(dir: &Path, index: usize, cores: usize, patience: Duration) -> R
     {
         println!("{}: already done", run.display());
         return Ok(());
+    }
+    // Training it again from scratch would replace the data it holds; nothing is recorded, so
+    // the run stays "copied".
+    if seads_rl::is_copy_without_checkpoints(&run) {
+        bail!(crate::BadInput(anyhow::anyhow!(
+            "{} holds a run's data but no checkpoints folder (copied in by `seads report \
+             --copy-runs`?): it is reported as it is and cannot be trained further",
+            run.display()
+        )));
     }
     let attempts = previous.map_or(0, |r| r.attempts) + 1;
     Record::write(&run, Outcome::Running, attempts, None)?;
