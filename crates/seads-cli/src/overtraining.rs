@@ -93,19 +93,14 @@ impl std::str::FromStr for Selection {
         }
         if text.contains(',') {
             // `500,` lists the one epoch 500 (a bare number is every N-th).
-            return text
-                .split(',')
-                .map(str::trim)
-                .filter(|e| !e.is_empty())
-                .map(|e| e.parse::<u64>().map_err(|_| bad()))
-                .collect::<Result<Vec<_>, _>>()
-                .and_then(|e| {
-                    if e.is_empty() {
-                        Err(bad())
-                    } else {
-                        Ok(Self::Epochs(e))
-                    }
-                });
+            // Epochs are listed, not ranged: few of a range's epochs have a checkpoint.
+            let listed = text.trim_end().trim_end_matches(',');
+            if listed.contains('-') {
+                return Err(bad());
+            }
+            return crate::NumberList::parse(listed)
+                .map(|epochs| Self::Epochs(epochs.0))
+                .map_err(|_| bad());
         }
         match text.parse::<usize>() {
             Ok(n) if n > 0 => Ok(Self::Every(n)),
@@ -241,7 +236,7 @@ mod tests {
         assert_eq!(epochs(&"300,".parse().unwrap()), [300]);
         let missing = "100,250,600".parse::<Selection>().unwrap().choose(&kept);
         assert_eq!(missing.unwrap_err(), "250, 600");
-        for bad in ["0", "x", "1,x", "-1", ","] {
+        for bad in ["0", "x", "1,x", "-1", ",", "1,,2", "1-3,"] {
             assert!(bad.parse::<Selection>().is_err(), "{bad}");
         }
     }
