@@ -40,6 +40,12 @@ pub trait Environment: Send + Sync {
     /// Where the end effector (cursor, fingertip, tool centre point) is above the board, in
     /// normalised board coordinates (u to the right, v down the rows).
     fn end_effector(&self) -> [f64; 2];
+    /// Where the end effector was when the last step made its move, if the manipulator has been
+    /// re-initialised since, within that step (the Jaco, as in the reference): then
+    /// [`Environment::end_effector`] tells the new pose, not the push. `None` otherwise.
+    fn move_point(&self) -> Option<[f64; 2]> {
+        None
+    }
     /// A boxed copy (same state, same random streams).
     fn box_clone(&self) -> Box<dyn Environment>;
 
@@ -103,6 +109,11 @@ pub trait Manipulator: Clone + Send + Sync + 'static {
     }
     /// The end effector in normalised board coordinates.
     fn end_effector(&self) -> [f64; 2];
+    /// Where the end effector was at the last step's move, if the manipulator re-initialised
+    /// itself after it within that step ([`Environment::move_point`]); `None` otherwise.
+    fn move_point(&self) -> Option<[f64; 2]> {
+        None
+    }
     /// Draws the manipulator and widens `extent` to what it can reach.
     fn draw(&self, shapes: &mut Vec<Shape>, extent: &mut [f64; 4]);
     /// Heights of the fields' top surfaces above the table, row-major, metres (empty: flat).
@@ -329,6 +340,10 @@ impl<M: Manipulator> Environment for Embodied<M> {
 
     fn end_effector(&self) -> [f64; 2] {
         self.manipulator.end_effector()
+    }
+
+    fn move_point(&self) -> Option<[f64; 2]> {
+        self.manipulator.move_point()
     }
 
     fn box_clone(&self) -> Box<dyn Environment> {

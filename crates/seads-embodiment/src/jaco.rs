@@ -264,6 +264,9 @@ pub struct Jaco {
     substeps: usize,
     /// Resets and re-initialisations that found no reachable pose and fell back to a fixed one.
     ik_fallbacks: u64,
+    /// Where the tool centre point was (board coordinates) when the last step made its move,
+    /// before the arm was re-initialised; `None` after a step without a move.
+    move_point: Option<[f64; 2]>,
 }
 
 impl Jaco {
@@ -363,6 +366,7 @@ impl Jaco {
             ctrl: [0.0; 9],
             substeps,
             ik_fallbacks: 0,
+            move_point: None,
         };
         let dofs: Vec<usize> = (0..LINKS.len()).map(|i| jaco.dof(i)).collect();
         let mb = jaco.multibody_mut();
@@ -664,6 +668,7 @@ impl Clone for Jaco {
         let action: Vec<f32> = ctrl.iter().zip(&LINKS).map(|(c, d)| c / d.ctrl).collect();
         copy.set_controls(&action);
         copy.ik_fallbacks = self.ik_fallbacks;
+        copy.move_point = self.move_point;
         copy
     }
 }
@@ -702,15 +707,15 @@ impl Manipulator for Jaco {
         touch: &mut dyn FnMut(Touch) -> Push,
     ) -> bool {
         self.set_controls(action);
-        let mut moved = false;
+        self.move_point = None;
         for _ in 0..self.substeps {
             self.world.step();
-            if !moved
+            if self.move_point.is_none()
                 && let Some(press) = self.detect_press()
                 && matches!(touch(press), Push::Move(_))
             {
                 // After a move the arm is re-initialised; the remaining substeps continue.
-                moved = true;
+                self.move_point = Some(self.end_effector());
                 self.randomize(rng);
             }
         }
@@ -746,6 +751,10 @@ impl Manipulator for Jaco {
 
     fn can_restore(&self) -> bool {
         false
+    }
+
+    fn move_point(&self) -> Option<[f64; 2]> {
+        self.move_point
     }
 
     fn end_effector(&self) -> [f64; 2] {

@@ -19,7 +19,9 @@ pub struct SkillRun {
     pub steps: usize,
     /// The last step's outcome (a move, a miss or a time-out).
     pub outcome: StepOutcome,
-    /// End-effector positions (board coordinates) before the first step and after every step.
+    /// End-effector positions (board coordinates) before the first step and after every step;
+    /// after the step of a move, where the move was made (a Jaco re-initialises its arm within
+    /// that step: [`Environment::move_point`]).
     pub path: Vec<[f64; 2]>,
     /// Steps at which a push happened (a move or a miss), as indices into `path`.
     pub pushes: Vec<usize>,
@@ -53,7 +55,9 @@ pub fn execute_skill(
         run.outcome = env.step(&action)?;
         run.steps += 1;
         env.observe(&mut obs);
-        run.path.push(env.end_effector());
+        // A Jaco re-initialises its arm within the step of a move: the path ends at the push.
+        run.path
+            .push(env.move_point().unwrap_or_else(|| env.end_effector()));
         if run.outcome.push != crate::Push::None {
             run.pushes.push(run.steps);
         }

@@ -9,7 +9,8 @@ use rand::SeedableRng;
 use rapier3d::math::{Rotation, Vector};
 use rapier3d::na::{DMatrix, DVector};
 use seads_embodiment::{
-    EnvConfig, Environment, Jaco, JacoBoard, Layout, Manipulator, Push, Touch, make_env,
+    EnvConfig, Environment, Jaco, JacoBoard, Layout, Manipulator, Push, SkillPolicy, Touch,
+    execute_skill, make_env,
 };
 use seads_games::MoveId;
 
@@ -95,6 +96,70 @@ fn press(env: &mut dyn Environment, seed: u64, target: [f32; 2], top: f32) -> Op
         }
     }
     None
+}
+
+/// The scripted reach of `press` as a one-skill policy, for `execute_skill`.
+struct Reach {
+    target: [f32; 2],
+    top: f32,
+    descending: std::cell::Cell<bool>,
+}
+
+impl SkillPolicy for Reach {
+    fn num_skills(&self) -> usize {
+        1
+    }
+
+    fn act(&self, observations: &[f32], _skills: &[usize], actions: &mut [f32]) {
+        let (tcp, _) = forward(&angles(observations));
+        let over = (tcp.x - self.target[0]).hypot(tcp.y - self.target[1]) < 0.02;
+        self.descending.set(self.descending.get() || over);
+        let z = if self.descending.get() {
+            (tcp.z - 0.05).max(self.top - 0.05)
+        } else {
+            self.top + 0.10
+        };
+        let goal = Vector::new(self.target[0], self.target[1], z);
+        actions.copy_from_slice(&controller(goal, observations));
+    }
+}
+
+/// The arm is re-initialised within the step of a move (as in the reference), so the end
+/// effector after that step is the new pose; a skill's path (the skill figures) ends where the
+/// move was made, above the pressed field, not at the new pose.
+#[test]
+fn a_skill_path_ends_at_the_press_not_at_the_re_initialised_arm() {
+    let mut env = make_env("lightsout-jaco", &EnvConfig::default()).unwrap();
+    env.seed(1);
+    env.reset().unwrap();
+    // Field 0 (row 0, column 0) is centred at world (-0.2, 0.2): board coordinates (0.1, 0.1),
+    // fields 0.2 wide in board units.
+    let reach = Reach {
+        target: [-0.2, 0.2],
+        top: 0.02,
+        descending: std::cell::Cell::new(false),
+    };
+    let run = execute_skill(env.as_mut(), &reach, 0).unwrap();
+    assert_eq!(run.outcome.game_move(), Some(0), "{:?}", run.outcome);
+    assert_eq!(run.pushes.last(), Some(&run.steps));
+    let field = [0.1, 0.1];
+    let distance = |p: [f64; 2]| (p[0] - field[0]).hypot(p[1] - field[1]);
+    let end = run.path[run.steps];
+    assert_eq!(env.move_point(), Some(end));
+    assert!(
+        distance(end) < 0.1,
+        "the path ends at {end:?}, off the pressed field"
+    );
+    // The re-initialised arm stands above the board's middle (TCP within ±0.1 m of its centre).
+    let now = env.end_effector();
+    assert!(
+        distance(now) > 0.15,
+        "the arm was not re-initialised: {now:?}"
+    );
+    // A step without a move has no move point.
+    env.reset_step_counter();
+    env.step(&[0.0; 9]).unwrap();
+    assert_eq!(env.move_point(), None);
 }
 
 /// The scene reports the fields' heights: LightsOut3DJaco's rise from the centre (2, 6 and
