@@ -343,6 +343,15 @@ fn trajectories_figure(
             ("sans-serif", 16),
         ).map_err(plot_err)?;
             for (skill, panel) in area.split_evenly((rows, cols)).iter().enumerate().take(k) {
+                // A frame per panel: the view reaches beyond the board, so without it a caption
+                // stands nearer to the board above it than to its own.
+                let (w, h) = panel.dim_in_pixel();
+                panel
+                    .draw(&Rectangle::new(
+                        [(1, 1), (w as i32 - 2, h as i32 - 2)],
+                        RGBColor(190, 190, 190).stroke_width(1),
+                    ))
+                    .map_err(plot_err)?;
                 let caption = match dominant_move(&runs[skill]) {
                     Some((m, c)) => format!("skill {skill}: move {m} ({c}/20)"),
                     None => format!("skill {skill}: no move"),
