@@ -74,35 +74,28 @@ fn controller(target: Vector, obs: &[f32]) -> Vec<f32> {
 fn press(env: &mut dyn Environment, seed: u64, target: [f32; 2], top: f32) -> Option<MoveId> {
     env.seed(seed);
     env.reset().unwrap();
-    let limit = env.spec().step_limit.unwrap();
-    let mut descending = false;
-    for _ in 0..limit {
-        let obs = env.observation();
-        let (tcp, _) = forward(&angles(&obs));
-        // Approach from above, then descend (and stay descending) once over the target.
-        descending |= (tcp.x - target[0]).hypot(tcp.y - target[1]) < 0.02;
-        let goal = Vector::new(
-            target[0],
-            target[1],
-            if descending {
-                (tcp.z - 0.05).max(top - 0.05)
-            } else {
-                top + 0.10
-            },
-        );
-        let out = env.step(&controller(goal, &obs)).unwrap();
-        if out.done() {
-            return out.game_move();
-        }
-    }
-    None
+    execute_skill(env, &Reach::new(target, top), 0)
+        .unwrap()
+        .outcome
+        .game_move()
 }
 
-/// The scripted reach of `press` as a one-skill policy, for `execute_skill`.
+/// The scripted reach as a one-skill policy: towards board point `target` (world x, y) at a
+/// field top `top`, approaching from above, then descending (and staying so) once over it.
 struct Reach {
     target: [f32; 2],
     top: f32,
     descending: std::cell::Cell<bool>,
+}
+
+impl Reach {
+    fn new(target: [f32; 2], top: f32) -> Self {
+        Self {
+            target,
+            top,
+            descending: std::cell::Cell::new(false),
+        }
+    }
 }
 
 impl SkillPolicy for Reach {
@@ -134,12 +127,7 @@ fn a_skill_path_ends_at_the_press_not_at_the_re_initialised_arm() {
     env.reset().unwrap();
     // Field 0 (row 0, column 0) is centred at world (-0.2, 0.2): board coordinates (0.1, 0.1),
     // fields 0.2 wide in board units.
-    let reach = Reach {
-        target: [-0.2, 0.2],
-        top: 0.02,
-        descending: std::cell::Cell::new(false),
-    };
-    let run = execute_skill(env.as_mut(), &reach, 0).unwrap();
+    let run = execute_skill(env.as_mut(), &Reach::new([-0.2, 0.2], 0.02), 0).unwrap();
     assert_eq!(run.outcome.game_move(), Some(0), "{:?}", run.outcome);
     assert_eq!(run.pushes.last(), Some(&run.steps));
     let field = [0.1, 0.1];

@@ -200,7 +200,7 @@ impl<L: Learner> Run<L> {
         mut build: impl FnMut(TrainConfig) -> Result<L, RlError>,
     ) -> Result<Self, RlError> {
         let config = load_config(dir)?;
-        let had_folder = dir.join(CHECKPOINTS).is_dir();
+        let copied = crate::store::is_copy_without_checkpoints(dir);
         // A directory planned by a sweep holds only its config: the run starts here.
         if !dir.join(METRICS).exists() {
             fs::create_dir_all(dir.join(CHECKPOINTS)).map_err(|e| RlError::io(dir, e))?;
@@ -245,9 +245,9 @@ impl<L: Learner> Run<L> {
             }
         }
         let (mut metrics, torn) = read_metrics_text::<L::Metrics>(dir)?;
-        // Every run makes its checkpoints folder before its first metrics line, and nothing
-        // removes it: without it, the run's checkpoints were taken away, not lost in a crash.
-        if !had_folder && !metrics.is_empty() {
+        // Checked before anything is written (see `is_copy_without_checkpoints`); a file that
+        // held only a torn line is no data.
+        if copied && !metrics.is_empty() {
             return Err(RlError::CheckpointsMissing {
                 dir: dir.display().to_string(),
                 lines: metrics.len(),
