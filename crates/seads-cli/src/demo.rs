@@ -21,10 +21,10 @@ pub struct RunArgs {
     /// Environment (its preset supplies every other setting).
     #[arg(long, default_value = "lightsout-cursor")]
     env: String,
-    /// Training budget in environment steps (the paper's Cursor budget is 500000). The default
-    /// ends seed 1 at epoch 1700, where its skill coverage is 24.9/25; the run is the same on
+    /// Training budget in environment steps (the paper's Cursor budget is 500000). With the
+    /// default, seed 1 ends at epoch 1720 with skill coverage 24.95/25; the run is the same on
     /// every machine (portable numerics), and coverage wobbles by about a skill between
-    /// evaluations (23.95 at epoch 1728).
+    /// evaluations (docs/results/demo).
     #[arg(long, default_value_t = 157_252)]
     env_steps: u64,
     /// Seed of the run.
