@@ -22,9 +22,9 @@ pub struct RunArgs {
     #[arg(long, default_value = "lightsout-cursor")]
     env: String,
     /// Training budget in environment steps (the paper's Cursor budget is 500000). With the
-    /// default, seed 1 ends at epoch 1720 with skill coverage 24.95/25; the run is the same on
-    /// every machine (portable numerics), and coverage wobbles by about a skill between
-    /// evaluations (docs/results/demo).
+    /// default, seed 1 ends at epoch 1720 with skill coverage 24.95/25 on the Intel Xeon it was
+    /// recorded on (portable numerics; an AMD EPYC gave another run), and coverage wobbles by
+    /// about a skill between evaluations (docs/results/demo).
     #[arg(long, default_value_t = 157_252)]
     env_steps: u64,
     /// Seed of the run.
@@ -50,7 +50,7 @@ pub fn run(args: RunArgs) -> Result<()> {
         let mut config = TrainConfig::preset(&args.env).map_err(|e| BadInput(e.into()))?;
         config.env_steps = args.env_steps;
         config.seed = args.seed;
-        // The demo gives the same numbers on every machine.
+        // Portable kernels: the same numbers on every machine of a kind (docs/RESULTS.md).
         config.portable_numerics = true;
         crate::kernels::use_kernels(true)?;
         println!(

@@ -10,6 +10,7 @@ mod kernels;
 mod overtraining;
 mod plan;
 mod plot;
+mod provenance;
 mod report;
 mod sweep;
 mod train;

@@ -298,6 +298,12 @@ pub fn drive<L: Shown>(run: &mut Run<L>, quiet: bool) -> Result<()> {
         run.set_hook(hook);
     }
     let budget = run.trainer().config().env_steps;
+    if !run.finished() {
+        let portable = run.trainer().config().portable_numerics;
+        crate::provenance::Provenance::here(run.trainer().epoch(), run.trainer().steps(), portable)
+            .append(run.dir())
+            .context("recording the run's provenance")?;
+    }
     let bar = if quiet {
         ProgressBar::hidden()
     } else {

@@ -298,6 +298,40 @@ fn train_writes_a_run_directory_and_resumes() {
     assert!(run.join("checkpoints/latest").exists());
     // Resuming a finished run has nothing left to do but succeeds.
     seads_ok(&["train", "--resume", run.to_str().unwrap(), "--quiet"]);
+    // Each training process names its code and processor, from where it started; a resume that
+    // raises the budget adds a line from the checkpoint's epoch, one with nothing to do does not.
+    seads_ok(&[
+        "train",
+        "--resume",
+        run.to_str().unwrap(),
+        "--env-steps",
+        "900",
+        "--quiet",
+    ]);
+    let provenance: Vec<serde_json::Value> = std::fs::read_to_string(run.join("provenance.jsonl"))
+        .unwrap()
+        .lines()
+        .map(|l| serde_json::from_str(l).unwrap())
+        .collect();
+    assert_eq!(provenance.len(), 2, "{provenance:?}");
+    assert_eq!(
+        (
+            provenance[0]["epoch"].as_u64(),
+            provenance[0]["env_steps"].as_u64()
+        ),
+        (Some(0), Some(0))
+    );
+    assert_eq!(provenance[1]["epoch"], last["epoch"]);
+    assert_eq!(provenance[1]["env_steps"], last["env_steps"]);
+    for line in &provenance {
+        let commit = line["commit"].as_str().unwrap();
+        assert!(
+            commit.len() == 40 && commit.bytes().all(|b| b.is_ascii_hexdigit()),
+            "{commit}"
+        );
+        assert_eq!(line["portable_numerics"], true);
+        assert!(line["logical_cpus"].as_u64().unwrap() >= 1);
+    }
     // The same directory cannot be trained into twice.
     check_bad_input(
         &[
@@ -699,6 +733,7 @@ fn uarm_twin_calibrates_and_trains() {
         "config.toml",
         "robot.toml",
         "metrics.jsonl",
+        "provenance.jsonl",
         "evaluation-replan.json",
     ] {
         assert!(report.join("runs/run").join(f).is_file(), "{f}");

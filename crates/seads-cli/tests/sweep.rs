@@ -262,6 +262,10 @@ fn a_sweep_is_planned_once_run_to_the_end_and_reported() {
             .is_file()
     );
     assert!(
+        data.join("runs/lightsout-cursor/seads/seed-1/provenance.jsonl")
+            .is_file()
+    );
+    assert!(
         !data
             .join("runs/lightsout-cursor/seads/seed-1/checkpoints")
             .exists()

@@ -10,6 +10,10 @@
 //! still makes a run repeat exactly on the same machine. ATen's own vectorised kernels are
 //! pinned to AVX2 in both cases (AVX2 and AVX-512 gave identical runs; pinning costs nothing).
 //!
+//! The aim is not met everywhere yet: the portable demo gave one run on an AMD EPYC and another
+//! on an Intel Xeon (docs/RESULTS.md, "Determinism"), so runs record their processor (the CLI's
+//! `provenance.jsonl`).
+//!
 //! Both are environment variables that libtorch reads once, when it first computes: the binary
 //! sets them before that, and `.cargo/config.toml` sets the portable ones for everything cargo
 //! runs (tests, examples, benches).

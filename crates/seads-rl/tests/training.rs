@@ -101,7 +101,7 @@ fn small(seed: u64, steps: u64) -> TrainConfig {
     config.eval_seeds = 2;
     // Tests run side by side: SAC taking a second thread would oversubscribe the cores.
     config.sac_threads_alone = 0;
-    // The same numbers on every machine (cargo sets the kernels: .cargo/config.toml).
+    // Portable kernels, as the demo uses (cargo sets them: .cargo/config.toml).
     config.portable_numerics = true;
     config
 }

@@ -201,7 +201,8 @@ pub fn group(runs: &[RunData]) -> Result<(Vec<Group<'_>>, Vec<&RunData>)> {
 }
 
 /// The files of a run that results rest on (small; never checkpoints): its configuration (with a
-/// robot run's `robot.toml`), metrics and evaluations.
+/// robot run's `robot.toml`), metrics, evaluations, and which code on which machine trained it
+/// (`provenance.jsonl`).
 pub fn data_files(run: &Path) -> Result<Vec<PathBuf>> {
     let mut files = Vec::new();
     for entry in std::fs::read_dir(run).with_context(|| format!("reading {}", run.display()))? {
@@ -212,6 +213,7 @@ pub fn data_files(run: &Path) -> Result<Vec<PathBuf>> {
         let wanted = name == "config.toml"
             || name == "robot.toml"
             || name == "metrics.jsonl"
+            || name == crate::provenance::PROVENANCE
             || (name.starts_with("evaluation")
                 && (name.ends_with(".json") || name.ends_with(".jsonl")));
         if wanted && path.is_file() {

@@ -1,0 +1,88 @@
+//! Which code on which machine trained which part of a run: each training process (a new run or a
+//! resume, from `seads train`, `seads sweep task`, the demo or the robot) appends one line to the
+//! run's `provenance.jsonl` before its first epoch.
+//!
+//! Runs with `portable_numerics = false` (the presets) repeat exactly only on the same kind of
+//! processor, and even portable runs were seen to differ between an AMD EPYC and an Intel Xeon
+//! (docs/RESULTS.md, "Determinism"), so a committed result names its processor and commit here.
+
+use std::path::Path;
+
+use serde::{Deserialize, Serialize};
+
+/// The file in a run directory.
+pub const PROVENANCE: &str = "provenance.jsonl";
+
+/// One training process of a run.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Provenance {
+    /// The epoch this process trained first (0 for a new run; the checkpoint's for a resume).
+    pub epoch: u64,
+    /// Environment steps of the run when this process started.
+    pub env_steps: u64,
+    /// The seads version (Cargo.toml).
+    pub seads: String,
+    /// The git commit the binary was built from ("VERGEN_IDEMPOTENT_OUTPUT" outside a checkout).
+    pub commit: String,
+    /// Whether tracked files differed from that commit when the binary was built.
+    pub dirty: bool,
+    /// The processor's vendor (`GenuineIntel`, `AuthenticAMD`), if it tells.
+    pub cpu_vendor: Option<String>,
+    /// The processor's brand string, if it tells.
+    pub cpu_model: Option<String>,
+    /// Whether the processor has AVX-512 (MKL's fast kernels differ with it).
+    pub avx512: bool,
+    /// Logical processors this process could use.
+    pub logical_cpus: usize,
+    /// The run's `portable_numerics` (MKL's `COMPATIBLE` branch when true).
+    pub portable_numerics: bool,
+    /// When this process started, in seconds since the Unix epoch.
+    pub started_unix_s: u64,
+}
+
+impl Provenance {
+    /// This process, about to train from `epoch` and `env_steps`.
+    pub fn here(epoch: u64, env_steps: u64, portable_numerics: bool) -> Self {
+        let (cpu_vendor, cpu_model, avx512) = cpu();
+        Self {
+            epoch,
+            env_steps,
+            seads: env!("CARGO_PKG_VERSION").to_string(),
+            commit: env!("VERGEN_GIT_SHA").to_string(),
+            dirty: env!("VERGEN_GIT_DIRTY") == "true",
+            cpu_vendor,
+            cpu_model,
+            avx512,
+            logical_cpus: std::thread::available_parallelism().map_or(1, |n| n.get()),
+            portable_numerics,
+            started_unix_s: std::time::SystemTime::now()
+                .duration_since(std::time::UNIX_EPOCH)
+                .map_or(0, |d| d.as_secs()),
+        }
+    }
+
+    /// Appends this line to `run_dir`'s provenance file (a torn last line is repaired first).
+    pub fn append(&self, run_dir: &Path) -> Result<(), seads_rl::RlError> {
+        seads_rl::append_json_line(&run_dir.join(PROVENANCE), self)
+    }
+}
+
+/// Vendor, brand string and AVX-512 of this processor.
+#[cfg(any(target_arch = "x86", target_arch = "x86_64"))]
+fn cpu() -> (Option<String>, Option<String>, bool) {
+    let id = raw_cpuid::CpuId::new();
+    let vendor = id.get_vendor_info().map(|v| v.as_str().to_string());
+    let model = id
+        .get_processor_brand_string()
+        .map(|b| b.as_str().trim().to_string());
+    let avx512 = id
+        .get_extended_feature_info()
+        .is_some_and(|f| f.has_avx512f());
+    (vendor, model, avx512)
+}
+
+/// Vendor, brand string and AVX-512 of this processor (not x86: unknown).
+#[cfg(not(any(target_arch = "x86", target_arch = "x86_64")))]
+fn cpu() -> (Option<String>, Option<String>, bool) {
+    (None, None, false)
+}
