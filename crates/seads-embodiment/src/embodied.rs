@@ -40,9 +40,10 @@ pub trait Environment: Send + Sync {
     /// Where the end effector (cursor, fingertip, tool centre point) is above the board, in
     /// normalised board coordinates (u to the right, v down the rows).
     fn end_effector(&self) -> [f64; 2];
-    /// Where the end effector was when the last step made its move, if the manipulator has been
-    /// re-initialised since, within that step (the Jaco, as in the reference): then
-    /// [`Environment::end_effector`] tells the new pose, not the push. `None` otherwise.
+    /// Where the last step made its move, if the manipulator has been re-initialised since,
+    /// within that step (the Jaco, as in the reference): the point where the arm touched the
+    /// board, which the reference's skill figures mark, while [`Environment::end_effector`]
+    /// tells the new pose. `None` otherwise.
     fn move_point(&self) -> Option<[f64; 2]> {
         None
     }
@@ -109,8 +110,9 @@ pub trait Manipulator: Clone + Send + Sync + 'static {
     }
     /// The end effector in normalised board coordinates.
     fn end_effector(&self) -> [f64; 2];
-    /// Where the end effector was at the last step's move, if the manipulator re-initialised
-    /// itself after it within that step ([`Environment::move_point`]); `None` otherwise.
+    /// Where the last step's move was made (the touch on the board), if the manipulator
+    /// re-initialised itself after it within that step ([`Environment::move_point`]); `None`
+    /// otherwise.
     fn move_point(&self) -> Option<[f64; 2]> {
         None
     }

@@ -598,13 +598,17 @@ impl Jaco {
     }
 
     /// The press of this physics step, if any: LightsOut the field with the largest force inside
-    /// its sensor, TileSwap the first contact on the board (as normalised board coordinates).
-    fn detect_press(&self) -> Option<Touch> {
-        let mut best: Option<(usize, f32)> = None;
-        let mut first_contact: Option<Vector> = None;
+    /// its sensor, TileSwap the first contact on the board (as normalised board coordinates);
+    /// with the point where it was touched (normalised board coordinates: the first contact on
+    /// that field, or on the board), which the reference marks as the skill's contact.
+    fn detect_press(&self) -> Option<(Touch, [f64; 2])> {
+        // (field, force, its first contact)
+        let mut best: Option<(usize, f32, Vector)> = None;
+        let mut first_on_board: Option<Vector> = None;
         for (index, &(field, top)) in self.fields.iter().enumerate() {
             let centre = self.world.colliders[field].position().translation;
             let mut force = 0.0;
+            let mut first: Option<Vector> = None;
             for pair in self.world.contact_pairs_with(field) {
                 let PairContacts::Rigid(contacts) = &pair.contacts else {
                     continue;
@@ -629,27 +633,38 @@ impl Jaco {
                             && (p.z - top).abs() <= SENSOR_DEPTH
                         {
                             force += point.data.impulse / self.world.integration_parameters.dt;
-                            first_contact.get_or_insert(p);
+                            first.get_or_insert(p);
+                            first_on_board.get_or_insert(p);
                         }
                     }
                 }
             }
-            if force > TOUCH_THRESHOLD && best.is_none_or(|(_, f)| force > f) {
-                best = Some((index, force));
+            if let Some(p) = first
+                && force > TOUCH_THRESHOLD
+                && best.is_none_or(|(_, f, _)| force > f)
+            {
+                best = Some((index, force, p));
             }
         }
+        let (index, _, at_field) = best?;
         match self.board {
-            JacoBoard::LightsOut { .. } => best.map(|(index, _)| Touch::Field(index)),
+            JacoBoard::LightsOut { .. } => {
+                Some((Touch::Field(index), self.board_coordinates(at_field)))
+            }
             JacoBoard::TileSwap => {
-                best?;
-                let p = first_contact?;
-                let w = 2.0 * self.board.half_width();
-                Some(Touch::At {
-                    u: ((p.x + w / 2.0) / w) as f64,
-                    v: (1.0 - (p.y + w / 2.0) / w) as f64,
-                })
+                let [u, v] = self.board_coordinates(first_on_board?);
+                Some((Touch::At { u, v }, [u, v]))
             }
         }
+    }
+
+    /// A world point in normalised board coordinates (u to the right, v down the rows).
+    fn board_coordinates(&self, p: Vector) -> [f64; 2] {
+        let w = 2.0 * self.board.half_width();
+        [
+            ((p.x + w / 2.0) / w) as f64,
+            (1.0 - (p.y + w / 2.0) / w) as f64,
+        ]
     }
 }
 
@@ -711,11 +726,11 @@ impl Manipulator for Jaco {
         for _ in 0..self.substeps {
             self.world.step();
             if self.move_point.is_none()
-                && let Some(press) = self.detect_press()
+                && let Some((press, at)) = self.detect_press()
                 && matches!(touch(press), Push::Move(_))
             {
                 // After a move the arm is re-initialised; the remaining substeps continue.
-                self.move_point = Some(self.end_effector());
+                self.move_point = Some(at);
                 self.randomize(rng);
             }
         }
@@ -758,9 +773,7 @@ impl Manipulator for Jaco {
     }
 
     fn end_effector(&self) -> [f64; 2] {
-        let w = 2.0 * self.board.half_width();
-        let [x, y, _] = self.tcp();
-        [((x + w / 2.0) / w) as f64, (1.0 - (y + w / 2.0) / w) as f64]
+        self.board_coordinates(vec3(self.tcp()))
     }
 
     fn field_heights(&self) -> Vec<f64> {
@@ -769,13 +782,7 @@ impl Manipulator for Jaco {
 
     fn draw(&self, shapes: &mut Vec<Shape>, extent: &mut [f64; 4]) {
         // Top view: links projected on the board plane, board coordinates with the y flip.
-        let w = 2.0 * self.board.half_width();
-        let to_board = |p: Vector| {
-            [
-                ((p.x + w / 2.0) / w) as f64,
-                (1.0 - (p.y + w / 2.0) / w) as f64,
-            ]
-        };
+        let to_board = |p: Vector| self.board_coordinates(p);
         let mut points = vec![to_board(vec3(BASE))];
         for &h in &self.bodies[..=HAND] {
             points.push(to_board(self.world.bodies[h].position().translation));

@@ -21,7 +21,7 @@ pub struct SkillRun {
     pub outcome: StepOutcome,
     /// End-effector positions (board coordinates) before the first step and after every step;
     /// after the step of a move, where the move was made (a Jaco re-initialises its arm within
-    /// that step: [`Environment::move_point`]).
+    /// that step, and the path ends where it touched the board: [`Environment::move_point`]).
     pub path: Vec<[f64; 2]>,
     /// Steps at which a push happened (a move or a miss), as indices into `path`.
     pub pushes: Vec<usize>,

@@ -70,14 +70,18 @@ fn controller(target: Vector, obs: &[f32]) -> Vec<f32> {
     action
 }
 
-/// Aims at board point `target` (world x, y): above it first, then down. Returns the move made.
-fn press(env: &mut dyn Environment, seed: u64, target: [f32; 2], top: f32) -> Option<MoveId> {
+/// Aims at board point `target` (world x, y): above it first, then down. Returns the move made
+/// and where the path ends (after a move, the touch on the board: `Environment::move_point`).
+fn press(
+    env: &mut dyn Environment,
+    seed: u64,
+    target: [f32; 2],
+    top: f32,
+) -> (Option<MoveId>, [f64; 2]) {
     env.seed(seed);
     env.reset().unwrap();
-    execute_skill(env, &Reach::new(target, top), 0)
-        .unwrap()
-        .outcome
-        .game_move()
+    let run = execute_skill(env, &Reach::new(target, top), 0).unwrap();
+    (run.outcome.game_move(), run.path[run.steps])
 }
 
 /// The scripted reach as a one-skill policy: towards board point `target` (world x, y) at a
@@ -119,7 +123,8 @@ impl SkillPolicy for Reach {
 
 /// The arm is re-initialised within the step of a move (as in the reference), so the end
 /// effector after that step is the new pose; a skill's path (the skill figures) ends where the
-/// move was made, above the pressed field, not at the new pose.
+/// move was made, at the touch on the pressed field (the reference's contact mark), not at the
+/// new pose.
 #[test]
 fn a_skill_path_ends_at_the_press_not_at_the_re_initialised_arm() {
     let mut env = make_env("lightsout-jaco", &EnvConfig::default()).unwrap();
@@ -134,9 +139,11 @@ fn a_skill_path_ends_at_the_press_not_at_the_re_initialised_arm() {
     let distance = |p: [f64; 2]| (p[0] - field[0]).hypot(p[1] - field[1]);
     let end = run.path[run.steps];
     assert_eq!(env.move_point(), Some(end));
+    // It ends where the hand touched the field: inside its touch sensor (70 % of the field's
+    // 0.2 board units).
     assert!(
-        distance(end) < 0.1,
-        "the path ends at {end:?}, off the pressed field"
+        (end[0] - field[0]).abs() <= 0.07 && (end[1] - field[1]).abs() <= 0.07,
+        "the path ends at {end:?}, off the pressed field's sensor"
     );
     // The re-initialised arm stands above the board's middle (TCP within ±0.1 m of its centre).
     let now = env.end_effector();
@@ -511,9 +518,22 @@ fn sweep(name: &str, substeps: usize, seeds: &[u64], moves: &[MoveId]) -> Vec<St
                     ([u as f32 * 0.3 - 0.15, (1.0 - v as f32) * 0.3 - 0.15], 0.02)
                 }
             };
-            let made = press(env.as_mut(), seed, target, top);
+            let (made, at) = press(env.as_mut(), seed, target, top);
             if made != Some(mv) {
                 failures.push(format!("seed {seed}: aimed at {mv}, made {made:?}"));
+            }
+            // The point a skill figure marks is the touch that made the move: it lies on the
+            // pressed field (LightsOut, inside its sensor, 70 % of the field) or within reach of
+            // the swapped pivot (TileSwap), as the reference's contact marks do.
+            let layout = match name {
+                "tileswap-jaco" => Layout::Pivots,
+                "lightsout3d-jaco" => Layout::ColumnMajor { n: 5 },
+                _ => Layout::Grid { n: 5 },
+            };
+            if made.is_some() && layout.locate(at[0], at[1]) != made {
+                failures.push(format!(
+                    "seed {seed}: made {made:?}, but the path ends at {at:?}, off that move"
+                ));
             }
         }
     }
