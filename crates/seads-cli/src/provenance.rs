@@ -61,6 +61,25 @@ impl Provenance {
         }
     }
 
+    /// The processors that trained the run in `run_dir`, distinct, in the order they first
+    /// trained it ("unknown" for one that did not tell); empty for a run without the file
+    /// (trained before 2026-11-25's provenance, or never trained).
+    pub fn processors(run_dir: &Path) -> Result<Vec<String>, seads_rl::RlError> {
+        let path = run_dir.join(PROVENANCE);
+        if !path.is_file() {
+            return Ok(Vec::new());
+        }
+        let (lines, _) = seads_rl::read_json_lines::<Provenance>(&path)?;
+        let mut seen: Vec<String> = Vec::new();
+        for line in lines {
+            let cpu = line.cpu_model.unwrap_or_else(|| "unknown".to_owned());
+            if !seen.contains(&cpu) {
+                seen.push(cpu);
+            }
+        }
+        Ok(seen)
+    }
+
     /// Appends this line to `run_dir`'s provenance file (a torn last line is repaired first).
     pub fn append(&self, run_dir: &Path) -> Result<(), seads_rl::RlError> {
         seads_rl::append_json_line(&run_dir.join(PROVENANCE), self)

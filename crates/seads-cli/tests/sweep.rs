@@ -237,6 +237,14 @@ fn a_sweep_is_planned_once_run_to_the_end_and_reported() {
     assert!(md.contains("## Where the training time went"), "{md}");
     let walltime = std::fs::read_to_string(report.join("walltime.csv")).unwrap();
     assert_eq!(walltime.lines().count(), 5, "{walltime}");
+    // Each run names the processor that trained it (from its provenance.jsonl).
+    assert!(
+        walltime
+            .lines()
+            .skip(1)
+            .all(|l| !l.ends_with(",unrecorded")),
+        "{walltime}"
+    );
     for f in [
         "success.csv",
         "lengths.csv",

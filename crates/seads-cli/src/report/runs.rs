@@ -35,6 +35,8 @@ pub struct RunData {
     pub plan_once: Option<Vec<DepthResult>>,
     /// Task success over training, if evaluated.
     pub over_training: Vec<CheckpointEvaluation>,
+    /// The processors that trained it (`provenance.jsonl`; empty for older runs).
+    pub processors: Vec<String>,
 }
 
 impl RunData {
@@ -83,6 +85,8 @@ impl RunData {
             plan_once: evaluation(EvaluationKind::PlanOnce)?,
             policy: evaluation(EvaluationKind::Policy)?,
             over_training: crate::overtraining::read(dir)?,
+            processors: crate::provenance::Provenance::processors(dir)
+                .with_context(|| format!("reading the provenance of {}", dir.display()))?,
             config,
             metrics,
             task_metrics,

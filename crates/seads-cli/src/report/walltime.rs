@@ -72,7 +72,7 @@ pub fn walltime_tables(groups: &[Group<'_>]) -> (String, String) {
     for p in PHASES {
         let _ = write!(csv, ",{}_s", p.replace(' ', "_").to_lowercase());
     }
-    csv.push('\n');
+    csv += ",processor\n";
     let minutes = |s: Option<f64>| s.map_or("–".to_owned(), |s| format!("{:.1}", s / 60.0));
     for g in groups {
         let spent: Vec<(&RunData, Spent)> = g
@@ -96,7 +96,13 @@ pub fn walltime_tables(groups: &[Group<'_>]) -> (String, String) {
             for p in s.phases {
                 let _ = write!(csv, ",{}", p.map_or(String::new(), |v| v.to_string()));
             }
-            csv.push('\n');
+            // Wall times depend on the processor: which trained the run ("; " between several).
+            let processor = if run.processors.is_empty() {
+                "unrecorded".to_owned()
+            } else {
+                run.processors.join("; ").replace(',', " ")
+            };
+            let _ = writeln!(csv, ",{processor}");
         }
         let walls = || spent.iter().map(|(_, s)| s.wall_s);
         let lo = walls().fold(f64::INFINITY, f64::min);
@@ -130,7 +136,8 @@ pub fn walltime_tables(groups: &[Group<'_>]) -> (String, String) {
            line; a resumed run counts its sessions from where each resumed. Phases are the seconds \
            spent in each, summed over the run: relabelling runs on its own thread beside the SAC \
            updates, so the phases may add up to more than the wall time. Runs that shared their \
-           cores took longer than they would alone.\n";
+           cores took longer than they would alone. `walltime.csv` names the processor that trained each \
+           run (its `provenance.jsonl`; \"unrecorded\" for runs trained before 2026-11-25).\n";
     (md, csv)
 }
 
@@ -157,6 +164,11 @@ mod tests {
             replan: None,
             plan_once: None,
             over_training: Vec::new(),
+            processors: if seed == 1 {
+                vec!["AMD EPYC, 9554".into(), "Intel(R) Xeon(R)".into()]
+            } else {
+                Vec::new()
+            },
         }
     }
 
@@ -177,7 +189,14 @@ mod tests {
         );
         let lines: Vec<&str> = csv.lines().collect();
         assert_eq!(lines.len(), 3, "{csv}");
-        assert!(lines[1].ends_with(",600,1000,60,120,30,510,6"), "{csv}");
-        assert!(lines[2].ends_with(",1200,1000,60,120,30,1110,6"), "{csv}");
+        assert!(lines[0].ends_with(",evaluate_s,processor"), "{csv}");
+        assert!(
+            lines[1].ends_with(",600,1000,60,120,30,510,6,AMD EPYC  9554; Intel(R) Xeon(R)"),
+            "{csv}"
+        );
+        assert!(
+            lines[2].ends_with(",1200,1000,60,120,30,1110,6,unrecorded"),
+            "{csv}"
+        );
     }
 }
