@@ -24,7 +24,7 @@ pub struct TrainArgs {
     /// `configs/hac-*.toml`). Default: the config's, else seads.
     #[arg(long, value_parser = ["seads", "sac", "hac"], conflicts_with = "resume")]
     algorithm: Option<String>,
-    /// Run directory to create (config.toml, metrics.jsonl, checkpoints/).
+    /// Run directory to create (config.toml, metrics.jsonl, provenance.jsonl, checkpoints/).
     #[arg(long, required_unless_present = "resume")]
     out: Option<PathBuf>,
     /// Seed of every random choice (default: the preset's).
