@@ -264,8 +264,8 @@ pub struct Jaco {
     substeps: usize,
     /// Resets and re-initialisations that found no reachable pose and fell back to a fixed one.
     ik_fallbacks: u64,
-    /// Where the tool centre point was (board coordinates) when the last step made its move,
-    /// before the arm was re-initialised; `None` after a step without a move.
+    /// Where the arm touched the board (board coordinates) for the last step's move, before it
+    /// was re-initialised; `None` after a step without a move.
     move_point: Option<[f64; 2]>,
 }
 
