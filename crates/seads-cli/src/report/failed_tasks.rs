@@ -1,7 +1,8 @@
 //! Every failed task of the runs' final evaluation with re-planning, one row each: which skills
 //! left another board than the forward model predicted, told as game moves (the move the model
-//! predicted, the move the skill made) and how often. Re-planning from the board a skill left
-//! often picks the same skill again, so one wrong skill can spend a task's whole budget.
+//! predicted, the move the skill made), how often, and after how many manipulator steps.
+//! Re-planning from the board a skill left often picks the same skill again, so one wrong skill
+//! can spend a task's whole budget.
 
 use std::fmt::Write as _;
 
@@ -51,13 +52,37 @@ fn effect(game: &dyn BoardGame, before: &str, after: &str) -> Result<Effect> {
         .map_or(Effect::Other, Effect::Move))
 }
 
-/// One kind of deviation in a task: a skill, the predicted and the made effect, and how often.
+/// One kind of deviation in a task: a skill, the predicted and the made effect, how often, and
+/// the manipulator steps of each time (empty for files without `skill_steps`).
 #[derive(Debug, PartialEq)]
 struct Repeat {
     skill: usize,
     predicted: Effect,
     made: Effect,
     times: usize,
+    steps: Vec<usize>,
+}
+
+impl Repeat {
+    /// "×10, 50 steps" or "×10, steps: median 1, 1–7" (the count alone where steps are unknown
+    /// for some of the times).
+    fn count(&self) -> String {
+        let times = self.times;
+        if self.steps.len() != times {
+            return format!("×{times}");
+        }
+        let (lo, hi) = (self.steps.iter().min(), self.steps.iter().max());
+        let (Some(&lo), Some(&hi)) = (lo, hi) else {
+            return format!("×{times}");
+        };
+        let unit = |n: usize| if n == 1 { "step" } else { "steps" };
+        if lo == hi {
+            return format!("×{times}, {lo} {}", unit(lo));
+        }
+        let values: Vec<f64> = self.steps.iter().map(|&s| s as f64).collect();
+        let median = super::stats::median(&values).unwrap_or(f64::NAN);
+        format!("×{times}, steps: median {median}, {lo}–{hi}")
+    }
 }
 
 /// One failed task.
@@ -87,16 +112,21 @@ impl FailedTask {
         for d in &line.deviations {
             let predicted = effect(game, &d.before, &d.predicted)?;
             let made = effect(game, &d.before, &d.reached)?;
+            let steps = line.skill_steps.get(d.step).copied();
             match repeats
                 .iter_mut()
                 .find(|r| r.skill == d.skill && r.predicted == predicted && r.made == made)
             {
-                Some(r) => r.times += 1,
+                Some(r) => {
+                    r.times += 1;
+                    r.steps.extend(steps);
+                }
                 None => repeats.push(Repeat {
                     skill: d.skill,
                     predicted,
                     made,
                     times: 1,
+                    steps: steps.into_iter().collect(),
                 }),
             }
         }
@@ -108,7 +138,7 @@ impl FailedTask {
         }))
     }
 
-    /// "skill 0: model move 7, made move 11 (×6); …", or "–".
+    /// "skill 0: model move 7, made move 11 (×6, steps: median 4, 3–9); …", or "–".
     fn deviations(&self) -> String {
         if self.repeats.is_empty() {
             return "–".to_owned();
@@ -117,8 +147,11 @@ impl FailedTask {
             .iter()
             .map(|r| {
                 format!(
-                    "skill {}: model {}, made {} (×{})",
-                    r.skill, r.predicted, r.made, r.times
+                    "skill {}: model {}, made {} ({})",
+                    r.skill,
+                    r.predicted,
+                    r.made,
+                    r.count()
                 )
             })
             .collect::<Vec<_>>()
@@ -164,7 +197,7 @@ pub fn failed_task_tables(groups: &[Group<'_>]) -> Result<Option<(String, String
         return Ok(None);
     }
     let mut md = String::from(
-        "| environment | variant | seed | depth | outcome | skills executed | deviations: skill, the model's move, the move made (times) |\n\
+        "| environment | variant | seed | depth | outcome | skills executed | deviations: skill, the model's move, the move made (times, manipulator steps) |\n\
          |---|---|---|---|---|---|---|\n",
     );
     let mut csv = String::from("env,variant,seed,depth,outcome,executed,deviations\n");
@@ -181,7 +214,9 @@ pub fn failed_task_tables(groups: &[Group<'_>]) -> Result<Option<(String, String
     md += "\nEvery failed task of the per-task files, with each way a skill left another board \
            than the forward model predicted: \"move m\" is the game's move m (LightsOut: the \
            field m, row by row from the top left; TileSwap: its swap m), \"nothing\" a skill \
-           that left the board as it was, \"no single move\" a board no one move reaches. \
+           that left the board as it was, \"no single move\" a board no one move reaches, \
+           and \"steps\" how many manipulator steps the skill ran each time (their median and \
+           range). \
            Re-planning searches again from the board reached, so a wrong skill may be chosen \
            again and again.\n";
     Ok(Some((md, csv)))
@@ -207,7 +242,7 @@ mod tests {
     }
 
     /// LightsOut 3×3 by hand: pressing field 4 (the centre) toggles fields 1, 3, 4, 5, 7; pressing
-    /// field 0 toggles 0, 1, 3.
+    /// field 0 toggles 0, 1, 3. Skill 2's first kind of deviation ran 7 and 1 steps (median 4).
     #[test]
     fn deviations_are_told_as_moves_and_grouped_by_skill_and_effect() {
         let game = GameKind::LightsOut.build(3).unwrap();
@@ -216,12 +251,13 @@ mod tests {
         let corner = "1,1,0,1,0,0,0,0,0";
         let two = "1,0,0,1,0,0,0,0,1";
         let text = format!(
-            r#"{{"depth":3,"solved":false,"plan_found":true,"timed_out":false,"executed":[2,2,5,2],
+            r#"{{"depth":3,"solved":false,"plan_found":true,"timed_out":false,"executed":[2,5,2,2],
+            "skill_steps":[7,50,1,12],
             "deviations":[
-              {{"skill":2,"before":"{empty}","predicted":"{centre}","reached":"{corner}"}},
-              {{"skill":5,"before":"{empty}","predicted":"{corner}","reached":"{empty}"}},
-              {{"skill":2,"before":"{empty}","predicted":"{centre}","reached":"{corner}"}},
-              {{"skill":2,"before":"{empty}","predicted":"{two}","reached":"{corner}"}}]}}"#
+              {{"step":0,"skill":2,"before":"{empty}","predicted":"{centre}","reached":"{corner}"}},
+              {{"step":1,"skill":5,"before":"{empty}","predicted":"{corner}","reached":"{empty}"}},
+              {{"step":2,"skill":2,"before":"{empty}","predicted":"{centre}","reached":"{corner}"}},
+              {{"step":3,"skill":2,"before":"{empty}","predicted":"{two}","reached":"{corner}"}}]}}"#
         );
         let task = FailedTask::of(game.as_ref(), &line(&text))
             .unwrap()
@@ -232,18 +268,21 @@ mod tests {
                 predicted: Effect::Move(4),
                 made: Effect::Move(0),
                 times: 2,
+                steps: vec![7, 1],
             },
             Repeat {
                 skill: 5,
                 predicted: Effect::Move(0),
                 made: Effect::Nothing,
                 times: 1,
+                steps: vec![50],
             },
             Repeat {
                 skill: 2,
                 predicted: Effect::Other,
                 made: Effect::Move(0),
                 times: 1,
+                steps: vec![12],
             },
         ];
         assert_eq!(task.repeats, expected);
@@ -251,8 +290,36 @@ mod tests {
         assert_eq!(task.outcome, "goal not reached");
         assert_eq!(
             task.deviations(),
-            "skill 2: model move 4, made move 0 (×2); skill 5: model move 0, made nothing (×1); \
-             skill 2: model no single move, made move 0 (×1)"
+            "skill 2: model move 4, made move 0 (×2, steps: median 4, 1–7); \
+             skill 5: model move 0, made nothing (×1, 50 steps); \
+             skill 2: model no single move, made move 0 (×1, 12 steps)"
+        );
+    }
+
+    /// A file written before `skill_steps` existed, or one whose deviation points past it, gives
+    /// the counts without steps, and one step reads in the singular.
+    #[test]
+    fn steps_are_left_out_where_the_file_does_not_have_them() {
+        let game = GameKind::TileSwap.build(3).unwrap();
+        let (goal, swapped) = ("0,1,2,3,4,5,6,7,8", "1,0,2,3,4,5,6,7,8");
+        let task = |steps: &str| {
+            let text = format!(
+                r#"{{"depth":1,"solved":false,"plan_found":true,"timed_out":false,"executed":[3,3],{steps}
+                "deviations":[{{"step":1,"skill":3,"before":"{goal}","predicted":"{goal}","reached":"{swapped}"}}]}}"#
+            );
+            FailedTask::of(game.as_ref(), &line(&text))
+                .unwrap()
+                .unwrap()
+                .deviations()
+        };
+        assert_eq!(task(""), "skill 3: model nothing, made move 6 (×1)");
+        assert_eq!(
+            task(r#""skill_steps":[4],"#),
+            "skill 3: model nothing, made move 6 (×1)"
+        );
+        assert_eq!(
+            task(r#""skill_steps":[4,1],"#),
+            "skill 3: model nothing, made move 6 (×1, 1 step)"
         );
     }
 
@@ -272,7 +339,7 @@ mod tests {
         assert_eq!(task.outcome, "no plan (search timed out)");
         assert_eq!(task.deviations(), "–");
         let broken = r#"{"depth":1,"solved":false,"plan_found":true,"timed_out":false,"executed":[0],
-            "deviations":[{"skill":0,"before":"1,0,2,3,4,5,6,7,8","predicted":"NaN","reached":"0,1,2,3,4,5,6,7,8"}]}"#;
+            "deviations":[{"step":0,"skill":0,"before":"1,0,2,3,4,5,6,7,8","predicted":"NaN","reached":"0,1,2,3,4,5,6,7,8"}]}"#;
         let err = FailedTask::of(game.as_ref(), &line(broken)).unwrap_err();
         assert!(format!("{err:#}").contains("\"NaN\""), "{err:#}");
     }

@@ -22,12 +22,18 @@ pub(super) struct TaskLine {
     pub timed_out: bool,
     /// The skills executed, in order.
     pub executed: Vec<usize>,
+    /// The manipulator steps each executed skill took (missing in files from before it was
+    /// written).
+    #[serde(default)]
+    pub skill_steps: Vec<usize>,
     pub deviations: Vec<DeviationLine>,
 }
 
 /// A skill that left another board than predicted (boards as `seads solve --board` takes them).
 #[derive(Debug, Deserialize)]
 pub(super) struct DeviationLine {
+    /// Its index among the executed skills.
+    pub step: usize,
     pub skill: usize,
     pub before: String,
     pub predicted: String,
