@@ -9,6 +9,7 @@ use std::fmt::Write as _;
 use anyhow::{Context, Result};
 use seads_games::{BoardGame, MoveId};
 
+use super::csv_field;
 use super::failures::{TaskLine, read_tasks};
 use super::runs::Group;
 use crate::envs::run_game;
@@ -222,15 +223,6 @@ pub fn failed_task_tables(groups: &[Group<'_>]) -> Result<Option<(String, String
     Ok(Some((md, csv)))
 }
 
-/// A CSV field, quoted when it holds a comma or a quote.
-fn csv_field(text: &str) -> String {
-    if text.contains([',', '"']) {
-        format!("\"{}\"", text.replace('"', "\"\""))
-    } else {
-        text.to_owned()
-    }
-}
-
 #[cfg(test)]
 mod tests {
     use seads_games::GameKind;
@@ -357,6 +349,5 @@ mod tests {
             effect(game.as_ref(), goal, "1,2,0,3,4,5,6,7,8").unwrap(),
             Effect::Other
         );
-        assert_eq!(csv_field("a, \"b\""), "\"a, \"\"b\"\"\"");
     }
 }

@@ -20,6 +20,15 @@ use clap::Args;
 
 use crate::BadInput;
 
+/// A CSV field, quoted when it holds a comma or a quote (RFC 4180).
+fn csv_field(text: &str) -> String {
+    if text.contains([',', '"', '\n']) {
+        format!("\"{}\"", text.replace('"', "\"\""))
+    } else {
+        text.to_owned()
+    }
+}
+
 /// Arguments of `seads report`.
 #[derive(Debug, Args)]
 pub struct ReportArgs {
@@ -194,4 +203,16 @@ pub fn report(args: ReportArgs) -> Result<()> {
         figures.len()
     );
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::csv_field;
+
+    #[test]
+    fn csv_fields_are_quoted_only_when_they_must_be() {
+        assert_eq!(csv_field("a, \"b\""), "\"a, \"\"b\"\"\"");
+        assert_eq!(csv_field("AMD EPYC 9554"), "AMD EPYC 9554");
+        assert_eq!(csv_field("a\nb"), "\"a\nb\"");
+    }
 }

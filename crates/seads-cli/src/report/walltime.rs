@@ -5,6 +5,7 @@ use std::fmt::Write as _;
 
 use seads_rl::Algorithm;
 
+use super::csv_field;
 use super::runs::{Group, RunData};
 
 /// The phases a metrics line times, in table order.
@@ -89,7 +90,7 @@ pub fn walltime_tables(groups: &[Group<'_>]) -> (String, String) {
                 "{},{},{},{},{}",
                 g.env,
                 g.variant,
-                run.dir.display(),
+                csv_field(&run.dir.display().to_string()),
                 s.wall_s,
                 s.env_steps
             );
@@ -100,9 +101,9 @@ pub fn walltime_tables(groups: &[Group<'_>]) -> (String, String) {
             let processor = if run.processors.is_empty() {
                 "unrecorded".to_owned()
             } else {
-                run.processors.join("; ").replace(',', " ")
+                run.processors.join("; ")
             };
-            let _ = writeln!(csv, ",{processor}");
+            let _ = writeln!(csv, ",{}", csv_field(&processor));
         }
         let walls = || spent.iter().map(|(_, s)| s.wall_s);
         let lo = walls().fold(f64::INFINITY, f64::min);
@@ -191,7 +192,7 @@ mod tests {
         assert_eq!(lines.len(), 3, "{csv}");
         assert!(lines[0].ends_with(",evaluate_s,processor"), "{csv}");
         assert!(
-            lines[1].ends_with(",600,1000,60,120,30,510,6,AMD EPYC  9554; Intel(R) Xeon(R)"),
+            lines[1].ends_with(",600,1000,60,120,30,510,6,\"AMD EPYC, 9554; Intel(R) Xeon(R)\""),
             "{csv}"
         );
         assert!(
