@@ -20,7 +20,37 @@ pub(crate) struct Buffers<'a> {
     pub(crate) k: usize,
     pub(crate) episodes: &'a mut VecDeque<Episode>,
     pub(crate) rng: &'a mut ChaCha8Rng,
+    /// Sees every joint relabelling (diagnostics; [`crate::Trainer::observe_relabelling`]).
+    pub(crate) observer: Option<&'a mut RelabelObserver>,
 }
+
+/// Which update batch a relabelling served.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum RelabelBatch {
+    /// The skill model's batch (every episode may be relabelled, p = `skill_model_p`).
+    SkillModel,
+    /// SAC's batch (board-changing episodes only, p = `sac_p`).
+    Sac,
+}
+
+/// One relabelling as training solved it: the chosen episodes' clipped log-posteriors
+/// (`k` per episode, row-major), the labels they were collected with and the labels they got.
+#[derive(Debug, Clone, Copy)]
+pub struct Relabelling<'a> {
+    /// The batch it served.
+    pub batch: RelabelBatch,
+    /// The number of skills.
+    pub k: usize,
+    /// `C_e[k]` of each chosen episode, row-major.
+    pub clipped: &'a [f32],
+    /// Each chosen episode's label before relabelling.
+    pub labels: &'a [usize],
+    /// Each chosen episode's label after relabelling.
+    pub relabelled: &'a [usize],
+}
+
+/// A callback that sees each relabelling of training.
+pub type RelabelObserver = dyn FnMut(&Relabelling<'_>) + Send;
 
 impl Buffers<'_> {
     /// Updates start once the buffer holds `sampled_episodes` episodes.
@@ -76,6 +106,7 @@ impl Buffers<'_> {
     /// each eligible episode, in `eligible` order.
     fn relabelled(
         &mut self,
+        which: RelabelBatch,
         batch: &[usize],
         eligible: &[usize],
         clipped: &[f32],
@@ -94,12 +125,17 @@ impl Buffers<'_> {
             .flat_map(|&e| clipped[e * k..(e + 1) * k].iter().copied())
             .collect();
         let chosen_labels: Vec<usize> = chosen.iter().map(|&e| labels[eligible[e]]).collect();
-        for (&e, new) in chosen.iter().zip(relabel(
-            self.config.relabel.kind,
-            &chosen_clipped,
-            k,
-            &chosen_labels,
-        )) {
+        let new = relabel(self.config.relabel.kind, &chosen_clipped, k, &chosen_labels);
+        if let Some(observer) = self.observer.as_mut() {
+            observer(&Relabelling {
+                batch: which,
+                k,
+                clipped: &chosen_clipped,
+                labels: &chosen_labels,
+                relabelled: &new,
+            });
+        }
+        for (&e, new) in chosen.iter().zip(new) {
             labels[eligible[e]] = new;
         }
         labels
@@ -116,6 +152,7 @@ impl Buffers<'_> {
             Default::default()
         };
         let labels = self.relabelled(
+            RelabelBatch::SkillModel,
             &batch,
             &eligible,
             &clipped,
@@ -150,7 +187,13 @@ impl Buffers<'_> {
             .collect();
         let changed: Vec<usize> = eligible.iter().map(|&j| batch[j]).collect();
         let (clipped, rewards) = self.score(model, &changed);
-        let labels = self.relabelled(&batch, &eligible, &clipped, config.relabel.sac_p);
+        let labels = self.relabelled(
+            RelabelBatch::Sac,
+            &batch,
+            &eligible,
+            &clipped,
+            config.relabel.sac_p,
+        );
         let mut finals = vec![minimum_reward(self.k); batch.len()];
         for (e, &j) in eligible.iter().enumerate() {
             finals[j] = rewards[e * self.k + labels[j]];
@@ -297,6 +340,7 @@ mod tests {
             k: 2,
             episodes,
             rng,
+            observer: None,
         }
     }
 

@@ -54,6 +54,7 @@ mod trainer;
 use std::path::Path;
 
 pub use agent::{Agent, AgentPolicy, find_checkpoint};
+pub use buffers::{RelabelBatch, RelabelObserver, Relabelling};
 pub use config::{Algorithm, BaselineConfig, HacConfig, RelabelConfig, TrainConfig};
 pub use episode::{Episode, policy_input, run_episodes, skill_coverage};
 pub use hac::{Hac, HacPolicy};

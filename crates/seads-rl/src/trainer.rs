@@ -14,7 +14,7 @@ use seads_skillmodel::{SkillModel, SkillTransition};
 use serde::{Deserialize, Serialize};
 use tch::Device;
 
-use crate::buffers::Buffers;
+use crate::buffers::{Buffers, RelabelObserver};
 use crate::checkpoint;
 use crate::episode::{run_episodes, skill_coverage};
 use crate::seeds::{Purpose, derived_seed, stream, train_env_seed};
@@ -95,6 +95,8 @@ pub struct Trainer {
     /// The next epoch's updates, prepared while SAC updated: the skill model has taken its
     /// steps, and the SAC minibatches wait here.
     prepared: Option<Prepared>,
+    /// Sees each joint relabelling (diagnostics only; not part of a checkpoint).
+    relabel_observer: Option<Box<RelabelObserver>>,
 }
 
 /// An epoch's skill-model update done and its SAC minibatches relabelled, ready for SAC.
@@ -180,6 +182,7 @@ impl Trainer {
             episodes: VecDeque::new(),
             progress,
             prepared: None,
+            relabel_observer: None,
         })
     }
 
@@ -226,6 +229,13 @@ impl Trainer {
     /// The skill model.
     pub fn skill_model(&self) -> &dyn SkillModel {
         self.model.as_ref()
+    }
+
+    /// Calls `observer` with every joint relabelling that training solves from now on (the
+    /// cost matrix, the labels in and out), for diagnostics such as the label-tie study
+    /// (`examples/relabel_dump.rs`). Observing changes nothing in the run.
+    pub fn observe_relabelling(&mut self, observer: Box<RelabelObserver>) {
+        self.relabel_observer = Some(observer);
     }
 
     /// One epoch of Algorithm 3.
@@ -288,6 +298,7 @@ impl Trainer {
                 k: self.k,
                 episodes: &mut self.episodes,
                 rng: &mut self.progress.streams.sample,
+                observer: self.relabel_observer.as_deref_mut(),
             },
             model: self.model.as_mut(),
             spec: &self.spec,

@@ -95,6 +95,77 @@ proptest! {
     }
 }
 
+/// The label-tie study's relabelling problems, dumped from real LightsOutCursor training with
+/// K = 25 and K = 30 (`docs/results/label-ties/`, made by the `relabel_dump` example of
+/// seads-rl). On each, relabelling reaches the optimum of the reference's square problem
+/// (SciPy's algorithm, ported), and the episodes it gives a label at the clip floor get the
+/// same multiset of labels as SciPy's solution gives them: ties do not push them towards other
+/// label indices than the reference's.
+#[test]
+fn tied_episodes_get_the_labels_scipy_gives_them_on_real_training_problems() {
+    use std::io::BufRead;
+    #[derive(serde::Deserialize)]
+    struct Problem {
+        k: usize,
+        labels: Vec<usize>,
+        relabelled: Vec<usize>,
+        clipped: Vec<f32>,
+    }
+    let dir =
+        std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../docs/results/label-ties");
+    let mut problems = 0;
+    for name in ["k25.jsonl.gz", "k30.jsonl.gz"] {
+        let file = std::fs::File::open(dir.join(name)).unwrap();
+        for line in std::io::BufReader::new(flate2::read::GzDecoder::new(file)).lines() {
+            let p: Problem = serde_json::from_str(&line.unwrap()).unwrap();
+            let (k, n) = (p.k, p.labels.len());
+            let ours = relabel_assignment(&p.clipped, k, &p.labels);
+            assert_eq!(
+                ours, p.relabelled,
+                "the solver no longer gives the dumped labels"
+            );
+            // The square problem as the reference states it: slot i carries labels[i].
+            let mut cost = vec![0.0f64; n * n];
+            for (i, &label) in p.labels.iter().enumerate() {
+                for j in 0..n {
+                    cost[i * n + j] = -f64::from(p.clipped[j * k + label]);
+                }
+            }
+            let (rows, cols) = lsap::solve(n, n, &cost, false).unwrap();
+            let mut scipy = vec![0; n];
+            for (&i, &j) in rows.iter().zip(&cols) {
+                scipy[j] = p.labels[i];
+            }
+            let total = |labels: &[usize]| -> f64 {
+                labels
+                    .iter()
+                    .enumerate()
+                    .map(|(j, &l)| f64::from(p.clipped[j * k + l]))
+                    .sum()
+            };
+            assert!((total(&ours) - total(&scipy)).abs() < 1e-6, "not optimal");
+            let floor = p.clipped.iter().copied().fold(f32::INFINITY, f32::min);
+            let tied = |labels: &[usize]| -> Vec<usize> {
+                let mut t: Vec<usize> = labels
+                    .iter()
+                    .enumerate()
+                    .filter(|&(j, &l)| p.clipped[j * k + l] == floor)
+                    .map(|(_, &l)| l)
+                    .collect();
+                t.sort_unstable();
+                t
+            };
+            assert!(
+                !tied(&ours).is_empty(),
+                "a problem without ties tests nothing"
+            );
+            assert_eq!(tied(&ours), tied(&scipy));
+            problems += 1;
+        }
+    }
+    assert_eq!(problems, 40);
+}
+
 /// Synthetic data of the ground-truth game: skill k performs move k (LightsOut 5×5 flip masks).
 fn lightsout_data(n: usize, seed: u64) -> Vec<SkillTransition> {
     let game = LightsOut::new(5).unwrap();
