@@ -5,12 +5,12 @@ use std::path::PathBuf;
 
 use anyhow::Result;
 use clap::Args;
-use seads_games::Split;
 use seads_planner::summarise;
 use seads_rl::{Run, TrainConfig, Trainer};
 
 use crate::BadInput;
-use crate::plan::{Tasks, run_evaluation};
+use crate::plan::run_evaluation;
+use seads_planner::{EvaluationKind, Protocol, SearchLimits, TaskSet};
 
 /// Arguments of `seads run`.
 #[derive(Debug, Args)]
@@ -65,24 +65,21 @@ pub fn run(args: RunArgs) -> Result<()> {
     drop(run);
 
     let mut agent = crate::plan::load_agent(&args.out, None)?;
-    let seeds = crate::plan::task_seeds(args.boards, None);
     println!(
         "\nsolving {} test boards per depth 1–5 by planning with the learned forward model:",
         args.boards
     );
     println!(" depth   with re-planning   plan once   median steps (re-planning)");
-    let tasks = |replan| Tasks {
-        depths: (1..=5).collect(),
-        seeds: seeds.clone(),
-        split: Split::Test,
-        replan,
-        limits: crate::plan::SearchLimits {
-            timeout: args.timeout,
+    let protocol = |replan| Protocol {
+        kind: EvaluationKind::planning(replan),
+        tasks: TaskSet::standard(args.boards),
+        limits: Some(SearchLimits {
+            timeout_s: args.timeout,
             max_expanded: None,
-        },
+        }),
     };
-    let replan = run_evaluation(&mut agent, &args.out, tasks(true), false)?;
-    let once = run_evaluation(&mut agent, &args.out, tasks(false), false)?;
+    let replan = run_evaluation(&mut agent, &args.out, &protocol(true), false)?.results;
+    let once = run_evaluation(&mut agent, &args.out, &protocol(false), false)?.results;
     let (a, b) = (summarise(&replan), summarise(&once));
     for r in &replan {
         let key = r.depth;

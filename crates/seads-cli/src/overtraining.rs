@@ -3,17 +3,16 @@
 //! and mode to `evaluation-over-training.jsonl`, keyed by environment steps. Checkpoints already
 //! in the file are skipped, so the command resumes where it stopped.
 
-use std::collections::BTreeSet;
 use std::path::Path;
 
 use anyhow::{Context, Result, anyhow};
 use indicatif::{ProgressBar, ProgressStyle};
-use seads_planner::DepthResult;
+use seads_planner::{DepthResult, EvaluationKind, Protocol, SearchLimits, TaskSet};
 use seads_rl::Agent;
 use serde::{Deserialize, Serialize};
 
 use crate::BadInput;
-use crate::plan::{SearchLimits, Tasks, evaluate_agent};
+use crate::plan::evaluate_agent;
 
 /// The file, in the run directory.
 pub const FILE: &str = "evaluation-over-training.jsonl";
@@ -36,6 +35,24 @@ pub struct CheckpointEvaluation {
     pub max_expanded: Option<usize>,
     /// Per depth.
     pub results: Vec<DepthResult>,
+}
+
+impl CheckpointEvaluation {
+    /// The protocol the line was evaluated with: test boards, the protocol's seeds, its
+    /// depths those of its results.
+    pub fn protocol(&self) -> Protocol {
+        Protocol {
+            kind: EvaluationKind::planning(self.replan),
+            tasks: TaskSet {
+                depths: self.results.iter().map(|r| r.depth).collect(),
+                ..TaskSet::standard(self.boards)
+            },
+            limits: Some(SearchLimits {
+                timeout_s: self.timeout_s,
+                max_expanded: self.max_expanded,
+            }),
+        }
+    }
 }
 
 /// Which checkpoints: `all`, every N-th kept one (the last always), or the listed epochs.
@@ -118,35 +135,23 @@ pub fn read(run: &Path) -> Result<Vec<CheckpointEvaluation>> {
     Ok(seads_rl::read_json_lines(&path)?.0)
 }
 
-/// The environment steps of training at checkpoint `epoch`: from the run's metrics (the presets
-/// evaluate coverage wherever they checkpoint), else from the checkpoint's progress file.
-fn env_steps_at(run: &Path, metrics: &[seads_rl::Metrics], epoch: u64, dir: &Path) -> Result<u64> {
-    if let Some(m) = metrics.iter().find(|m| m.epoch == epoch) {
-        return Ok(m.env_steps);
+/// The protocol of over-training evaluations of `tasks` with `limits`, with or without
+/// re-planning.
+pub fn protocol(tasks: &TaskSet, limits: SearchLimits, replan: bool) -> Protocol {
+    Protocol {
+        kind: EvaluationKind::planning(replan),
+        tasks: tasks.clone(),
+        limits: Some(limits),
     }
-    #[derive(Deserialize)]
-    struct Progress {
-        env_steps: u64,
-    }
-    let path = dir.join("progress.json");
-    let text = std::fs::read_to_string(&path).map_err(|_| {
-        anyhow!(
-            "{}: no metrics line at epoch {epoch} and no progress file to tell its environment steps",
-            run.display()
-        )
-    })?;
-    Ok(serde_json::from_str::<Progress>(&text)
-        .with_context(|| format!("reading {}", path.display()))?
-        .env_steps)
 }
 
-/// Evaluates the selected checkpoints of `run` that the file does not hold yet, both modes, on
-/// test boards of `depths` with `boards` per depth. Returns the number of lines appended.
+/// Evaluates the selected checkpoints of `run` in both modes on `tasks` (test boards, the
+/// protocol's seeds), unless the file holds them evaluated with the same protocol already.
+/// Returns the number of lines appended.
 pub fn evaluate_checkpoints(
     run: &Path,
     selection: Selection,
-    depths: &[usize],
-    boards: usize,
+    tasks: &TaskSet,
     limits: SearchLimits,
     quiet: bool,
 ) -> Result<usize> {
@@ -163,15 +168,13 @@ pub fn evaluate_checkpoints(
             run.display()
         ))
     })?;
-    let done: BTreeSet<(u64, bool)> = read(run)?.iter().map(|l| (l.epoch, l.replan)).collect();
+    let done: Vec<(u64, Protocol)> = read(run)?.iter().map(|l| (l.epoch, l.protocol())).collect();
     let todo: Vec<(u64, &Path, bool)> = chosen
         .iter()
         .flat_map(|(epoch, dir)| [true, false].map(|replan| (*epoch, dir.as_path(), replan)))
-        .filter(|(epoch, _, replan)| !done.contains(&(*epoch, *replan)))
+        .filter(|(epoch, _, replan)| !done.contains(&(*epoch, protocol(tasks, limits, *replan))))
         .collect();
-    let metrics = seads_rl::read_metrics(run)?;
-    let seeds = crate::plan::task_seeds(boards, None);
-    let per = (depths.len() * seeds.len()) as u64;
+    let per = tasks.len() as u64;
     let bar = if quiet {
         ProgressBar::hidden()
     } else {
@@ -192,20 +195,22 @@ pub fn evaluate_checkpoints(
         }
         let agent = &mut loaded.as_mut().expect("just loaded").1;
         bar.set_prefix(format!("epoch {epoch}"));
-        let tasks = Tasks {
-            depths: depths.to_vec(),
-            seeds: seeds.clone(),
-            split: seads_games::Split::Test,
-            replan: *replan,
-            limits,
-        };
-        let results = evaluate_agent(agent, &tasks, &bar)?;
+        let results = evaluate_agent(agent, &protocol(tasks, limits, *replan), &bar)?;
+        let env_steps = seads_rl::checkpoint_id(run, dir)?
+            .env_steps
+            .ok_or_else(|| {
+                anyhow!(
+                    "{}: no metrics line at epoch {epoch} and no progress file to tell its \
+                 environment steps",
+                    run.display()
+                )
+            })?;
         let line = CheckpointEvaluation {
             epoch: *epoch,
-            env_steps: env_steps_at(run, &metrics, *epoch, dir)?,
+            env_steps,
             replan: *replan,
-            boards,
-            timeout_s: limits.timeout,
+            boards: tasks.boards,
+            timeout_s: limits.timeout_s,
             max_expanded: limits.max_expanded,
             results,
         };

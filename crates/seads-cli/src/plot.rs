@@ -15,7 +15,8 @@ use seads_rl::{Agent, AgentPolicy, COVERAGE_SEED, find_checkpoint, read_metrics}
 
 use crate::draw::{draw_paths, draw_scene, plot_err, render_to, skill_colour};
 use crate::envs::build_env;
-use crate::plan::{EvaluationKind, Tasks, load_agent, run_evaluation, task_seeds};
+use crate::plan::{load_agent, read_evaluation, run_evaluation};
+use seads_planner::{EvaluationKind, Protocol, STANDARD_DEPTHS, SearchLimits, TaskSet};
 
 /// Arguments of `seads plot`.
 #[derive(Debug, Args)]
@@ -78,9 +79,18 @@ pub fn write_figures(
         let agent = Agent::load_for(config, spec, &find_checkpoint(run, checkpoint)?)?;
         let k = agent.policy_skills();
         both("coverage", &|p| coverage_figure(p, &metrics, k, &title))?;
-        if let Some(results) = saved_evaluation(run, true)? {
-            let replan = [(true, results)];
-            both("success", &|p| success_figure(p, &replan, &title))?;
+        let file = EvaluationKind::Replan.results_file(&STANDARD_DEPTHS, None);
+        match read_evaluation(&run.join(&file))? {
+            Some(record) if record.checkpoint.is_some_and(|c| c.epoch == agent.epoch) => {
+                let replan = [(true, record.results)];
+                both("success", &|p| success_figure(p, &replan, &title))?;
+            }
+            Some(_) if !quiet => eprintln!(
+                "seads: {file} is not an evaluation of epoch {}: no success figure \
+                 (`seads uarm evaluate` makes one)",
+                agent.epoch
+            ),
+            _ => {}
         }
         if !quiet {
             eprintln!(
@@ -142,7 +152,10 @@ impl PolicySkills for Agent {
     }
 }
 
-/// The saved evaluations of the run (with and without re-planning), run first where missing.
+/// The run's evaluations of the agent's checkpoint with and without re-planning: the saved ones
+/// where they name that checkpoint (`evaluation-replan.json`, `evaluation-plan-once.json`),
+/// otherwise evaluated now (an evaluation of an earlier checkpoint, or one that does not say
+/// which it evaluated, is never shown for this one).
 fn evaluations(
     agent: &mut Agent,
     run: &Path,
@@ -151,35 +164,24 @@ fn evaluations(
     quiet: bool,
 ) -> Result<[(bool, Vec<DepthResult>); 2]> {
     let mut load = |replan: bool| -> Result<Vec<DepthResult>> {
-        if let Some(results) = saved_evaluation(run, replan)? {
-            return Ok(results);
+        let kind = EvaluationKind::planning(replan);
+        let saved = read_evaluation(&run.join(kind.results_file(&STANDARD_DEPTHS, None)))?;
+        if let Some(record) = saved
+            && record.checkpoint.is_some_and(|c| c.epoch == agent.epoch)
+        {
+            return Ok(record.results);
         }
-        let tasks = Tasks {
-            depths: (1..=5).collect(),
-            seeds: task_seeds(boards, None),
-            split: Split::Test,
-            replan,
-            limits: crate::plan::SearchLimits {
-                timeout,
+        let protocol = Protocol {
+            kind,
+            tasks: TaskSet::standard(boards),
+            limits: Some(SearchLimits {
+                timeout_s: timeout,
                 max_expanded: None,
-            },
+            }),
         };
-        run_evaluation(agent, run, tasks, quiet)
+        Ok(run_evaluation(agent, run, &protocol, quiet)?.results)
     };
     Ok([(true, load(true)?), (false, load(false)?)])
-}
-
-/// The run's saved evaluation with or without re-planning (`evaluation-replan.json`,
-/// `evaluation-plan-once.json`), if there is one.
-fn saved_evaluation(run: &Path, replan: bool) -> Result<Option<Vec<DepthResult>>> {
-    let path = run.join(EvaluationKind::planning(replan).results_file());
-    match std::fs::read_to_string(&path) {
-        Ok(text) => serde_json::from_str(&text)
-            .map(Some)
-            .with_context(|| format!("reading {}", path.display())),
-        Err(e) if e.kind() == std::io::ErrorKind::NotFound => Ok(None),
-        Err(e) => Err(e).with_context(|| format!("reading {}", path.display())),
-    }
 }
 
 /// Every skill executed from the 20 coverage initialisations of `env` (for registry

@@ -7,11 +7,12 @@ use std::path::{Path, PathBuf};
 use anyhow::{Context, Result, bail};
 use clap::{Args, Subcommand};
 use indicatif::ProgressBar;
-use rand::SeedableRng;
-use rand_chacha::ChaCha8Rng;
 use seads_embodiment::Environment;
-use seads_games::{BoardDataset, BoardGame, Gf2Solver, LightsOut, Split};
-use seads_planner::{DepthResult, PlannerConfig, SolveConfig, solve};
+use seads_games::{BoardGame, GameKind, Gf2Solver, LightsOut};
+use seads_planner::{
+    DepthResult, EvaluationKind, EvaluationRecord, PlannerConfig, Protocol, SearchLimits,
+    SolveConfig, TaskSet, solve,
+};
 use seads_rl::{Agent, Run, TrainConfig, Trainer, find_checkpoint, load_config};
 use seads_uarm::{
     ActionSpace, AdbTablet, Calibration, CalibrationFile, DriverConfig, SerialTransport, Swift,
@@ -422,10 +423,11 @@ pub fn evaluate_run(args: UarmEvaluateArgs) -> Result<()> {
     )
 }
 
-/// Success with re-planning on test boards of depth 1–5 (the twin's boards can be set), or on the
-/// boards the app shows (the real tablet's cannot), of the checkpoint of `epoch` or the latest.
-/// Saved per depth as `evaluation-replan.json` (the file `seads plot` and `seads report` read),
-/// or `evaluation-replan-epoch-<EPOCH>.json` for a chosen checkpoint.
+/// Success with re-planning on the protocol's tasks of depth 1–5 (the twin's boards are set to
+/// them: the boards a Cursor evaluation plays), or on the boards the app shows (the real
+/// tablet's cannot be set), of the checkpoint of `epoch` or the latest. Saved per depth as
+/// `evaluation-replan.json` (the file `seads plot` and `seads report` read), or
+/// `evaluation-replan-epoch-<EPOCH>.json` for an earlier checkpoint.
 fn evaluate(
     run: &Path,
     epoch: Option<u64>,
@@ -436,17 +438,19 @@ fn evaluate(
     quiet: bool,
 ) -> Result<()> {
     let checkpoint = find_checkpoint(run, epoch).map_err(|e| BadInput(e.into()))?;
-    let file = match epoch {
-        Some(epoch) => format!("evaluation-replan-epoch-{epoch:06}.json"),
-        None => crate::plan::EvaluationKind::Replan.results_file(),
-    };
     let config = load_config(run)?;
     let mut agent = Agent::load_for(config, env.spec().clone(), &checkpoint)?;
     let (policy, model) = agent.parts()?;
     let game = LightsOut::new(5)?;
     let solver = Gf2Solver::new(&game);
-    let data = BoardDataset::build(&game, 5)?;
-    let mut rng = ChaCha8Rng::seed_from_u64(4343);
+    let protocol = Protocol {
+        kind: EvaluationKind::Replan,
+        tasks: TaskSet::standard(boards),
+        limits: Some(SearchLimits {
+            timeout_s: timeout,
+            max_expanded: None,
+        }),
+    };
     let solve_config = SolveConfig {
         replan: true,
         planner: PlannerConfig {
@@ -458,18 +462,16 @@ fn evaluate(
     let bar = if quiet {
         ProgressBar::hidden()
     } else {
-        ProgressBar::new(5 * boards as u64)
+        ProgressBar::new(protocol.tasks.len() as u64)
     };
-    // Keyed by the board's solution depth: the twin's are 1–5 by construction, the tablet's are
-    // whatever the app shows.
+    // Keyed by the board's solution depth: the twin's are the tasks' by construction, the
+    // tablet's are whatever the app shows.
     let mut results: BTreeMap<usize, DepthResult> = BTreeMap::new();
-    for depth in 1..=5 {
-        for _ in 0..boards {
+    let seeds = protocol.tasks.seeds();
+    for &depth in &protocol.tasks.depths {
+        for &seed in &seeds {
             if settable {
-                env.set_board(
-                    data.sample(depth, Split::Test, &mut rng)
-                        .expect("boards of depth 1..5"),
-                )?;
+                env.set_board(protocol.tasks.board(GameKind::LightsOut, 5, depth, seed)?)?;
             }
             let d = solver.depth(env.board()).unwrap_or(0);
             let outcome = solve(&mut env, policy, model, game.goal(), &solve_config)?;
@@ -481,11 +483,14 @@ fn evaluate(
         }
     }
     bar.finish_and_clear();
-    let results: Vec<DepthResult> = results.into_values().collect();
-    seads_rl::write_atomic(
-        &run.join(&file),
-        serde_json::to_string_pretty(&results)?.as_bytes(),
-    )?;
+    let (id, named) = crate::plan::checkpoint_of(run, &checkpoint)?;
+    let record = EvaluationRecord {
+        checkpoint: Some(id),
+        protocol: Some(protocol),
+        results: results.into_values().collect(),
+    };
+    crate::plan::save_evaluation(run, &record, named, None)?;
+    let results = record.results;
     let (solved, tasks) = results
         .iter()
         .fold((0, 0), |(s, t), r| (s + r.solved, t + r.tasks));

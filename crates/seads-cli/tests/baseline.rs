@@ -205,7 +205,15 @@ fn trains_resumes_evaluates_and_is_reported(algorithm: &str) {
     let saved: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(run.join("evaluation-policy.json")).unwrap())
             .unwrap();
-    assert!(saved.as_array().unwrap().iter().all(|d| d["tasks"] == 2));
+    // The record names the checkpoint it evaluated and its protocol.
+    assert_eq!(saved["checkpoint"]["epoch"], 40, "{saved}");
+    assert_eq!(saved["checkpoint"]["env_steps"], 320, "{saved}");
+    assert_eq!(saved["protocol"]["kind"], "policy", "{saved}");
+    assert_eq!(saved["protocol"]["tasks"]["boards"], 2, "{saved}");
+    let results = saved["results"].as_array().unwrap();
+    assert!(results.iter().all(|d| d["tasks"] == 2));
+    let tasks = std::fs::read_to_string(run.join("evaluation-policy-tasks.jsonl")).unwrap();
+    assert_eq!(tasks.lines().count(), 10, "one line per task");
 
     check_bad_input(
         &[

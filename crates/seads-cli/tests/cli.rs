@@ -727,10 +727,14 @@ fn uarm_twin_calibrates_and_trains() {
     let evaluation: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(run.join("evaluation-replan.json")).unwrap())
             .unwrap();
-    let tasks: u64 = (0..5)
-        .map(|d| evaluation[d]["tasks"].as_u64().unwrap())
+    let tasks: u64 = evaluation["results"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|d| d["tasks"].as_u64().unwrap())
         .sum();
     assert_eq!(tasks, 5, "{evaluation}");
+    assert_eq!(evaluation["protocol"]["tasks"]["boards"], 1, "{evaluation}");
     let report = dir.path().join("report");
     seads_ok(&["report", s(&run), "--out", s(&report), "--copy-runs"]);
     let md = std::fs::read_to_string(report.join("report.md")).unwrap();
@@ -784,8 +788,10 @@ fn a_resumed_robot_run_keeps_its_action_space() {
             .unwrap()
             .contains("uarm-lightsout-displacement")
     );
-    // A chosen checkpoint evaluated on its own, beside the final evaluation.
-    let epoch: u64 = std::fs::read_dir(run.join("checkpoints"))
+    // An earlier checkpoint evaluated on its own, beside the final evaluation (issue 32: it
+    // took the final evaluation's file). The run keeps one checkpoint; a copy of it under a
+    // lower epoch stands in for an earlier one.
+    let last: u64 = std::fs::read_dir(run.join("checkpoints"))
         .unwrap()
         .filter_map(|e| {
             e.unwrap()
@@ -795,8 +801,17 @@ fn a_resumed_robot_run_keeps_its_action_space() {
                 .parse()
                 .ok()
         })
-        .min()
+        .max()
         .unwrap();
+    let earlier = last - 1;
+    let status = std::process::Command::new("cp")
+        .arg("-r")
+        .arg(run.join(format!("checkpoints/epoch-{last:06}")))
+        .arg(run.join(format!("checkpoints/epoch-{earlier:06}")))
+        .status()
+        .unwrap();
+    assert!(status.success());
+    let final_evaluation = std::fs::read_to_string(run.join("evaluation-replan.json")).unwrap();
     let evaluate = |extra: &[&str]| {
         let mut args = vec![
             "uarm",
@@ -814,12 +829,21 @@ fn a_resumed_robot_run_keeps_its_action_space() {
         args.extend_from_slice(extra);
         args.iter().map(|a| a.to_string()).collect::<Vec<_>>()
     };
-    let args = evaluate(&["--checkpoint", &epoch.to_string()]);
+    let args = evaluate(&["--checkpoint", &earlier.to_string()]);
     seads_ok(&args.iter().map(String::as_str).collect::<Vec<_>>());
-    assert!(
-        run.join(format!("evaluation-replan-epoch-{epoch:06}.json"))
-            .is_file()
+    let record: serde_json::Value = serde_json::from_str(
+        &std::fs::read_to_string(run.join(format!("evaluation-replan-epoch-{earlier:06}.json")))
+            .unwrap(),
+    )
+    .unwrap();
+    assert_eq!(record["checkpoint"]["epoch"], earlier, "{record}");
+    assert_eq!(
+        std::fs::read_to_string(run.join("evaluation-replan.json")).unwrap(),
+        final_evaluation,
+        "the final evaluation is untouched"
     );
+    let final_record: serde_json::Value = serde_json::from_str(&final_evaluation).unwrap();
+    assert_eq!(final_record["checkpoint"]["epoch"], last, "{final_record}");
     let args = evaluate(&["--checkpoint", "999999"]);
     check_bad_input(
         &args.iter().map(String::as_str).collect::<Vec<_>>(),

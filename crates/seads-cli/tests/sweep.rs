@@ -310,8 +310,8 @@ fn a_sweep_is_planned_once_run_to_the_end_and_reported() {
     let evaluation = data.join("runs/lightsout-cursor/seads/seed-1/evaluation-replan.json");
     let mut v: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(&evaluation).unwrap()).unwrap();
-    v[2]["timeouts"] = 1.into();
-    v[4]["timeouts"] = 1.into();
+    v["results"][2]["timeouts"] = 1.into();
+    v["results"][4]["timeouts"] = 1.into();
     std::fs::write(&evaluation, v.to_string()).unwrap();
     seads_ok(&["report", s(&data), "--out", s(&again)]);
     let md = std::fs::read_to_string(again.join("report.md")).unwrap();
@@ -631,7 +631,7 @@ fn results(run: &Path) -> (Vec<serde_json::Value>, Vec<serde_json::Value>) {
     for file in ["evaluation-replan.json", "evaluation-plan-once.json"] {
         let mut v: serde_json::Value =
             serde_json::from_str(&std::fs::read_to_string(run.join(file)).unwrap()).unwrap();
-        for depth in v.as_array_mut().unwrap() {
+        for depth in v["results"].as_array_mut().unwrap() {
             assert_eq!(
                 depth["timeouts"], 0,
                 "no search stopped at the clock: {depth}"

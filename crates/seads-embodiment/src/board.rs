@@ -21,9 +21,27 @@ enum BoardSource {
     ActionSampling,
 }
 
-/// The game part of an environment, with its own RNG stream (SPEC §1.5).
+/// The board side of an environment: the game, its current board, the reset distribution and
+/// its own RNG stream (SPEC §1.5). Every environment of the registry holds one, and so does the
+/// robot's; seeded with the same seed, each draws the same boards.
+///
+/// ```
+/// use seads_embodiment::{BoardState, EnvConfig, make_env};
+/// use seads_games::GameKind;
+///
+/// let config = EnvConfig { max_solution_depth: 3, random_solution_depth: false, ..EnvConfig::default() };
+/// let mut board = BoardState::new(GameKind::LightsOut, 5, &config)?;
+/// board.seed(7);
+/// board.reset();
+/// // An environment seeded alike starts from the same board.
+/// let mut env = make_env("lightsout-cursor", &config)?;
+/// env.seed(7);
+/// env.reset()?;
+/// assert_eq!(env.board(), board.board());
+/// # Ok::<(), seads_embodiment::EnvError>(())
+/// ```
 #[derive(Clone)]
-pub(crate) struct BoardState {
+pub struct BoardState {
     game: Arc<dyn BoardGame>,
     source: BoardSource,
     split: Split,
@@ -67,14 +85,17 @@ impl BoardState {
         })
     }
 
+    /// The game.
     pub fn game(&self) -> &dyn BoardGame {
         self.game.as_ref()
     }
 
+    /// The current board.
     pub fn board(&self) -> SymbolicState {
         self.board
     }
 
+    /// Restarts the board's RNG stream from `seed`.
     pub fn seed(&mut self, seed: u64) {
         self.rng = ChaCha8Rng::seed_from_u64(seed);
     }
@@ -108,6 +129,7 @@ impl BoardState {
         Ok(())
     }
 
+    /// Makes move `mv`.
     pub fn apply(&mut self, mv: MoveId) {
         self.board = self.game.apply(self.board, mv);
     }

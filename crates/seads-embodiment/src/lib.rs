@@ -61,6 +61,7 @@ mod scene;
 mod spec;
 mod task;
 
+pub use board::BoardState;
 pub use config::EnvConfig;
 pub use cursor::Cursor;
 pub use embodied::{Embodied, Environment, Manipulator, Touch};

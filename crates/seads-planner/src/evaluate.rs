@@ -4,10 +4,10 @@
 use std::collections::BTreeMap;
 
 use seads_embodiment::{EnvConfig, EnvError, SkillPolicy, make_env};
-use seads_games::{Split, Successor, SymbolicState};
+use seads_games::{Successor, SymbolicState};
 use serde::{Deserialize, Serialize};
 
-use crate::{SolveConfig, SolveOutcome, solve};
+use crate::{SolveConfig, SolveOutcome, TaskSet, solve};
 
 /// One task of an evaluation, as it ended.
 #[derive(Debug, Clone, Copy)]
@@ -84,19 +84,15 @@ impl DepthResult {
     }
 }
 
-/// What to evaluate on: an environment, the depths and seeds of its tasks.
+/// What to evaluate on: an environment and the tasks of the protocol.
 #[derive(Debug, Clone)]
 pub struct Evaluation {
     /// Environment name.
     pub env: String,
     /// Environment options (the reset distribution is overridden per depth).
     pub env_config: EnvConfig,
-    /// Solution depths of the boards.
-    pub depths: Vec<usize>,
-    /// Environment seeds; one task per seed and depth.
-    pub seeds: Vec<u64>,
-    /// Board split (the paper evaluates on test boards).
-    pub split: Split,
+    /// Depths, boards per depth and the split ([`TaskSet::seeds`] gives the boards' seeds).
+    pub tasks: TaskSet,
     /// With or without re-planning, search limits.
     pub solve: SolveConfig,
 }
@@ -110,9 +106,10 @@ pub fn evaluate(
     mut each: impl FnMut(&TaskRecord<'_>),
 ) -> Result<Vec<DepthResult>, EnvError> {
     let mut results = Vec::new();
-    for &depth in &evaluation.depths {
+    let seeds = evaluation.tasks.seeds();
+    for &depth in &evaluation.tasks.depths {
         let env_config = EnvConfig {
-            reset_split: evaluation.split,
+            reset_split: evaluation.tasks.split,
             max_solution_depth: depth,
             random_solution_depth: false,
             ..evaluation.env_config.clone()
@@ -121,7 +118,7 @@ pub fn evaluate(
         let game = env.spec().game.build(env.spec().board_size)?;
         let goal = game.goal();
         let mut result = DepthResult::new(depth);
-        for &seed in &evaluation.seeds {
+        for &seed in &seeds {
             env.seed(seed);
             env.reset()?;
             let board = env.board();

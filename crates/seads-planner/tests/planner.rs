@@ -9,8 +9,8 @@ use seads_games::{
     TileSwap,
 };
 use seads_planner::{
-    DepthResult, Evaluation, PlanError, PlannerConfig, SolveConfig, bfs_plan, evaluate, solve,
-    summarise,
+    DepthResult, Evaluation, PlanError, PlannerConfig, SolveConfig, TaskSet, bfs_plan, evaluate,
+    solve, summarise,
 };
 use std::sync::LazyLock;
 
@@ -303,9 +303,12 @@ fn evaluation_protocol_reports_per_depth() {
     let evaluation = Evaluation {
         env: "lightsout-cursor".into(),
         env_config: EnvConfig::default(),
-        depths: vec![1, 3],
-        seeds: vec![1, 2, 3, 4],
-        split: Split::Test,
+        tasks: TaskSet {
+            depths: vec![1, 3],
+            boards: 4,
+            split: Split::Test,
+            seed: Some(1),
+        },
         solve: SolveConfig::default(),
     };
     let mut calls = 0;

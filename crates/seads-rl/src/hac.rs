@@ -34,7 +34,7 @@ use std::time::Instant;
 use rand::RngExt;
 use seads_embodiment::{EnvSpec, TaskEnv};
 use seads_games::SymbolicState;
-use seads_planner::DepthResult;
+use seads_planner::{DepthResult, TaskSet};
 use serde::{Deserialize, Serialize};
 use tch::Device;
 
@@ -511,7 +511,12 @@ impl Hac {
     pub fn task_success(&mut self, boards: usize) -> Result<Vec<DepthResult>, RlError> {
         let start = Instant::now();
         let config = self.config.clone();
-        let results = task_success(&config, &mut self.policy(), &[1, 2, 3, 4, 5], boards)?;
+        let results = task_success(
+            &config,
+            &mut self.policy(),
+            &TaskSet::standard(boards),
+            |_, _, _, _| {},
+        )?;
         self.progress.timings.evaluate += start.elapsed().as_secs_f64();
         Ok(results)
     }

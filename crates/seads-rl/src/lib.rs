@@ -64,7 +64,7 @@ pub use run::{Hook, Learner, Metrics, Moment, Run, RunEvent, load_config, raise_
 pub use sac::{Sac, SacConfig, SacLosses, TransitionBatch, checkpoint_files};
 pub use seeds::{Purpose, derived_seed, stream, train_env_seed};
 pub use store::{
-    MetricsLine, append_json_line, check_origin, checkpoint_name, checkpoints,
+    MetricsLine, append_json_line, check_origin, checkpoint_id, checkpoint_name, checkpoints,
     is_copy_without_checkpoints, last_env_steps, latest_checkpoint, read_json_lines, read_metrics,
     read_metrics_as, write_atomic,
 };

@@ -16,6 +16,8 @@ use std::path::{Path, PathBuf};
 use serde::Serialize;
 use serde::de::DeserializeOwned;
 
+use seads_planner::CheckpointId;
+
 use crate::{Metrics, RlError};
 
 /// A line of `metrics.jsonl`: what resuming needs to know of it.
@@ -228,6 +230,43 @@ pub fn last_env_steps(dir: &Path) -> Result<u64, RlError> {
     }
     let (lines, _) = read_json_lines::<Steps>(&dir.join(METRICS))?;
     Ok(lines.last().map_or(0, |l| l.env_steps))
+}
+
+/// Which checkpoint the folder `checkpoint` of the run in `dir` is: its epoch (from its name)
+/// and the environment steps of training there, from the run's metrics line of that epoch (the
+/// presets evaluate wherever they checkpoint), else from the checkpoint's progress file, else
+/// unknown.
+pub fn checkpoint_id(dir: &Path, checkpoint: &Path) -> Result<CheckpointId, RlError> {
+    #[derive(serde::Deserialize)]
+    struct Steps {
+        #[serde(default)]
+        epoch: u64,
+        env_steps: u64,
+    }
+    let epoch = checkpoint
+        .file_name()
+        .and_then(|n| n.to_str())
+        .and_then(checkpoint_epoch)
+        .ok_or_else(|| RlError::Checkpoint {
+            path: checkpoint.display().to_string(),
+            reason: "not a checkpoint folder (epoch-NNNNNN)".into(),
+        })?;
+    let metrics = dir.join(METRICS);
+    let from_metrics = if metrics.is_file() {
+        let (lines, _) = read_json_lines::<Steps>(&metrics)?;
+        lines.iter().find(|l| l.epoch == epoch).map(|l| l.env_steps)
+    } else {
+        None
+    };
+    let from_progress = || {
+        let text = fs::read_to_string(checkpoint.join(crate::checkpoint::PROGRESS_FILE)).ok()?;
+        let steps = serde_json::from_str::<Steps>(&text).ok()?;
+        (steps.epoch == epoch).then_some(steps.env_steps)
+    };
+    Ok(CheckpointId {
+        epoch,
+        env_steps: from_metrics.or_else(from_progress),
+    })
 }
 
 /// Whether `dir` holds a run's metrics but no checkpoints folder: a run copied without its

@@ -4,12 +4,12 @@
 use std::path::Path;
 
 use seads_embodiment::{EnvConfig, TaskEnv, make_env};
-use seads_games::Split;
-use seads_planner::{DepthResult, EVALUATION_SEEDS};
+use seads_games::SymbolicState;
+use seads_planner::{DepthResult, TaskSet};
 use tch::Device;
 
 use crate::hac::HacPolicy;
-use crate::{Algorithm, Purpose, RlError, Sac, TrainConfig, derived_seed};
+use crate::{Algorithm, RlError, Sac, TrainConfig};
 
 /// A deterministic policy acting in task mode: one action per observation of an episode.
 pub trait TaskPolicy {
@@ -60,26 +60,20 @@ pub fn load_policy(
     }
 }
 
-/// Task success of `policy` on the SEADS protocol: `boards` test boards per depth (1–5 in the
-/// protocol), the authors' evaluation seeds first, each episode until solved or T_lim.
+/// Task success of `policy` on the tasks of the SEADS protocol (the boards a planning
+/// evaluation with the same task set plays), each episode until solved or T_lim. `each` is
+/// called with every task as it ends: (depth, seed, board, solved).
 pub fn task_success(
     config: &TrainConfig,
     policy: &mut dyn TaskPolicy,
-    depths: &[usize],
-    boards: usize,
+    tasks: &TaskSet,
+    mut each: impl FnMut(usize, u64, SymbolicState, bool),
 ) -> Result<Vec<DepthResult>, RlError> {
-    let seeds: Vec<u64> = (0..boards as u64)
-        .map(|i| {
-            EVALUATION_SEEDS
-                .get(i as usize)
-                .copied()
-                .unwrap_or_else(|| derived_seed(4343, Purpose::TrainEnvs, i))
-        })
-        .collect();
+    let seeds = tasks.seeds();
     let mut results = Vec::new();
-    for &depth in depths {
+    for &depth in &tasks.depths {
         let env_config = EnvConfig {
-            reset_split: Split::Test,
+            reset_split: tasks.split,
             max_solution_depth: depth,
             random_solution_depth: false,
             ..config.env_config.clone()
@@ -90,6 +84,7 @@ pub fn task_success(
         for &seed in &seeds {
             env.seed(seed);
             env.reset()?;
+            let board = env.env().board();
             policy.begin();
             result.tasks += 1;
             loop {
@@ -101,6 +96,7 @@ pub fn task_success(
                         result.solved += 1;
                         result.solution_steps.push(env.steps());
                     }
+                    each(depth, seed, board, step.solved);
                     break;
                 }
             }

@@ -17,7 +17,7 @@ use std::time::Instant;
 use rand_chacha::ChaCha8Rng;
 use seads_embodiment::{EnvConfig, EnvSpec, TaskEnv, make_env};
 use seads_games::Split;
-use seads_planner::DepthResult;
+use seads_planner::{DepthResult, TaskSet};
 use serde::{Deserialize, Serialize};
 use tch::Device;
 
@@ -363,7 +363,12 @@ impl TaskSac {
     /// (the authors' evaluation seeds first), as the SEADS evaluation's per-depth results.
     pub fn task_success(&mut self, boards: usize) -> Result<Vec<DepthResult>, RlError> {
         let start = Instant::now();
-        let results = task_success(&self.config, &mut &self.sac, &[1, 2, 3, 4, 5], boards)?;
+        let results = task_success(
+            &self.config,
+            &mut &self.sac,
+            &TaskSet::standard(boards),
+            |_, _, _, _| {},
+        )?;
         self.progress.timings.evaluate += start.elapsed().as_secs_f64();
         Ok(results)
     }

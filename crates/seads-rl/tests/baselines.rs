@@ -2,6 +2,7 @@
 //! schedule by hand, determinism, exact resume through a run directory, task success on the
 //! SEADS protocol's boards, and the presets against the seed's settings.
 
+use seads_planner::TaskSet;
 use seads_rl::{
     Algorithm, Hac, Learner, Run, TaskMetrics, TaskSac, TrainConfig, read_metrics_as, task_success,
     updates_due,
@@ -134,7 +135,13 @@ fn a_resumed_hac_run_is_the_uninterrupted_run() {
 fn task_success_covers_every_depth() {
     let config = small(1, 800);
     let agent = TaskSac::new(config.clone()).unwrap();
-    let results = task_success(&config, &mut agent.policy(), &[1, 2, 3, 4, 5], 3).unwrap();
+    let results = task_success(
+        &config,
+        &mut agent.policy(),
+        &TaskSet::standard(3),
+        |_, _, _, _| {},
+    )
+    .unwrap();
     assert_eq!(
         results.iter().map(|r| r.depth).collect::<Vec<_>>(),
         [1, 2, 3, 4, 5]
@@ -305,7 +312,13 @@ fn bad_baseline_settings_are_refused() {
 fn hac_task_success_covers_every_depth() {
     let config = small_of(Algorithm::Hac, 1, 800);
     let agent = Hac::new(config.clone()).unwrap();
-    let results = task_success(&config, &mut agent.policy(), &[1, 2, 3, 4, 5], 3).unwrap();
+    let results = task_success(
+        &config,
+        &mut agent.policy(),
+        &TaskSet::standard(3),
+        |_, _, _, _| {},
+    )
+    .unwrap();
     assert_eq!(results.len(), 5);
     for r in &results {
         assert_eq!(r.tasks, 3);
@@ -429,4 +442,68 @@ fn a_checkpoint_of_another_environment_is_refused_naming_both() {
         "{}",
         chain(&e)
     );
+}
+
+/// One evaluation protocol: a baseline's policy evaluation and a SEADS planning evaluation of the
+/// same task set play the same boards, beyond the authors' 20 seeds too (30 boards per depth).
+#[test]
+fn policy_and_planning_evaluations_play_the_same_boards() {
+    /// Zero actions: the boards, not the outcomes, are compared.
+    struct Still(usize);
+    impl seads_rl::TaskPolicy for Still {
+        fn act(&mut self, _: &[f32]) -> Vec<f32> {
+            vec![0.0; self.0]
+        }
+    }
+    impl seads_embodiment::SkillPolicy for Still {
+        fn num_skills(&self) -> usize {
+            25
+        }
+        fn act(&self, _: &[f32], _: &[usize], actions: &mut [f32]) {
+            actions.fill(0.0);
+        }
+    }
+    let config = small(1, 100);
+    let spec = seads_embodiment::make_env(&config.env, &config.env_config)
+        .unwrap()
+        .spec()
+        .clone();
+    let still = Still(spec.action_dim);
+    let tasks = TaskSet {
+        depths: vec![1, 4],
+        ..TaskSet::standard(30)
+    };
+    let mut policy_boards = Vec::new();
+    task_success(
+        &config,
+        &mut Still(spec.action_dim),
+        &tasks,
+        |depth, seed, board, _| {
+            policy_boards.push((depth, seed, board));
+        },
+    )
+    .unwrap();
+    let game = seads_games::LightsOut::new(5).unwrap();
+    let evaluation = seads_planner::Evaluation {
+        env: config.env.clone(),
+        env_config: config.env_config.clone(),
+        tasks: tasks.clone(),
+        solve: seads_planner::SolveConfig::default(),
+    };
+    let mut planning_boards = Vec::new();
+    seads_planner::evaluate(
+        &evaluation,
+        &still,
+        &mut seads_games::GameSuccessor::new(&game),
+        |task| planning_boards.push((task.depth, task.seed, task.board)),
+    )
+    .unwrap();
+    assert_eq!(policy_boards.len(), 60);
+    assert_eq!(policy_boards, planning_boards);
+    // The authors' seeds come first, and every board has its depth.
+    assert_eq!(policy_boards[0].1, seads_planner::EVALUATION_SEEDS[0]);
+    let solver = seads_games::Gf2Solver::new(&game);
+    for (depth, _, board) in &policy_boards {
+        assert_eq!(solver.depth(*board).unwrap(), *depth);
+    }
 }

@@ -6,9 +6,9 @@ use std::path::PathBuf;
 use anyhow::{Context, Result, bail};
 use clap::Args;
 use seads_games::Split;
-use seads_planner::summarise;
+use seads_planner::{EvaluationKind, Protocol, SearchLimits, TaskSet, summarise};
 
-use super::{EvaluationKind, SearchLimits, Tasks, load_agent, run_evaluation, task_seeds};
+use super::{load_agent, run_evaluation, run_policy_evaluation};
 use crate::BadInput;
 
 /// Parses "1-5", "6,8,10" or "3": sorted, each once, none zero.
@@ -77,7 +77,7 @@ pub struct EvaluateArgs {
 pub fn evaluate_run(args: EvaluateArgs) -> Result<()> {
     let depths = parse_depths(&args.depths)?;
     let limits = SearchLimits {
-        timeout: args.timeout,
+        timeout_s: args.timeout,
         max_expanded: args
             .max_expanded
             .map(|m| m.try_into().unwrap_or(usize::MAX)),
@@ -95,18 +95,32 @@ pub fn evaluate_run(args: EvaluateArgs) -> Result<()> {
                 args.run.display()
             )));
         }
-        return evaluate_policy(&args, &config, &depths);
+        let tasks = TaskSet {
+            depths,
+            boards: args.boards,
+            split: args.split,
+            seed: args.seed,
+        };
+        return evaluate_policy(&args, &config, tasks);
     }
     if let Some(selection) = args.checkpoints {
+        let tasks = TaskSet {
+            depths,
+            ..TaskSet::standard(args.boards)
+        };
         let added = crate::overtraining::evaluate_checkpoints(
             &args.run,
             selection,
-            &depths,
-            args.boards,
+            &tasks,
             limits,
             args.quiet || args.json,
         )?;
-        let lines = crate::overtraining::read(&args.run)?;
+        // The lines of this protocol only: the file may hold evaluations with other depths,
+        // boards or limits.
+        let lines: Vec<_> = crate::overtraining::read(&args.run)?
+            .into_iter()
+            .filter(|l| l.protocol() == crate::overtraining::protocol(&tasks, limits, l.replan))
+            .collect();
         if args.json {
             println!("{}", serde_json::to_string(&lines)?);
         } else {
@@ -134,15 +148,18 @@ pub fn evaluate_run(args: EvaluateArgs) -> Result<()> {
         return Ok(());
     }
     let mut agent = load_agent(&args.run, args.checkpoint)?;
-    let seeds = task_seeds(args.boards, args.seed);
-    let tasks = Tasks {
-        depths,
-        seeds,
-        split: args.split,
-        replan: args.replan,
-        limits,
+    let protocol = Protocol {
+        kind: EvaluationKind::planning(args.replan),
+        tasks: TaskSet {
+            depths,
+            boards: args.boards,
+            split: args.split,
+            seed: args.seed,
+        },
+        limits: Some(limits),
     };
-    let results = run_evaluation(&mut agent, &args.run, tasks, args.quiet || args.json)?;
+    let record = run_evaluation(&mut agent, &args.run, &protocol, args.quiet || args.json)?;
+    let results = record.results;
     let summary = summarise(&results);
     if args.json {
         println!("{}", serde_json::to_string(&summary)?);
@@ -176,34 +193,19 @@ pub fn evaluate_run(args: EvaluateArgs) -> Result<()> {
     Ok(())
 }
 
-/// `seads evaluate` on a baseline run: its policy alone on the test boards of each depth, saved
-/// as `evaluation-policy.json` (depths 1–5) or `evaluation-policy-depths-A-B.json`.
+/// `seads evaluate` on a baseline run: its policy alone on the tasks of the protocol, saved as
+/// `evaluation-policy.json` (depths 1–5) or `evaluation-policy-depths-A-B.json`, with one line
+/// per task (the boards a planning evaluation of the same tasks plays).
 fn evaluate_policy(
     args: &EvaluateArgs,
     config: &seads_rl::TrainConfig,
-    depths: &[usize],
+    tasks: TaskSet,
 ) -> Result<()> {
     crate::kernels::use_kernels(config.portable_numerics)?;
-    let checkpoint = match args.checkpoint {
-        Some(epoch) => args
-            .run
-            .join("checkpoints")
-            .join(seads_rl::checkpoint_name(epoch)),
-        None => seads_rl::latest_checkpoint(&args.run)?.ok_or_else(|| {
-            BadInput(anyhow::anyhow!(
-                "{} has no checkpoint yet",
-                args.run.display()
-            ))
-        })?,
-    };
-    let mut policy = seads_rl::load_policy(config, &checkpoint)
-        .with_context(|| format!("loading the policy of run {}", args.run.display()))?;
-    let results = seads_rl::task_success(config, policy.as_mut(), depths, args.boards)?;
-    let name = format!("{}.json", EvaluationKind::Policy.stem(depths));
-    seads_rl::write_atomic(
-        &args.run.join(name),
-        serde_json::to_string_pretty(&results)?.as_bytes(),
-    )?;
+    let checkpoint =
+        seads_rl::find_checkpoint(&args.run, args.checkpoint).map_err(|e| BadInput(e.into()))?;
+    let record = run_policy_evaluation(config, &args.run, &checkpoint, tasks)?;
+    let results = record.results;
     let summary = summarise(&results);
     if args.json {
         println!("{}", serde_json::to_string(&summary)?);

@@ -14,7 +14,8 @@ use seads_rl::Agent;
 pub use bench::{PlanBenchArgs, plan_bench};
 pub use evaluate::{EvaluateArgs, evaluate_run};
 pub use evaluation::{
-    EvaluationKind, SearchLimits, Tasks, evaluate_agent, run_evaluation, task_seeds,
+    checkpoint_of, evaluate_agent, read_evaluation, run_evaluation, run_policy_evaluation,
+    save_evaluation,
 };
 pub use solve::{SolveArgs, solve_board};
 

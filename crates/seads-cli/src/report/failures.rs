@@ -10,7 +10,7 @@ use anyhow::Result;
 use serde::Deserialize;
 
 use super::runs::Group;
-use crate::plan::EvaluationKind;
+use seads_planner::{EvaluationKind, STANDARD_DEPTHS};
 
 /// What the report reads of one line of a per-task file (`failed_tasks.rs` lists the failed
 /// ones).
@@ -101,7 +101,7 @@ impl Summary {
 
 /// The per-task lines of a run, or `None` if it has no per-task file.
 pub(super) fn read_tasks(run: &Path) -> Result<Option<Vec<TaskLine>>> {
-    let path = run.join(EvaluationKind::Replan.tasks_file());
+    let path = run.join(EvaluationKind::Replan.tasks_file(&STANDARD_DEPTHS, None));
     if !path.exists() {
         return Ok(None);
     }
@@ -225,7 +225,8 @@ mod tests {
         let dir = tempfile::tempdir().unwrap();
         assert!(read_tasks(dir.path()).unwrap().is_none());
         std::fs::write(
-            dir.path().join(EvaluationKind::Replan.tasks_file()),
+            dir.path()
+                .join(EvaluationKind::Replan.tasks_file(&STANDARD_DEPTHS, None)),
             "{\"solved\": true}\n",
         )
         .unwrap();

@@ -127,6 +127,7 @@ pub fn report(args: ReportArgs) -> Result<()> {
     let _ = writeln!(md, "\nAs CSV: `table1.csv`.\n");
     let _ = writeln!(md, "## Task success at the end of training\n");
     md += &success_md;
+    md += &evaluation_notes(&collection.runs);
     let _ = writeln!(md, "\nAs CSV: `success.csv`.\n");
     if let Some(comparison) = tables::success_comparison(&groups, reference.as_deref()) {
         let _ = writeln!(md, "## SEADS against the baselines: task success\n");
@@ -203,6 +204,29 @@ pub fn report(args: ReportArgs) -> Result<()> {
         figures.len()
     );
     Ok(())
+}
+
+/// Which evaluation files the end-of-training tables left out (they evaluated an earlier
+/// checkpoint) or took without knowing their checkpoint (older files), as Markdown lines.
+fn evaluation_notes(runs: &[runs::RunData]) -> String {
+    let mut md = String::new();
+    for run in runs {
+        for note in &run.evaluation_notes {
+            let _ = writeln!(md, "- `{}`: {note}", run.dir.display());
+        }
+    }
+    let unrecorded: usize = runs.iter().map(|r| r.unrecorded_evaluations).sum();
+    if unrecorded > 0 {
+        let _ = writeln!(
+            md,
+            "- {unrecorded} evaluation file(s) do not record which checkpoint they evaluated \
+             (written before evaluations did): taken as the end of training"
+        );
+    }
+    if !md.is_empty() {
+        md.insert(0, '\n');
+    }
+    md
 }
 
 #[cfg(test)]

@@ -5,11 +5,10 @@ use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
 use anyhow::{Context, Result, anyhow, bail};
-use seads_planner::DepthResult;
+use seads_planner::{DepthResult, EvaluationKind, STANDARD_DEPTHS};
 use seads_rl::{Algorithm, Metrics, TaskMetrics, TrainConfig};
 
 use crate::overtraining::CheckpointEvaluation;
-use crate::plan::EvaluationKind;
 use crate::sweep::Sweep;
 
 /// One run, as read from its directory.
@@ -37,6 +36,12 @@ pub struct RunData {
     pub over_training: Vec<CheckpointEvaluation>,
     /// The processors that trained it (`provenance.jsonl`; empty for older runs).
     pub processors: Vec<String>,
+    /// Evaluation files left out of the end-of-training tables because they evaluated an
+    /// earlier checkpoint: one line each.
+    pub evaluation_notes: Vec<String>,
+    /// Evaluation files taken as the end of training although they do not record their
+    /// checkpoint (written before evaluations did).
+    pub unrecorded_evaluations: usize,
 }
 
 impl RunData {
@@ -67,23 +72,48 @@ impl RunData {
                 seads_rl::read_metrics_as::<TaskMetrics>(dir).unwrap_or_default(),
             ),
         };
-        let evaluation = |kind: EvaluationKind| -> Result<Option<Vec<DepthResult>>> {
-            let path = dir.join(kind.results_file());
-            match std::fs::read_to_string(&path) {
-                Ok(text) => Ok(Some(
-                    serde_json::from_str(&text)
-                        .with_context(|| format!("reading {}", path.display()))?,
-                )),
-                Err(_) => Ok(None),
+        // The last epoch of training: an evaluation of the end of training names it.
+        let last_epoch = match config.algorithm {
+            Algorithm::Seads => metrics.last().map(|m| m.epoch),
+            Algorithm::Sac | Algorithm::Hac => task_metrics.last().map(|m| m.epoch),
+        };
+        let mut evaluation_notes = Vec::new();
+        let mut unrecorded_evaluations = 0;
+        let mut evaluation = |kind: EvaluationKind| -> Result<Option<Vec<DepthResult>>> {
+            let file = kind.results_file(&STANDARD_DEPTHS, None);
+            let Some(record) = crate::plan::read_evaluation(&dir.join(&file))? else {
+                return Ok(None);
+            };
+            match record.checkpoint {
+                Some(c) if Some(c.epoch) != last_epoch => {
+                    evaluation_notes.push(format!(
+                        "`{file}` evaluated epoch {}, not the end of training (epoch {}): left out",
+                        c.epoch,
+                        last_epoch.map_or("unknown".into(), |e| e.to_string())
+                    ));
+                    Ok(None)
+                }
+                Some(_) => Ok(Some(record.results)),
+                None => {
+                    unrecorded_evaluations += 1;
+                    Ok(Some(record.results))
+                }
             }
         };
+        let (replan, plan_once, policy) = (
+            evaluation(EvaluationKind::Replan)?,
+            evaluation(EvaluationKind::PlanOnce)?,
+            evaluation(EvaluationKind::Policy)?,
+        );
         Ok(Self {
             dir: dir.to_path_buf(),
             copy_to,
             variant,
-            replan: evaluation(EvaluationKind::Replan)?,
-            plan_once: evaluation(EvaluationKind::PlanOnce)?,
-            policy: evaluation(EvaluationKind::Policy)?,
+            replan,
+            plan_once,
+            policy,
+            evaluation_notes,
+            unrecorded_evaluations,
             over_training: crate::overtraining::read(dir)?,
             processors: crate::provenance::Provenance::processors(dir)
                 .with_context(|| format!("reading the provenance of {}", dir.display()))?,

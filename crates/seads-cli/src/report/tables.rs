@@ -8,7 +8,7 @@ use seads_planner::DepthResult;
 
 use super::runs::{Group, RunData};
 use super::stats::{Summary, Test, median, summary, worse_than};
-use crate::plan::EvaluationKind as Mode;
+use seads_planner::EvaluationKind as Mode;
 
 /// One cell of Table 1.
 pub struct CoverageCell {

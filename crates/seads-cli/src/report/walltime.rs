@@ -170,6 +170,8 @@ mod tests {
             } else {
                 Vec::new()
             },
+            evaluation_notes: Vec::new(),
+            unrecorded_evaluations: 0,
         }
     }
 

@@ -83,9 +83,9 @@ impl Default for EvaluationPlan {
 
 impl EvaluationPlan {
     /// The limits of each search.
-    pub fn limits(&self) -> crate::plan::SearchLimits {
-        crate::plan::SearchLimits {
-            timeout: self.timeout,
+    pub fn limits(&self) -> seads_planner::SearchLimits {
+        seads_planner::SearchLimits {
+            timeout_s: self.timeout,
             max_expanded: self.max_expanded,
         }
     }

@@ -14,7 +14,8 @@ use seads_skillmodel::SkillModelKind;
 use super::index::Sweep;
 use super::state::{Claim, Outcome, Record};
 use crate::overtraining::{Selection, evaluate_checkpoints};
-use crate::plan::{Tasks, load_agent, run_evaluation, task_seeds};
+use crate::plan::{load_agent, run_evaluation, run_policy_evaluation};
+use seads_planner::{EvaluationKind, Protocol, TaskSet};
 
 /// libtorch threads for a task with `cores` cores: two training threads of `cores / 2` each,
 /// and all cores for SAC when the other thread waits (0 = keep: a task alone on one core).
@@ -98,8 +99,7 @@ fn train_and_evaluate(sweep: &Sweep, run: &Path, cores: usize) -> Result<()> {
         let added = evaluate_checkpoints(
             run,
             Selection::Every(plan.every),
-            &[1, 2, 3, 4, 5],
-            plan.boards,
+            &TaskSet::standard(plan.boards),
             plan.limits(),
             true,
         )?;
@@ -111,14 +111,12 @@ fn train_and_evaluate(sweep: &Sweep, run: &Path, cores: usize) -> Result<()> {
     if plan.last {
         let mut agent = load_agent(run, None)?;
         for replan in [true, false] {
-            let tasks = Tasks {
-                depths: (1..=5).collect(),
-                seeds: task_seeds(plan.boards, None),
-                split: seads_games::Split::Test,
-                replan,
-                limits: plan.limits(),
+            let protocol = Protocol {
+                kind: EvaluationKind::planning(replan),
+                tasks: TaskSet::standard(plan.boards),
+                limits: Some(plan.limits()),
             };
-            let results = run_evaluation(&mut agent, run, tasks, true)?;
+            let results = run_evaluation(&mut agent, run, &protocol, true)?.results;
             let solved: usize = results.iter().map(|r| r.solved).sum();
             let tasks: usize = results.iter().map(|r| r.tasks).sum();
             println!(
@@ -162,17 +160,13 @@ fn train_and_evaluate_baseline<L: Shown>(sweep: &Sweep, run: &Path, cores: usize
         // The final checkpoint holds the trained policy.
         let checkpoint = seads_rl::latest_checkpoint(run)?
             .with_context(|| format!("{} has no checkpoint", run.display()))?;
-        let mut policy = seads_rl::load_policy(&config, &checkpoint)?;
-        let results = seads_rl::task_success(
+        let results = run_policy_evaluation(
             &config,
-            policy.as_mut(),
-            &[1, 2, 3, 4, 5],
-            sweep.evaluation.boards,
-        )?;
-        seads_rl::write_atomic(
-            &run.join(crate::plan::EvaluationKind::Policy.results_file()),
-            serde_json::to_string_pretty(&results)?.as_bytes(),
-        )?;
+            run,
+            &checkpoint,
+            TaskSet::standard(sweep.evaluation.boards),
+        )?
+        .results;
         let solved: usize = results.iter().map(|r| r.solved).sum();
         let tasks: usize = results.iter().map(|r| r.tasks).sum();
         println!("{}: policy {solved}/{tasks} solved", run.display());

@@ -1,0 +1,357 @@
+//! What an evaluation is, in one place: its tasks (the boards and environment seeds of each
+//! solution depth), its search limits, which checkpoint it evaluated, and the names of the files
+//! it leaves in a run directory. Planning, policy, robot and over-training evaluations all take
+//! their tasks from [`TaskSet::seeds`], so two evaluations of one run with the same task set
+//! play the same boards.
+//!
+//! ```
+//! use seads_games::Split;
+//! use seads_planner::{EVALUATION_SEEDS, EvaluationKind, TaskSet};
+//!
+//! // The paper's protocol: 20 test boards per depth 1–5, the authors' 20 seeds.
+//! let tasks = TaskSet::standard(20);
+//! assert_eq!(tasks.seeds(), EVALUATION_SEEDS.to_vec());
+//! // More boards keep the authors' 20 first.
+//! assert_eq!(TaskSet::standard(30).seeds()[..20], EVALUATION_SEEDS[..]);
+//! // The files of an evaluation of the last checkpoint with re-planning:
+//! let kind = EvaluationKind::Replan;
+//! assert_eq!(kind.results_file(&tasks.depths, None), "evaluation-replan.json");
+//! assert_eq!(kind.tasks_file(&[6, 7, 8], Some(500)), "evaluation-replan-depths-6-8-epoch-000500-tasks.jsonl");
+//! assert_eq!(tasks.split, Split::Test);
+//! ```
+
+use rand::{RngExt, SeedableRng};
+use rand_chacha::ChaCha8Rng;
+use seads_embodiment::{BoardState, EnvConfig, EnvError};
+use seads_games::{GameKind, Split, SymbolicState};
+use serde::{Deserialize, Serialize};
+
+use crate::{DepthResult, EVALUATION_SEEDS};
+
+/// The seed of the stream that task seeds beyond the authors' 20 are drawn from.
+pub const TASK_STREAM_SEED: u64 = 4343;
+
+/// The paper's solution depths.
+pub const STANDARD_DEPTHS: [usize; 5] = [1, 2, 3, 4, 5];
+
+/// The tasks of an evaluation: `boards` boards of each solution depth from `split`.
+#[derive(Debug, Clone, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct TaskSet {
+    /// Solution depths of the boards.
+    pub depths: Vec<usize>,
+    /// Boards (environment seeds) per depth.
+    pub boards: usize,
+    /// The board split.
+    pub split: Split,
+    /// `None`: the authors' 20 seeds first, then draws from [`TASK_STREAM_SEED`]'s stream.
+    /// `Some(s)`: every seed drawn from `s`'s stream.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub seed: Option<u64>,
+}
+
+impl TaskSet {
+    /// The paper's protocol with `boards` boards per depth: depths 1–5, test boards, the
+    /// authors' seeds first.
+    pub fn standard(boards: usize) -> Self {
+        Self {
+            depths: STANDARD_DEPTHS.to_vec(),
+            boards,
+            split: Split::Test,
+            seed: None,
+        }
+    }
+
+    /// The environment seeds of the tasks, the same for every depth: one board per seed and
+    /// depth.
+    pub fn seeds(&self) -> Vec<u64> {
+        let authors = match self.seed {
+            None => &EVALUATION_SEEDS[..self.boards.min(EVALUATION_SEEDS.len())],
+            Some(_) => &[],
+        };
+        let mut rng = ChaCha8Rng::seed_from_u64(self.seed.unwrap_or(TASK_STREAM_SEED));
+        let drawn = (authors.len()..self.boards).map(|_| rng.random_range(0..100_000_000));
+        authors.iter().copied().chain(drawn).collect()
+    }
+
+    /// The board of the task of `depth` and `seed` on a `game` of `size`: the board that an
+    /// environment seeded with `seed` draws at reset (for manipulators whose boards are set,
+    /// such as the robot's twin).
+    pub fn board(
+        &self,
+        game: GameKind,
+        size: usize,
+        depth: usize,
+        seed: u64,
+    ) -> Result<SymbolicState, EnvError> {
+        let config = EnvConfig {
+            reset_split: self.split,
+            max_solution_depth: depth,
+            random_solution_depth: false,
+            ..EnvConfig::default()
+        };
+        let mut board = BoardState::new(game, size, &config)?;
+        board.seed(seed);
+        board.reset();
+        Ok(board.board())
+    }
+
+    /// The number of tasks.
+    pub fn len(&self) -> usize {
+        self.depths.len() * self.boards
+    }
+
+    /// No task at all.
+    pub fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
+}
+
+/// The limits of each search of an evaluation.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SearchLimits {
+    /// Seconds per search.
+    pub timeout_s: f64,
+    /// States expanded per search (`None`: no bound).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub max_expanded: Option<usize>,
+}
+
+/// How an evaluation acts, as its files name it.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum EvaluationKind {
+    /// Plan, and plan again after every skill that deviated from the forward model.
+    Replan,
+    /// Plan once and execute the whole plan.
+    PlanOnce,
+    /// A baseline's policy acting alone, no planning.
+    Policy,
+}
+
+impl EvaluationKind {
+    /// The planning evaluation, with or without re-planning.
+    pub fn planning(replan: bool) -> Self {
+        if replan { Self::Replan } else { Self::PlanOnce }
+    }
+
+    /// The kind's name in file names.
+    pub fn name(self) -> &'static str {
+        match self {
+            Self::Replan => "replan",
+            Self::PlanOnce => "plan-once",
+            Self::Policy => "policy",
+        }
+    }
+
+    /// The stem of an evaluation's files: `evaluation-replan` for the standard depths 1–5 of
+    /// the last checkpoint, which plots and reports read; `-depths-6-12` for another range,
+    /// `-depths-1_3_5` for a list with gaps (a list never takes the name of its range), and
+    /// `-epoch-000500` for a chosen checkpoint (`epoch`).
+    pub fn stem(self, depths: &[usize], epoch: Option<u64>) -> String {
+        let contiguous = depths.windows(2).all(|w| w[1] == w[0] + 1);
+        let mut stem = format!("evaluation-{}", self.name());
+        match (depths.first(), depths.last()) {
+            _ if depths == STANDARD_DEPTHS => {}
+            (Some(a), Some(b)) if contiguous => stem += &format!("-depths-{a}-{b}"),
+            _ => {
+                let list: Vec<String> = depths.iter().map(usize::to_string).collect();
+                stem += &format!("-depths-{}", list.join("_"));
+            }
+        }
+        if let Some(epoch) = epoch {
+            stem += &format!("-epoch-{epoch:06}");
+        }
+        stem
+    }
+
+    /// The per-depth results ([`EvaluationRecord`], JSON).
+    pub fn results_file(self, depths: &[usize], epoch: Option<u64>) -> String {
+        format!("{}.json", self.stem(depths, epoch))
+    }
+
+    /// Every task, one JSON line each.
+    pub fn tasks_file(self, depths: &[usize], epoch: Option<u64>) -> String {
+        format!("{}-tasks.jsonl", self.stem(depths, epoch))
+    }
+}
+
+/// Everything that decides an evaluation's outcome besides the agent.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Protocol {
+    /// How the agent acts.
+    pub kind: EvaluationKind,
+    /// Which boards.
+    pub tasks: TaskSet,
+    /// The search limits (`None` for a policy acting alone).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub limits: Option<SearchLimits>,
+}
+
+/// The checkpoint an evaluation evaluated.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct CheckpointId {
+    /// Its epoch.
+    pub epoch: u64,
+    /// Environment steps of training when it was written (`None` where the run does not say).
+    pub env_steps: Option<u64>,
+}
+
+/// An evaluation file: what was evaluated, how, and the results per depth.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct EvaluationRecord {
+    /// The checkpoint (`None` in files written before evaluations recorded it).
+    pub checkpoint: Option<CheckpointId>,
+    /// The protocol (`None` in files written before evaluations recorded it).
+    pub protocol: Option<Protocol>,
+    /// Per depth.
+    pub results: Vec<DepthResult>,
+}
+
+/// The two shapes of an evaluation file: today's record, and the bare list of per-depth
+/// results that files had before they recorded their checkpoint and protocol.
+#[derive(Deserialize)]
+#[serde(untagged)]
+enum Stored {
+    Record(EvaluationRecord),
+    Bare(Vec<DepthResult>),
+}
+
+impl EvaluationRecord {
+    /// Parses an evaluation file of either shape.
+    pub fn from_json(text: &str) -> Result<Self, serde_json::Error> {
+        Ok(match serde_json::from_str(text)? {
+            Stored::Record(record) => record,
+            Stored::Bare(results) => Self {
+                checkpoint: None,
+                protocol: None,
+                results,
+            },
+        })
+    }
+
+    /// The file's text (pretty JSON).
+    pub fn to_json(&self) -> String {
+        serde_json::to_string_pretty(self).expect("an evaluation record serialises")
+    }
+
+    /// The record says it was made with `protocol` (older files say nothing, so never).
+    pub fn made_with(&self, protocol: &Protocol) -> bool {
+        self.protocol.as_ref() == Some(protocol)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn twenty_boards_or_fewer_are_the_authors_seeds_and_more_extend_them() {
+        assert_eq!(TaskSet::standard(5).seeds(), EVALUATION_SEEDS[..5].to_vec());
+        assert_eq!(TaskSet::standard(20).seeds(), EVALUATION_SEEDS.to_vec());
+        let thirty = TaskSet::standard(30).seeds();
+        assert_eq!(thirty.len(), 30);
+        assert_eq!(thirty[..20], EVALUATION_SEEDS[..]);
+        // The extension is a prefix of the stream: 40 boards extend 30.
+        assert_eq!(TaskSet::standard(40).seeds()[..30], thirty[..]);
+        let mut distinct = thirty.clone();
+        distinct.sort_unstable();
+        distinct.dedup();
+        assert_eq!(distinct.len(), 30);
+        // An explicit seed draws every seed from its stream.
+        let own = TaskSet {
+            seed: Some(7),
+            ..TaskSet::standard(3)
+        };
+        assert_eq!(own.seeds().len(), 3);
+        assert_ne!(own.seeds()[0], EVALUATION_SEEDS[0]);
+        assert_eq!(own.seeds(), own.seeds());
+    }
+
+    #[test]
+    fn a_task_board_is_the_board_an_environment_seeded_alike_draws() {
+        let tasks = TaskSet::standard(3);
+        for env_name in ["lightsout-cursor", "tileswap-reacher"] {
+            for &depth in &[1, 4] {
+                let config = EnvConfig {
+                    reset_split: Split::Test,
+                    max_solution_depth: depth,
+                    random_solution_depth: false,
+                    ..EnvConfig::default()
+                };
+                let mut env = seads_embodiment::make_env(env_name, &config).unwrap();
+                let (game, size) = (env.spec().game, env.spec().board_size);
+                for seed in tasks.seeds() {
+                    env.seed(seed);
+                    env.reset().unwrap();
+                    assert_eq!(tasks.board(game, size, depth, seed).unwrap(), env.board());
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn files_name_their_depths_and_a_chosen_checkpoint() {
+        let replan = EvaluationKind::Replan;
+        assert_eq!(replan.stem(&STANDARD_DEPTHS, None), "evaluation-replan");
+        assert_eq!(
+            EvaluationKind::PlanOnce.stem(&[6, 7, 8, 9, 10, 11, 12], None),
+            "evaluation-plan-once-depths-6-12"
+        );
+        assert_eq!(
+            EvaluationKind::Policy.stem(&[1, 2, 3], None),
+            "evaluation-policy-depths-1-3"
+        );
+        assert_eq!(
+            replan.stem(&[1, 3, 5], None),
+            "evaluation-replan-depths-1_3_5",
+            "a list with gaps must not overwrite the files of its range"
+        );
+        assert_eq!(replan.stem(&[7], None), "evaluation-replan-depths-7-7");
+        assert_eq!(
+            replan.results_file(&STANDARD_DEPTHS, Some(10)),
+            "evaluation-replan-epoch-000010.json",
+            "an earlier checkpoint must not take the file of the last"
+        );
+        assert_eq!(
+            replan.tasks_file(&STANDARD_DEPTHS, None),
+            "evaluation-replan-tasks.jsonl"
+        );
+    }
+
+    #[test]
+    fn a_record_round_trips_and_old_bare_lists_still_read() {
+        let record = EvaluationRecord {
+            checkpoint: Some(CheckpointId {
+                epoch: 100,
+                env_steps: Some(4_496),
+            }),
+            protocol: Some(Protocol {
+                kind: EvaluationKind::Replan,
+                tasks: TaskSet::standard(20),
+                limits: Some(SearchLimits {
+                    timeout_s: 10.0,
+                    max_expanded: None,
+                }),
+            }),
+            results: vec![DepthResult::new(1)],
+        };
+        let back = EvaluationRecord::from_json(&record.to_json()).unwrap();
+        assert_eq!(back.checkpoint, record.checkpoint);
+        assert!(back.made_with(record.protocol.as_ref().unwrap()));
+        let other = Protocol {
+            tasks: TaskSet::standard(10),
+            ..record.protocol.clone().unwrap()
+        };
+        assert!(!back.made_with(&other));
+        let old = serde_json::to_string(&vec![DepthResult::new(2)]).unwrap();
+        let old = EvaluationRecord::from_json(&old).unwrap();
+        assert_eq!((old.checkpoint, old.protocol), (None, None));
+        assert_eq!(old.results[0].depth, 2);
+        assert!(EvaluationRecord::from_json("{\"results\": 3}").is_err());
+    }
+}
