@@ -3,6 +3,7 @@
 
 mod ci;
 mod gen_splits;
+mod golden;
 
 use std::path::{Path, PathBuf};
 use std::process::{Command, ExitCode};
@@ -18,6 +19,8 @@ Commands:
   setup        install libtorch for tch into .venv / .libtorch (idempotent; scripts/setup.sh)
   package      cargo package every library crate in dependency order, building each package (slow)
   gen-splits   write data/depth_counts.csv and data/split_counts.csv from a fresh enumeration
+  golden       train the golden run (data/golden/) and say whether this processor repeats it
+               (`--record` makes this processor's run the golden); not part of ci
 ";
 
 fn main() -> ExitCode {
@@ -30,6 +33,14 @@ fn main() -> ExitCode {
             setup().and_then(|()| step("cargo", &[&PACKAGE[..], &["--allow-dirty"]].concat()))
         }
         Some("gen-splits") => gen_splits::run(&root()),
+        Some("golden") => match args.get(1).map(String::as_str) {
+            None => golden::run(&root(), false),
+            Some("--record") => golden::run(&root(), true),
+            Some(other) => {
+                eprint!("unknown option {other:?} of golden\n\n{HELP}");
+                return ExitCode::from(2);
+            }
+        },
         Some("help" | "--help" | "-h") | None => {
             print!("{HELP}");
             Ok(())
