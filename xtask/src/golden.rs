@@ -4,8 +4,10 @@
 //! numerics, evaluated every 10 epochs, as one processor trained it (its `provenance.jsonl`
 //! names it). The command builds the release binary, trains the same configuration, and compares
 //! every metrics line up to epoch 300 field by field, clock fields left out. It names the first
-//! line and field that differ, so that a processor that parts from the golden shows when. Not
-//! part of CI, whose processor varies.
+//! line and field that differ, so that a processor that parts from the golden shows when. It
+//! then compares the fingerprint of the floating-point primitives a run uses (the seads-rl
+//! example `numerics_fingerprint`) with the golden's, to show which. Not part of CI, whose
+//! processor varies.
 
 use std::path::Path;
 
@@ -46,13 +48,30 @@ pub fn run(root: &Path, record: bool) -> Result<()> {
         ],
     )?;
     let this = processor(&out)?;
+    let fingerprint = fingerprint(root)?;
     if record {
         for file in ["metrics.jsonl", "provenance.jsonl"] {
             std::fs::copy(out.join(file), golden.join(file))
                 .with_context(|| format!("copying {file} into {}", golden.display()))?;
         }
+        let path = golden.join("fingerprint.json");
+        std::fs::write(&path, serde_json::to_string_pretty(&fingerprint)? + "\n")
+            .with_context(|| format!("writing {}", path.display()))?;
         println!("golden: recorded on {this}");
         return Ok(());
+    }
+    let path = golden.join("fingerprint.json");
+    let text =
+        std::fs::read_to_string(&path).with_context(|| format!("reading {}", path.display()))?;
+    let theirs: Value = serde_json::from_str(&text)?;
+    let parted = parted_primitives(&fingerprint, &theirs);
+    if parted.is_empty() {
+        println!("golden: every primitive of the fingerprint equals the golden's");
+    } else {
+        println!(
+            "golden: primitives that differ from the golden's: {}",
+            parted.join(", ")
+        );
     }
     let ours = lines(&out.join("metrics.jsonl"))?;
     let theirs = lines(&golden.join("metrics.jsonl"))?;
@@ -69,6 +88,49 @@ pub fn run(root: &Path, record: bool) -> Result<()> {
             "golden: this processor ({this}) parts from the golden ({golden_processor}): {difference}"
         ),
     }
+}
+
+/// The fingerprint of this machine's floating-point primitives (a JSON object: name → CRC).
+fn fingerprint(root: &Path) -> Result<Value> {
+    let args = [
+        "run",
+        "--release",
+        "--quiet",
+        "-p",
+        "seads-rl",
+        "--example",
+        "numerics_fingerprint",
+    ];
+    eprintln!("xtask: $ cargo {}", args.join(" "));
+    let output = std::process::Command::new("cargo")
+        .args(args)
+        .current_dir(root)
+        .output()
+        .context("could not start cargo")?;
+    if !output.status.success() {
+        bail!(
+            "the fingerprint failed: {}",
+            String::from_utf8_lossy(&output.stderr)
+        );
+    }
+    Ok(serde_json::from_slice(&output.stdout).context("the fingerprint's JSON")?)
+}
+
+/// The primitives whose fingerprints differ (or that only one side has).
+fn parted_primitives(ours: &Value, theirs: &Value) -> Vec<String> {
+    let empty = serde_json::Map::new();
+    let (a, b) = (
+        ours.as_object().unwrap_or(&empty),
+        theirs.as_object().unwrap_or(&empty),
+    );
+    let mut names: Vec<&String> = a.keys().chain(b.keys()).collect();
+    names.sort();
+    names.dedup();
+    names
+        .into_iter()
+        .filter(|n| a.get(n.as_str()) != b.get(n.as_str()))
+        .cloned()
+        .collect()
 }
 
 /// The metrics lines of a run up to [`EPOCHS`], without their clock fields.
