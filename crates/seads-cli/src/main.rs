@@ -189,7 +189,7 @@ const SPIN: &str = "GOMP_SPINCOUNT";
 /// waits for needs. A 10⁴-step LightsOutCursor run with two SAC threads beside two or three busy
 /// single-threaded processes did not reach step 4473 in 150 s with the default, and finished in
 /// 33–50 s at 1000 (3000: 58 s, 10000: 60–84 s); alone on the machine it takes 5 % longer at
-/// 1000 (15.4 → 16.2 s, docs/RESULTS.md). The same numbers either way: only waiting changes. A
+/// 1000 (15.4 → 16.2 s, docs/results/log-2026-11.md). The same numbers either way: only waiting changes. A
 /// user's own `GOMP_SPINCOUNT` or `OMP_WAIT_POLICY` is kept. If the program cannot be run again,
 /// it goes on as it is.
 fn spin_briefly_in_libgomp() {

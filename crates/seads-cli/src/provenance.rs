@@ -4,7 +4,8 @@
 //!
 //! Runs with `portable_numerics = false` (the presets) repeat exactly only on the same kind of
 //! processor, and even portable runs were seen to differ between an AMD EPYC and an Intel Xeon
-//! (docs/RESULTS.md, "Determinism"), so a committed result names its processor and commit here.
+//! (docs/RESULTS.md, "Determinism across processors"), so a committed result names its
+//! processor and commit here.
 
 use std::path::Path;
 

@@ -11,8 +11,9 @@
 //! pinned to AVX2 in both cases (AVX2 and AVX-512 gave identical runs; pinning costs nothing).
 //!
 //! The aim is not met everywhere yet: the portable demo gave one run on an AMD EPYC and another
-//! on an Intel Xeon (docs/RESULTS.md, "Determinism"), so runs record their processor (the CLI's
-//! `provenance.jsonl`).
+//! on an Intel Xeon (docs/RESULTS.md, "Determinism across processors"), so runs record their
+//! processor (the CLI's `provenance.jsonl`), and `cargo xtask golden` compares a processor with
+//! the committed golden run.
 //!
 //! Both are environment variables that libtorch reads once, when it first computes: the binary
 //! sets them before that, and `.cargo/config.toml` sets the portable ones for everything cargo
