@@ -297,3 +297,91 @@ fn every_environment_has_a_preset() {
         );
     }
 }
+
+/// Paths that are outside the repository or made by set-up and runs, not committed.
+fn generated(path: &str) -> bool {
+    [
+        "../",
+        "/tmp",
+        ".libtorch",
+        ".venv",
+        "target/",
+        "runs/",
+        "sweeps/",
+        "RUN/",
+        "DIR/",
+    ]
+    .iter()
+    .any(|p| path.starts_with(p))
+}
+
+/// Every file path and test name that the two reference documents cite in backticks exists: a
+/// path (with a `/`, or a file name with an extension) somewhere in the repository, a test name
+/// (four or more words joined by `_`) as a `fn` in some Rust file.
+#[test]
+fn the_documents_cite_only_files_and_tests_that_exist() {
+    let mut files: Vec<String> = Vec::new();
+    let mut dirs = vec![root()];
+    while let Some(dir) = dirs.pop() {
+        for entry in std::fs::read_dir(&dir).unwrap() {
+            let path = entry.unwrap().path();
+            let name = path.file_name().unwrap().to_string_lossy().into_owned();
+            if name.starts_with('.') && name != ".ci" && name != ".cargo" || name == "target" {
+                continue;
+            }
+            let relative = path
+                .strip_prefix(root())
+                .unwrap()
+                .to_string_lossy()
+                .into_owned();
+            if path.is_dir() {
+                files.push(format!("{relative}/"));
+                dirs.push(path);
+            } else {
+                files.push(relative);
+            }
+        }
+    }
+    let rust: String = files
+        .iter()
+        .filter(|f| f.ends_with(".rs"))
+        .map(|f| std::fs::read_to_string(root().join(f)).unwrap())
+        .collect();
+    let extensions = [
+        ".rs", ".toml", ".md", ".py", ".json", ".jsonl", ".csv", ".sh", ".gz",
+    ];
+    let mut missing = Vec::new();
+    for doc in ["docs/ARCHITECTURE.md", "docs/RESULTS.md"] {
+        let text = read(doc);
+        for cited in text.split('`').skip(1).step_by(2) {
+            let cited = cited.trim();
+            if cited.contains(' ') || cited.contains('*') || cited.contains('<') {
+                continue;
+            }
+            let is_test = cited.split('_').count() >= 4
+                && cited
+                    .chars()
+                    .all(|c| c.is_ascii_lowercase() || c.is_ascii_digit() || c == '_');
+            let is_path = (cited.contains('/') && !cited.contains("://"))
+                || extensions.iter().any(|e| cited.ends_with(e));
+            if is_test {
+                if !rust.contains(&format!("fn {cited}(")) {
+                    missing.push(format!("{doc}: test {cited}"));
+                }
+            } else if is_path && !generated(cited) {
+                // A path relative to the root, or the end of one (`src/x.rs`, `report/`).
+                let found = files
+                    .iter()
+                    .any(|f| f == cited || f.ends_with(&format!("/{cited}")));
+                if !found {
+                    missing.push(format!("{doc}: path {cited}"));
+                }
+            }
+        }
+    }
+    assert!(
+        missing.is_empty(),
+        "cited but missing:\n{}",
+        missing.join("\n")
+    );
+}

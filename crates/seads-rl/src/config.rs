@@ -84,7 +84,7 @@ impl Default for BaselineConfig {
 
 /// Settings of the HAC baseline (SPEC §5.2) beyond those it shares with SAC: the low level is the
 /// `[sac]` section (its α is α_low), the high level has the same networks and optimiser with
-/// its own α. Choices where the seed is silent follow Levy's HAC (docs/ARCHITECTURE.md).
+/// its own α. Choices where the seed is silent follow Levy's HAC (`src/hac.rs`).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields, default)]
 pub struct HacConfig {

@@ -10,7 +10,7 @@
 //! - The **low level** is a Gaussian SAC on the observation and the subgoal. It pursues a subgoal
 //!   for at most H steps and is rewarded 1 (and its return ends) on the step whose board is z.
 //!
-//! What the seed leaves open follows Levy's HAC (docs/ARCHITECTURE.md gives the reasons):
+//! What the seed leaves open (SPEC §9.7) follows Levy's HAC; the reasons are below:
 //! - *hindsight action transitions*: the high level stores each subgoal attempt with the board
 //!   actually reached as its action, so every attempt teaches it a reachable subgoal;
 //! - *hindsight goal transitions*: the low level also stores every attempt that missed its
@@ -22,6 +22,39 @@
 //!   subgoal that is missed gives the high level a terminal transition of reward −1 for it: worse
 //!   than any return of the task (0 to 1), as Levy's penalty −H is at least as bad as any return
 //!   of his −1-per-step rewards;
+//!
+//! # Choices where the seed is silent, and why
+//!
+//! - Subgoal horizon H = the environment's steps per skill T_max (10 Cursor, 50 Reacher/Jaco): a
+//!   subgoal is one board change away at best, and T_max is what a skill gets for one move. The
+//!   low level's attempt ends when the board equals the subgoal (checked after every step, so a
+//!   subgoal equal to the current board is reached by one step that changes nothing), after H
+//!   steps, or when the episode ends.
+//! - Low-level reward: 1 on the step whose board is the subgoal, which also ends its return (the
+//!   0/1 form of Levy's −1/0; it matches the task reward's scale). Running out of H steps does
+//!   not end the return.
+//! - Hindsight goal transitions of the low level use the "final" strategy: the board an attempt
+//!   ended on is always reached at least at the last step, so every attempt yields a reward.
+//! - Subgoal testing with probability λ = 0.3 (Levy's value). With the 0/1 task reward every
+//!   return lies in [0, 1], so −1 is the penalty on that scale (Levy's −H is at least as bad as
+//!   any return of his −1 per step).
+//! - The high level is conditioned on a goal board. Without its hindsight goal transitions
+//!   (tried first, with an unconditioned top level) its only signal before its first solved
+//!   board is the testing penalty, whose values differ from the others' by 1 − γ: 30 k steps of
+//!   LightsOutCursor reached none of their subgoals (0.0 %); with them 0.1 % of the attempts of
+//!   the first 30 k steps reached theirs, and the share was rising.
+//! - Schedule and buffers as the SAC baseline's: 8 environments stepped once per epoch, N
+//!   gradient steps per epoch for each level once its replay holds a batch (Levy also updates
+//!   both levels equally often), replay buffers of 10⁶ transitions each, batch 256 (Levy: 1024;
+//!   SAC's 256 keeps the two baselines comparable). N is not in the seed for HAC: the presets
+//!   use the SAC baseline's best N per environment.
+//! - Both levels reuse [`Sac`]: the high level is [`Sac::relaxed_bernoulli`], the same critics
+//!   and updates with a factorised RelaxedBernoulli actor (logits clamped to [−5, 5],
+//!   log-probability summed over the D entries, deterministic action = logit > 0, as the
+//!   reference's `RelaxedBernoulliPolicy`). `[sac]` configures the low level (α = α_low); the
+//!   high level copies it with α = `hac.alpha_high`.
+//! - Exact resume: as the SAC baseline's, plus each environment's subgoal (bits, tested, start
+//!   step, reward so far) and the start and end steps of the open episode's ended attempts.
 //!
 //! An epoch steps each of the 8 environments once (as the SAC baseline does) and then takes N
 //! gradient steps of each level whose replay holds a batch. Resuming is exact, as for the SAC

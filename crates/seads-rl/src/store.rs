@@ -1,13 +1,22 @@
 //! The files of a run directory and how they are written, so that a crash at any point leaves a
 //! directory that resumes to exactly the run it would have been.
 //!
-//! The contract (docs/ARCHITECTURE.md, "Crash consistency"):
+//! The contract (docs/ARCHITECTURE.md, "Invariants"):
 //! - every file is written to a temporary name, fsynced, renamed into place and its folder
 //!   fsynced ([`write_atomic`]); a checkpoint is a folder written the same way ([`commit_dir`]);
 //! - `metrics.jsonl` only grows by whole lines, each fsynced before the checkpoint that follows
 //!   it; a line cut by a crash has no newline and is dropped when read ([`read_metrics`]);
 //! - the two newest checkpoints keep what resuming needs, so one that cannot be read has a
 //!   complete predecessor to fall back to.
+//!
+//! Resuming (`Run::resume`) loads `latest`, or, if it cannot be loaded, the newest checkpoint
+//! that can; drops evaluation lines after that checkpoint and a torn last line; says what it
+//! repaired on stderr; and continues exactly: environments, RNG streams, buffers, optimiser
+//! moments (required, never silently reset) and prepared updates are all restored. It is an
+//! error when checkpoints were written and none can be loaded; a run killed before its first
+//! checkpoint starts again. A run with metrics but no `checkpoints/` folder (a `seads report
+//! --copy-runs` copy) is refused, not trained again over its metrics. Every checkpoint names the
+//! environment and algorithm that wrote it (`origin.json`), and loading refuses another's.
 
 use std::fs;
 use std::io::Write as _;

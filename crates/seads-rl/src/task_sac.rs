@@ -7,6 +7,16 @@
 //! epochs. An episode ends when the board is solved or after T_lim steps; both end the return
 //! (the observation carries the time left, so the limit is part of the state).
 //!
+//! Choices where the seed is silent (SPEC §9.7), and why:
+//! - "8 new samples per epoch" are one step of each of 8 environments: the sample count per
+//!   update is the seed's either way, and parallel episodes give less correlated samples.
+//! - N < 1 updates per epoch: ⌊(e+1)·N⌋ − ⌊e·N⌋ steps after epoch e (N = 0.5: one every other
+//!   epoch); updates start once the replay buffer holds a batch.
+//! - Evaluation: the deterministic policy (tanh of the mean) on the protocol's tasks, each
+//!   episode until solved or T_lim; results in the planner's `DepthResult` form, so that reports
+//!   treat SEADS and the baselines alike. [`Sac`] is reused as it is (3 × 512 layers and batch
+//!   256 are config values).
+//!
 //! Resuming is exact: a checkpoint holds the networks, the optimisers, the replay buffer, the
 //! random streams, and for each environment the seed and actions of its open episode, which
 //! resuming replays (the simulations are deterministic given a seed).
