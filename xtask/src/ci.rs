@@ -53,20 +53,8 @@ struct Totals {
 /// Runs `cargo <args>`, echoing its output and adding up its `test result:` lines.
 fn test(args: &[&str], totals: &mut Totals) -> Result<()> {
     eprintln!("xtask: $ cargo {}", args.join(" "));
-    // Doc-tests run from temporary folders, where the binaries' rpath cannot reach libtorch.
-    let libtorch = root().join(".libtorch/lib");
-    let library_path = match std::env::var_os("LD_LIBRARY_PATH") {
-        Some(old) if !old.is_empty() => {
-            let mut path = libtorch.into_os_string();
-            path.push(":");
-            path.push(old);
-            path
-        }
-        _ => libtorch.into_os_string(),
-    };
     let mut child = Command::new("cargo")
         .args(args)
-        .env("LD_LIBRARY_PATH", library_path)
         .current_dir(root())
         .stdout(Stdio::piped())
         .spawn()
