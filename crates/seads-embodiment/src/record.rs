@@ -98,6 +98,22 @@ pub enum ReplayError {
 
 /// Puts `env` into `record.initial_obs` and applies the recorded actions in order (no step
 /// limit, no reset after moves); returns the episode with observations and moves recomputed.
+///
+/// ```
+/// use seads_embodiment::{EnvConfig, make_env, record_episode, replay_episode};
+/// let mut env = make_env("lightsout-reacher", &EnvConfig::default())?;
+/// env.seed(2);
+/// let mut t = 0.0f32;
+/// let recorded = record_episode(env.as_mut(), 30, |_, action| {
+///     t += 0.1;
+///     action.fill(t.sin());
+/// })?;
+/// // Another environment replays it step for step, bit for bit.
+/// let mut other = make_env("lightsout-reacher", &EnvConfig::default())?;
+/// let replayed = replay_episode(other.as_mut(), &recorded).unwrap();
+/// assert_eq!(replayed, recorded);
+/// # Ok::<(), seads_embodiment::EnvError>(())
+/// ```
 pub fn replay_episode(
     env: &mut dyn Environment,
     record: &EpisodeRecord,

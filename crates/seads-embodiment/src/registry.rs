@@ -78,6 +78,21 @@ pub fn env_names() -> Vec<&'static str> {
 }
 
 /// Builds the environment `name` with `config` (validated).
+///
+/// ```
+/// use seads_embodiment::{EnvConfig, make_env};
+/// let mut env = make_env("lightsout-cursor", &EnvConfig::default())?;
+/// env.seed(3);
+/// env.reset()?;
+/// // Observations are [manipulator, board bits, time left]; actions are checked first.
+/// let spec = env.spec().clone();
+/// assert_eq!(spec.obs_dim, spec.manipulator_dim + spec.symbolic_len + 1);
+/// assert!(env.step(&[f32::NAN, 0.0, 0.0]).is_err());
+/// let step = env.step(&vec![0.0; spec.action_dim])?;
+/// assert!(!step.truncated, "one step of ten");
+/// assert!(make_env("chess-robot", &EnvConfig::default()).is_err());
+/// # Ok::<(), seads_embodiment::EnvError>(())
+/// ```
 pub fn make_env(name: &str, config: &EnvConfig) -> Result<Box<dyn Environment>, EnvError> {
     let entry = REGISTRY
         .iter()

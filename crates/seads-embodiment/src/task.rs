@@ -39,6 +39,17 @@ pub struct TaskEnv {
 
 impl TaskEnv {
     /// Task mode of `env`, whose boards come from its own reset distribution (split, depths).
+    ///
+    /// ```
+    /// use seads_embodiment::{EnvConfig, TaskEnv, make_env};
+    /// let config = EnvConfig { max_solution_depth: 2, random_solution_depth: false, ..EnvConfig::default() };
+    /// let mut task = TaskEnv::new(make_env("lightsout-cursor", &config)?, 2)?;
+    /// task.seed(5);
+    /// // A reset says the board's solution depth; the episode may take T_max per move.
+    /// assert_eq!(task.reset()?, 2);
+    /// assert_eq!(task.limit(), 2 * 10);
+    /// # Ok::<(), seads_embodiment::EnvError>(())
+    /// ```
     pub fn new(env: Box<dyn Environment>, max_depth: usize) -> Result<Self, EnvError> {
         let spec = env.spec();
         let steps_per_depth = spec.step_limit.ok_or_else(|| {

@@ -42,6 +42,19 @@ impl BoardDataset {
     }
 
     /// A board drawn uniformly among those of depth `depth` in `split`; `None` if there is none.
+    ///
+    /// ```
+    /// use rand::SeedableRng;
+    /// use seads_games::{BoardDataset, BoardGame, Gf2Solver, LightsOut, Split, split_of};
+    /// let game = LightsOut::new(5)?;
+    /// let data = BoardDataset::build(&game, 3)?;
+    /// let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(1);
+    /// let board = data.sample(3, Split::Test, &mut rng).unwrap();
+    /// assert_eq!(Gf2Solver::new(&game).depth(board)?, 3);
+    /// assert_eq!(split_of(&game.values(board)), Split::Test);
+    /// assert!(data.sample(4, Split::Test, &mut rng).is_none(), "built up to depth 3");
+    /// # Ok::<(), seads_games::GameError>(())
+    /// ```
     pub fn sample<R: Rng + ?Sized>(
         &self,
         depth: usize,

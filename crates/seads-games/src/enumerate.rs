@@ -154,6 +154,15 @@ impl Enumeration {
 ///
 /// Moves are their own inverses, so the layer in which a board first appears is its solution
 /// depth. Errors if the game's state space is too large to index.
+///
+/// ```
+/// use seads_games::{LightsOut, enumerate};
+/// // 3×3 LightsOut's presses are independent: each set of k presses is its own board, at
+/// // depth k, so the layers are the binomial coefficients C(9, k).
+/// let all = enumerate(&LightsOut::new(3)?, None)?;
+/// assert_eq!(all.depth_counts(), [1, 9, 36, 84, 126, 126, 84, 36, 9, 1]);
+/// # Ok::<(), seads_games::GameError>(())
+/// ```
 pub fn enumerate<G: Enumerable + ?Sized>(
     game: &G,
     max_depth: Option<usize>,

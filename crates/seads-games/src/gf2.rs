@@ -94,6 +94,17 @@ impl Gf2Solver {
     }
 
     /// A shortest set of moves turning `board` off, as ascending move ids.
+    ///
+    /// ```
+    /// use seads_games::{BoardGame, Gf2Solver, LightsOut};
+    /// let game = LightsOut::new(5)?;
+    /// let board = game.apply_all(game.goal(), &[7, 3, 18]);
+    /// let solver = Gf2Solver::new(&game);
+    /// // Presses commute and undo themselves: the same three, in order.
+    /// assert_eq!(solver.solve(board)?, vec![3, 7, 18]);
+    /// assert_eq!(solver.depth(board)?, 3);
+    /// # Ok::<(), seads_games::GameError>(())
+    /// ```
     pub fn solve(&self, board: SymbolicState) -> Result<Vec<MoveId>, GameError> {
         Ok(self.optimal_moves(board)?.ones().collect())
     }

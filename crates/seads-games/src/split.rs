@@ -59,6 +59,14 @@ pub fn board_string(values: &[u8]) -> String {
 /// The split of a board given by its canonical values: train iff CRC-32 of the board string is
 /// divisible by 3. The spaced variant "1, 0, …" printed in the paper's supplement is typography
 /// only; the unspaced string reproduces its split table (SPEC §1.4).
+///
+/// ```
+/// use seads_games::{Split, split_of};
+/// // CRC-32 of "0,1,2,3,4,5,6,7,8" (the solved TileSwap board) is 0 mod 3 (Python's zlib.crc32).
+/// assert_eq!(split_of(&[0, 1, 2, 3, 4, 5, 6, 7, 8]), Split::Train);
+/// // The dark 5×5 LightsOut board's CRC-32 is 2510077351, 1 mod 3.
+/// assert_eq!(split_of(&[0; 25]), Split::Test);
+/// ```
 pub fn split_of(values: &[u8]) -> Split {
     if crc32fast::hash(board_string(values).as_bytes()).is_multiple_of(3) {
         Split::Train

@@ -169,6 +169,18 @@ fn median<T: Copy + Into<f64>>(values: &[T]) -> Option<f64> {
 }
 
 /// Summarises per-depth results.
+///
+/// ```
+/// use seads_planner::{DepthResult, summarise};
+/// let mut depth2 = DepthResult::new(2);
+/// (depth2.tasks, depth2.solved, depth2.plan_found) = (4, 3, 4);
+/// depth2.planning_s = vec![0.5, 0.5, 1.0, 2.0];
+/// depth2.solution_steps = vec![6, 8, 7];
+/// let summary = summarise(&[depth2]);
+/// assert_eq!(summary.success_rate[&2], 0.75);
+/// assert_eq!(summary.planning_s[&2], 1.0);
+/// assert_eq!(summary.solution_steps[&2], Some(7.0), "the median");
+/// ```
 pub fn summarise(results: &[DepthResult]) -> EvaluationSummary {
     let key = |r: &DepthResult| r.depth;
     let rate = |n: usize, r: &DepthResult| n as f64 / r.tasks.max(1) as f64;

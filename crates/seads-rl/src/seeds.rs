@@ -38,6 +38,18 @@ pub fn stream(seed: u64, purpose: Purpose) -> ChaCha8Rng {
 
 /// The `index`-th 64-bit value of the stream of `purpose`: a seed for something that is
 /// re-seeded often (an environment per epoch), found without drawing the values before it.
+///
+/// ```
+/// use rand::RngExt;
+/// use seads_rl::{Purpose, derived_seed, stream};
+/// // The same value as drawing the stream up to it.
+/// let mut labels = stream(7, Purpose::Labels);
+/// let drawn: Vec<u64> = (0..3).map(|_| labels.random()).collect();
+/// assert_eq!(derived_seed(7, Purpose::Labels, 2), drawn[2]);
+/// // Another purpose, or another run, has other numbers.
+/// assert_ne!(derived_seed(7, Purpose::TrainEnvs, 2), drawn[2]);
+/// assert_ne!(derived_seed(8, Purpose::Labels, 2), drawn[2]);
+/// ```
 pub fn derived_seed(seed: u64, purpose: Purpose, index: u64) -> u64 {
     let mut rng = stream(seed, purpose);
     // One u64 is two 32-bit words of the ChaCha block stream.

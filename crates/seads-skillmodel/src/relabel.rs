@@ -135,6 +135,13 @@ fn capacitated_assignment(cost: &[Vec<f64>], capacity: &[usize]) -> Vec<usize> {
 }
 
 /// New labels by independent maximisation: `argmax_k C_e[k]` (first maximum on ties).
+///
+/// ```
+/// use seads_skillmodel::relabel_max;
+/// // Two episodes of K = 3: the second ties skills 0 and 2 and takes the first.
+/// let clipped = [-2.0, -0.1, -3.0, /* episode 1: */ -0.5, -2.0, -0.5];
+/// assert_eq!(relabel_max(&clipped, 3), vec![1, 0]);
+/// ```
 pub fn relabel_max(clipped: &[f32], k: usize) -> Vec<usize> {
     clipped
         .chunks(k)

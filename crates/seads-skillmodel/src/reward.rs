@@ -47,6 +47,17 @@ pub fn skill_log_posterior(scores: &[f32]) -> Vec<f32> {
 }
 
 /// The clipped log-posterior C_k = max(log q(k | z_0, z_T), −2·log K) (relabelling's input).
+///
+/// ```
+/// use seads_skillmodel::clipped_log_posterior;
+/// // Two skills that explain the episode equally: log ½ each.
+/// let c = clipped_log_posterior(&[-3.0, -3.0]);
+/// assert!((c[0] - 0.5f32.ln()).abs() < 1e-6 && c[0] == c[1]);
+/// // A skill far less likely than the best is clipped at −2·log K (K = 4: −2.7726).
+/// let c = clipped_log_posterior(&[0.0, -20.0, -20.0, -20.0]);
+/// assert!(c[0] > -1e-6);
+/// assert!((c[1] - (-2.0 * 4f32.ln())).abs() < 1e-6 && c[1] == c[3]);
+/// ```
 pub fn clipped_log_posterior(scores: &[f32]) -> Vec<f32> {
     let floor = minimum_reward(scores.len());
     skill_log_posterior(scores)

@@ -38,6 +38,14 @@ impl ActionSpace {
     }
 
     /// The action space of the environment called `name`, if it is the uArm's.
+    ///
+    /// ```
+    /// use seads_uarm::ActionSpace;
+    /// let space = ActionSpace::of_env("uarm-lightsout-displacement");
+    /// assert_eq!(space, Some(ActionSpace::Displacement));
+    /// assert_eq!(space.unwrap().env_name(), "uarm-lightsout-displacement");
+    /// assert_eq!(ActionSpace::of_env("lightsout-cursor"), None);
+    /// ```
     pub fn of_env(name: &str) -> Option<Self> {
         [Self::Absolute, Self::Displacement]
             .into_iter()
