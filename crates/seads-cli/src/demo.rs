@@ -41,11 +41,13 @@ pub struct RunArgs {
 
 /// `seads run`.
 pub fn run(args: RunArgs) -> Result<()> {
-    let mut run = if args.out.join("config.toml").exists() {
+    let (mut run, _lock) = if args.out.join("config.toml").exists() {
         println!("resuming the run in {}", args.out.display());
+        let lock = crate::lock_run(&args.out)?;
         let config = seads_rl::load_config(&args.out)?;
         crate::kernels::use_kernels(config.portable_numerics)?;
-        crate::train::resume(&args.out, Run::<Trainer>::resume(&args.out))?
+        let run = crate::train::resume(&args.out, Run::<Trainer>::resume(&args.out))?;
+        (run, lock)
     } else {
         let mut config = TrainConfig::preset(&args.env).map_err(|e| BadInput(e.into()))?;
         config.env_steps = args.env_steps;
@@ -59,7 +61,8 @@ pub fn run(args: RunArgs) -> Result<()> {
             config.env_steps,
             args.out.display()
         );
-        Run::create(&args.out, config)?
+        let run = Run::create(&args.out, config)?;
+        (run, crate::lock_run(&args.out)?)
     };
     crate::train::drive(&mut run, false)?;
     drop(run);

@@ -113,6 +113,7 @@ pub struct ReplayArgs {
 
 /// `seads replay`.
 pub fn replay(args: ReplayArgs) -> Result<()> {
+    crate::refuse_overwriting_input(&args.out, &[&args.input])?;
     let mut env = build_env(&args.env, &EnvConfig::default())?;
     let m = env.spec().manipulator_dim;
     let input = std::fs::File::open(&args.input)

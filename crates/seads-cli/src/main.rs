@@ -77,6 +77,51 @@ enum Command {
 #[error(transparent)]
 pub struct BadInput(#[from] pub anyhow::Error);
 
+/// Takes the run directory `dir` for this command, the one writer it may have at a time (see
+/// [`seads_rl::RunLock`]); another writer holding it is exit 2, naming it. Waits a moment, for a
+/// `sweep status` that looks at the lock.
+pub fn lock_run(dir: &std::path::Path) -> anyhow::Result<seads_rl::RunLock> {
+    use anyhow::Context as _;
+    // Only a run directory is locked: anything else is said as such.
+    seads_rl::load_config(dir).with_context(|| format!("loading run {}", dir.display()))?;
+    let mut command: String = std::env::args()
+        .map(|a| a.rsplit('/').next().unwrap_or_default().to_owned())
+        .collect::<Vec<_>>()
+        .join(" ");
+    command.truncate(200);
+    seads_rl::RunLock::acquire(dir, &command, std::time::Duration::from_secs(2)).map_err(
+        |e| match e {
+            seads_rl::RlError::Busy { .. } => BadInput(e.into()).into(),
+            other => anyhow::Error::from(other),
+        },
+    )
+}
+
+/// Refuses an output path that is one of the command's inputs (the same file or folder, through
+/// any path or link): an output never overwrites what the command reads. Exit 2.
+pub fn refuse_overwriting_input(
+    output: &std::path::Path,
+    inputs: &[&std::path::Path],
+) -> anyhow::Result<()> {
+    use std::os::unix::fs::MetadataExt as _;
+    let Ok(out) = std::fs::metadata(output) else {
+        return Ok(()); // a new file overwrites nothing
+    };
+    for input in inputs {
+        if let Ok(meta) = std::fs::metadata(input)
+            && (meta.dev(), meta.ino()) == (out.dev(), out.ino())
+        {
+            return Err(BadInput(anyhow::anyhow!(
+                "{} is also an input ({}): an output never overwrites its input",
+                output.display(),
+                input.display()
+            ))
+            .into());
+        }
+    }
+    Ok(())
+}
+
 /// A command-line number that must be finite and positive (seconds, millimetres, spacings):
 /// negative, zero, NaN and infinite values are usage errors (exit code 2), never a panic.
 fn positive_finite(text: &str) -> Result<f64, String> {

@@ -40,6 +40,10 @@ pub struct PlotArgs {
 
 /// `seads plot`: writes every figure of the run into `out`; returns the files written.
 pub fn plot(args: PlotArgs) -> Result<()> {
+    // Plotting may evaluate the run and save that evaluation into it.
+    seads_rl::load_config(&args.run)
+        .with_context(|| format!("loading run {}", args.run.display()))?;
+    let _lock = crate::lock_run(&args.run)?;
     let written = write_figures(
         &args.run,
         &args.out,

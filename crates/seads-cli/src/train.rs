@@ -52,12 +52,10 @@ fn config(args: &TrainArgs) -> Result<TrainConfig> {
         (Some(path), env) => {
             let text = std::fs::read_to_string(path)
                 .with_context(|| format!("reading {}", path.display()))?;
-            let mut config = TrainConfig::from_toml(&text)
-                .map_err(|e| BadInput(anyhow::anyhow!("{}: {e}", path.display())))?;
-            if let Some(env) = env {
-                config.env = env.clone();
-            }
-            config
+            // What the file leaves out comes from its environment's preset.
+            let algorithm = args.algorithm.as_deref().map(|a| algorithm(Some(a)));
+            TrainConfig::from_user_toml(&text, env.as_deref(), algorithm)
+                .map_err(|e| BadInput(anyhow::anyhow!("{}: {e}", path.display())))?
         }
         (None, Some(env)) => TrainConfig::preset_for(env, algorithm(args.algorithm.as_deref()))
             .map_err(|e| BadInput(e.into()))?,
@@ -89,6 +87,7 @@ fn algorithm(name: Option<&str>) -> Algorithm {
 pub fn train(args: TrainArgs) -> Result<()> {
     match &args.resume {
         Some(dir) => {
+            let _lock = crate::lock_run(dir)?;
             if let Some(steps) = args.env_steps {
                 seads_rl::raise_budget(dir, steps).map_err(|e| match e {
                     seads_rl::RlError::Config(_) => BadInput(e.into()).into(),
@@ -111,20 +110,26 @@ pub fn train(args: TrainArgs) -> Result<()> {
             crate::kernels::use_kernels(config.portable_numerics)?;
             let out = args.out.as_ref().expect("clap requires --out");
             match config.algorithm {
-                Algorithm::Seads => drive(&mut create::<Trainer>(out, config)?, args.quiet),
-                Algorithm::Sac => drive(&mut create::<TaskSac>(out, config)?, args.quiet),
-                Algorithm::Hac => drive(&mut create::<Hac>(out, config)?, args.quiet),
+                Algorithm::Seads => drive(&mut create::<Trainer>(out, config)?.0, args.quiet),
+                Algorithm::Sac => drive(&mut create::<TaskSac>(out, config)?.0, args.quiet),
+                Algorithm::Hac => drive(&mut create::<Hac>(out, config)?.0, args.quiet),
             }
         }
     }
 }
 
-/// A new run; a configuration error is bad input.
-fn create<L: Learner>(out: &std::path::Path, config: TrainConfig) -> Result<Run<L>> {
-    Run::create(out, config).map_err(|e| match e {
-        seads_rl::RlError::Config(_) => BadInput(e.into()).into(),
+/// A new run and the lock on its directory, held while it trains; a configuration error is
+/// bad input.
+fn create<L: Learner>(
+    out: &std::path::Path,
+    config: TrainConfig,
+) -> Result<(Run<L>, seads_rl::RunLock)> {
+    let run = Run::create(out, config).map_err(|e| match e {
+        seads_rl::RlError::Config(_) => anyhow::Error::from(BadInput(e.into())),
         other => anyhow::Error::from(other),
-    })
+    })?;
+    let lock = crate::lock_run(out)?;
+    Ok((run, lock))
 }
 
 /// The resumed run, after telling on stderr what resuming repaired.

@@ -164,8 +164,8 @@ pub struct UarmTrainArgs {
     /// Seed of the run.
     #[arg(long, default_value_t = 1)]
     seed: u64,
-    /// Test boards per solution depth 1–5 in the final evaluation.
-    #[arg(long, default_value_t = 20)]
+    /// Test boards per solution depth 1–5 in the final evaluation (at least 1).
+    #[arg(long, value_parser = clap::builder::RangedU64ValueParser::<usize>::new().range(1..), default_value_t = 20)]
     boards: usize,
     /// Time limit per search in the final evaluation, seconds.
     #[arg(long, default_value_t = 60.0, value_parser = crate::positive_finite)]
@@ -303,11 +303,14 @@ pub fn train(mut args: UarmTrainArgs) -> Result<()> {
         }
         Trainer::with_environments(config, env.box_clone(), env.box_clone())
     };
-    let mut run = if args.resume {
-        crate::train::resume(&args.out, Run::resume_with(&args.out, trainer))?
+    let (mut run, _lock) = if args.resume {
+        let lock = crate::lock_run(&args.out)?;
+        let run = crate::train::resume(&args.out, Run::resume_with(&args.out, trainer))?;
+        (run, lock)
     } else {
         let run = Run::with_trainer(&args.out, trainer(robot_config(&env, &args)?)?)
             .map_err(|e| BadInput(e.into()))?;
+        let lock = crate::lock_run(&args.out)?;
         let settings = RobotSettings {
             action_space: args.action_space,
             reset_board: args.reset_board,
@@ -316,7 +319,7 @@ pub fn train(mut args: UarmTrainArgs) -> Result<()> {
             &args.out.join(ROBOT_SETTINGS),
             toml::to_string(&settings)?.as_bytes(),
         )?;
-        run
+        (run, lock)
     };
     crate::train::drive(&mut run, args.quiet)?;
     drop(run);
@@ -380,8 +383,8 @@ pub struct UarmEvaluateArgs {
     /// `evaluation-replan-epoch-<EPOCH>.json`.
     #[arg(long)]
     checkpoint: Option<u64>,
-    /// Test boards per solution depth 1–5.
-    #[arg(long, default_value_t = 20)]
+    /// Test boards per solution depth 1–5 (at least 1).
+    #[arg(long, value_parser = clap::builder::RangedU64ValueParser::<usize>::new().range(1..), default_value_t = 20)]
     boards: usize,
     /// Time limit per search, seconds.
     #[arg(long, default_value_t = 60.0, value_parser = crate::positive_finite)]
@@ -396,6 +399,7 @@ pub struct UarmEvaluateArgs {
 pub fn evaluate_run(args: UarmEvaluateArgs) -> Result<()> {
     let config =
         load_config(&args.run).with_context(|| format!("loading run {}", args.run.display()))?;
+    let _lock = crate::lock_run(&args.run)?;
     crate::kernels::use_kernels(config.portable_numerics)?;
     let action_space = ActionSpace::of_env(&config.env).ok_or_else(|| {
         BadInput(anyhow::anyhow!(

@@ -668,6 +668,59 @@ fn replay_reports_bad_lines_with_their_number() {
         ],
         "not supported",
     );
+    // An output that is the input (issue 32: it left the input empty), through another path too.
+    let before = std::fs::read(&good).unwrap();
+    let same = dir.path().join(".").join("good.jsonl");
+    for out in [&good, &same] {
+        check_bad_input(
+            &[
+                "replay",
+                "--env",
+                "lightsout-cursor",
+                "--input",
+                good.to_str().unwrap(),
+                "--out",
+                out.to_str().unwrap(),
+            ],
+            "never overwrites its input",
+        );
+    }
+    assert_eq!(std::fs::read(&good).unwrap(), before, "the input is intact");
+}
+
+/// `uarm train --boards 0` is refused (issue 32: it reported "solved 0 of 0 boards"), as is an
+/// absurd calibration file.
+#[test]
+fn uarm_refuses_no_boards_and_absurd_calibrations() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("run");
+    for command in ["train", "evaluate"] {
+        let output = seads(&[
+            "uarm", command, "--port", "sim", "--boards", "0", "--run", "x", "--out", "y",
+        ]);
+        assert_eq!(output.status.code(), Some(2), "{command}");
+        assert!(!out.exists());
+    }
+    let cal = dir.path().join("cal.toml");
+    std::fs::write(
+        &cal,
+        "corners = [[180.0, -60.0, 20.0], [180.0, 60.0, 20.0], [300.0, 60.0, 20.0], [300.0, -60.0, 20.0]]\nd_max_mm = 1e300\n",
+    )
+    .unwrap();
+    check_bad_input(
+        &[
+            "uarm",
+            "train",
+            "--port",
+            "sim",
+            "--calibration",
+            cal.to_str().unwrap(),
+            "--out",
+            out.to_str().unwrap(),
+        ],
+        "reach",
+    );
+    assert!(!out.exists(), "a refused calibration writes nothing");
 }
 
 #[test]

@@ -14,7 +14,7 @@ use std::sync::OnceLock;
 use serde_json::Value;
 
 mod common;
-use common::kill_at_moment;
+use common::{kill_at_moment, park_at_moment};
 
 const SEADS: &str = env!("CARGO_BIN_EXE_seads");
 
@@ -267,4 +267,39 @@ fn a_finished_run_can_be_extended() {
     let stderr = String::from_utf8_lossy(&output.stderr);
     assert_eq!(output.status.code(), Some(2), "{stderr}");
     assert!(stderr.contains("can only be raised"), "{stderr}");
+}
+
+/// One writer per run directory: while a run trains (here waiting at a moment after its first
+/// checkpoint), a second `train --resume`, an evaluation and a plot of it are refused with exit
+/// 2 in one line naming the holder, and change nothing; `sweep status`-style readers and the
+/// resume after the holder is gone work.
+#[test]
+fn a_second_writer_is_refused_while_the_run_trains() {
+    let dir = tempfile::tempdir().unwrap();
+    let config = config(dir.path());
+    let out = dir.path().join("run");
+    let mut first = park_at_moment(train(&config, &out), 40);
+    let before = std::fs::read(out.join("metrics.jsonl")).unwrap();
+    let figures = dir.path().join("figures");
+    let run = out.to_str().unwrap();
+    for args in [
+        vec!["train", "--quiet", "--resume", run],
+        vec!["evaluate", "--run", run, "--boards", "1", "--quiet"],
+        vec!["plot", "--run", run, "--out", figures.to_str().unwrap()],
+    ] {
+        let output = Command::new(SEADS).args(&args).output().unwrap();
+        let stderr = String::from_utf8_lossy(&output.stderr);
+        assert_eq!(output.status.code(), Some(2), "{args:?}: {stderr}");
+        assert!(
+            stderr.contains(&format!("pid {} (seads train", first.id()))
+                && stderr.contains("one writer at a time"),
+            "{args:?}: {stderr}"
+        );
+        assert_eq!(stderr.trim().lines().count(), 1, "{stderr}");
+    }
+    assert_eq!(std::fs::read(out.join("metrics.jsonl")).unwrap(), before);
+    assert!(!figures.exists(), "a refused plot writes nothing");
+    first.kill().unwrap();
+    first.wait().unwrap();
+    resume(&out);
 }

@@ -354,3 +354,31 @@ fn summaries_order_depths_numerically() {
     let depths: Vec<usize> = summary.success_rate.keys().copied().collect();
     assert_eq!(depths, [2, 9, 10]);
 }
+
+/// A board that is already the goal is solved without a skill, in both modes.
+#[test]
+fn a_solved_board_is_solved_without_a_skill() {
+    let lo = &*LIGHTSOUT;
+    for replan in [false, true] {
+        let mut env =
+            seads_embodiment::make_env("lightsout-cursor", &EnvConfig::default()).unwrap();
+        env.seed(1);
+        env.reset().unwrap();
+        env.set_board(lo.goal()).unwrap();
+        let config = SolveConfig {
+            replan,
+            ..SolveConfig::default()
+        };
+        let outcome = solve(
+            env.as_mut(),
+            &CursorPolicy::lightsout(None),
+            &mut GameSuccessor::new(lo),
+            lo.goal(),
+            &config,
+        )
+        .unwrap();
+        assert!(outcome.solved && outcome.plan_found, "{outcome:?}");
+        assert!(outcome.executed.is_empty() && outcome.first_plan.is_empty());
+        assert_eq!(outcome.manipulator_steps, 0);
+    }
+}

@@ -346,8 +346,74 @@ impl TrainConfig {
         HAC_PRESETS
     }
 
-    /// Parses a TOML configuration and validates its values (not the environment: see
-    /// [`TrainConfig::validate`]).
+    /// A configuration a user wrote (a `--config` file, a run's `config.toml`): it must name its
+    /// `env` (or `env` is given here), and what it leaves out comes from that environment's
+    /// preset of its `algorithm` (or the given one), never from generic defaults. Unknown
+    /// fields and bad values are errors naming the line. The robot's environments (`uarm-…`)
+    /// have no preset; their runs write the whole configuration, taken as written.
+    ///
+    /// ```
+    /// use seads_rl::TrainConfig;
+    /// let config = TrainConfig::from_user_toml("env = \"tileswap-reacher\"\nseed = 3", None, None)?;
+    /// assert_eq!(config.seed, 3);
+    /// // The rest is the environment's preset, not the generic defaults.
+    /// assert_eq!(config.sac.alpha, TrainConfig::preset("tileswap-reacher")?.sac.alpha);
+    /// assert!(TrainConfig::from_user_toml("", None, None).is_err());
+    /// # Ok::<(), seads_rl::RlError>(())
+    /// ```
+    pub fn from_user_toml(
+        text: &str,
+        env: Option<&str>,
+        algorithm: Option<Algorithm>,
+    ) -> Result<Self, RlError> {
+        // Fields, types and values first, with the user's line numbers.
+        Self::from_toml(text)?;
+        let mut table: toml::Table = text
+            .parse()
+            .map_err(|e| RlError::Config(one_line_toml_error(text, &e)))?;
+        if let Some(env) = env {
+            table.insert("env".into(), toml::Value::String(env.into()));
+        }
+        if let Some(algorithm) = algorithm {
+            table.insert(
+                "algorithm".into(),
+                toml::Value::String(algorithm.name().into()),
+            );
+        }
+        let Some(toml::Value::String(env)) = table.get("env") else {
+            return Err(RlError::Config(format!(
+                "the configuration names no `env` (one of {}); its preset fills in the rest",
+                env_names().join(", ")
+            )));
+        };
+        let algorithm = match table.get("algorithm") {
+            Some(value) => value
+                .clone()
+                .try_into::<Algorithm>()
+                .map_err(|e| RlError::Config(format!("algorithm: {e}")))?,
+            None => Algorithm::Seads,
+        };
+        // Environments outside the registry (the robot's) have no preset: their runs write the
+        // whole configuration, which is taken as written.
+        if !env_names().contains(&env.as_str()) && env.starts_with("uarm-") {
+            return Self::from_toml(&toml::to_string(&table).expect("a table serialises"));
+        }
+        let preset = Self::preset_for(env, algorithm)?;
+        let mut merged: toml::Table = preset
+            .to_toml()
+            .parse()
+            .expect("a serialised preset parses");
+        merge_toml(&mut merged, &table);
+        let config: Self = merged
+            .try_into()
+            .map_err(|e: toml::de::Error| RlError::Config(e.message().trim().replace('\n', " ")))?;
+        config.validate_values()?;
+        Ok(config)
+    }
+
+    /// Parses a complete TOML configuration (fields left out take the generic defaults, which
+    /// only the presets rely on: a user's file goes through [`TrainConfig::from_user_toml`]) and
+    /// validates its values (not the environment: see [`TrainConfig::validate`]).
     pub fn from_toml(text: &str) -> Result<Self, RlError> {
         let config: Self =
             toml::from_str(text).map_err(|e| RlError::Config(one_line_toml_error(text, &e)))?;
@@ -502,6 +568,66 @@ impl TrainConfig {
 }
 
 /// A TOML error as one line: "line L, column C: message".
+/// Lays `layer` over `base`: a key of `layer` replaces `base`'s, except that two tables merge,
+/// key by key. How a partial configuration fills from its preset, and how a study's variant
+/// overrides its preset.
+pub fn merge_toml(base: &mut toml::Table, layer: &toml::Table) {
+    for (key, value) in layer {
+        match (base.get_mut(key), value) {
+            (Some(toml::Value::Table(b)), toml::Value::Table(l)) => merge_toml(b, l),
+            _ => {
+                base.insert(key.clone(), value.clone());
+            }
+        }
+    }
+}
+
+/// Fields that a resumed run may change: the budget (`--env-steps`) and the thread counts,
+/// which sweeps and the robot set per task and which do not change a run's numbers (a test in
+/// `tests/training.rs` checks).
+const RESUMABLE_CHANGES: [&str; 3] = ["env_steps", "threads", "sac_threads_alone"];
+
+/// The first field in which two configurations differ, other than those a resumed run may
+/// change (the budget, thread counts), as `(dotted name, this value, that value)`.
+pub fn config_difference(
+    this: &TrainConfig,
+    that: &TrainConfig,
+) -> Option<(String, String, String)> {
+    fn walk(prefix: &str, a: &toml::Table, b: &toml::Table) -> Option<(String, String, String)> {
+        let mut keys: Vec<&String> = a.keys().chain(b.keys()).collect();
+        keys.sort();
+        keys.dedup();
+        for key in keys {
+            let name = if prefix.is_empty() {
+                key.clone()
+            } else {
+                format!("{prefix}.{key}")
+            };
+            if RESUMABLE_CHANGES.contains(&name.as_str()) {
+                continue;
+            }
+            match (a.get(key), b.get(key)) {
+                (Some(toml::Value::Table(x)), Some(toml::Value::Table(y))) => {
+                    if let Some(d) = walk(&name, x, y) {
+                        return Some(d);
+                    }
+                }
+                (x, y) if x != y => {
+                    let show =
+                        |v: Option<&toml::Value>| v.map_or("unset".into(), |v| v.to_string());
+                    return Some((name, show(x), show(y)));
+                }
+                _ => {}
+            }
+        }
+        None
+    }
+    let table = |c: &TrainConfig| -> toml::Table {
+        c.to_toml().parse().expect("a serialised config parses")
+    };
+    walk("", &table(this), &table(that))
+}
+
 fn one_line_toml_error(text: &str, e: &toml::de::Error) -> String {
     let message = e.message().trim().replace('\n', " ");
     match e.span() {
@@ -512,5 +638,75 @@ fn one_line_toml_error(text: &str, e: &toml::de::Error) -> String {
             format!("line {line}, column {column}: {message}")
         }
         None => message,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_user_config_must_name_its_env_and_fills_from_its_preset() {
+        let err = TrainConfig::from_user_toml("", None, None).unwrap_err();
+        assert!(err.to_string().contains("names no `env`"), "{err}");
+        let err = TrainConfig::from_user_toml("seed = 2", None, None).unwrap_err();
+        assert!(err.to_string().contains("names no `env`"), "{err}");
+        // The issue's case: only the environment, which must get its preset (α 0.01), not the
+        // generic defaults (α 0.1).
+        let partial =
+            TrainConfig::from_user_toml("env = \"tileswap-reacher\"", None, None).unwrap();
+        let preset = TrainConfig::preset("tileswap-reacher").unwrap();
+        assert_eq!(partial, preset);
+        assert_ne!(preset.sac.alpha, TrainConfig::default().sac.alpha);
+        // A nested override keeps the rest of its table.
+        let lr = TrainConfig::from_user_toml(
+            "env = \"lightsout-cursor\"\n[sac]\nlr = 0.001",
+            None,
+            None,
+        )
+        .unwrap();
+        assert_eq!(lr.sac.lr, 0.001);
+        assert_eq!(
+            lr.sac.hidden,
+            TrainConfig::preset("lightsout-cursor").unwrap().sac.hidden
+        );
+        // The command line may give the environment and the algorithm.
+        let sac =
+            TrainConfig::from_user_toml("seed = 4", Some("lightsout-cursor"), Some(Algorithm::Sac))
+                .unwrap();
+        assert_eq!(
+            (sac.seed, sac.sac.hidden.clone()),
+            (
+                4,
+                TrainConfig::preset_for("lightsout-cursor", Algorithm::Sac)
+                    .unwrap()
+                    .sac
+                    .hidden
+            )
+        );
+        for bad in [
+            "env = \"nowhere\"",
+            "env = \"lightsout-cursor\"\nlrr = 1",
+            "env = 3",
+        ] {
+            assert!(
+                TrainConfig::from_user_toml(bad, None, None).is_err(),
+                "{bad}"
+            );
+        }
+    }
+
+    #[test]
+    fn config_differences_name_the_field_but_not_the_budget_or_threads() {
+        let a = TrainConfig::preset("lightsout-cursor").unwrap();
+        let mut b = a.clone();
+        b.env_steps += 1000;
+        b.threads = 4;
+        b.sac_threads_alone = 0;
+        assert_eq!(config_difference(&a, &b), None);
+        b.skill_model.lr = 0.5;
+        let (field, now, then) = config_difference(&b, &a).unwrap();
+        assert_eq!(field, "skill_model.lr");
+        assert_eq!((now.as_str(), then.as_str()), ("0.5", "0.001"));
     }
 }

@@ -55,7 +55,9 @@ use std::path::Path;
 
 pub use agent::{Agent, AgentPolicy, find_checkpoint};
 pub use buffers::{RelabelBatch, RelabelObserver, Relabelling};
-pub use config::{Algorithm, BaselineConfig, HacConfig, RelabelConfig, TrainConfig};
+pub use config::{
+    Algorithm, BaselineConfig, HacConfig, RelabelConfig, TrainConfig, config_difference, merge_toml,
+};
 pub use episode::{Episode, policy_input, run_episodes, skill_coverage};
 pub use hac::{Hac, HacPolicy};
 pub use numerics::{FAST_KERNELS, PORTABLE_KERNELS, kernel_environment, portable_kernels_active};
@@ -64,9 +66,9 @@ pub use run::{Hook, Learner, Metrics, Moment, Run, RunEvent, load_config, raise_
 pub use sac::{Sac, SacConfig, SacLosses, TransitionBatch, checkpoint_files};
 pub use seeds::{Purpose, derived_seed, stream, train_env_seed};
 pub use store::{
-    MetricsLine, append_json_line, check_origin, checkpoint_id, checkpoint_name, checkpoints,
-    is_copy_without_checkpoints, last_env_steps, latest_checkpoint, read_json_lines, read_metrics,
-    read_metrics_as, write_atomic,
+    MetricsLine, RUN_LOCK, RunLock, append_json_line, check_origin, checkpoint_id, checkpoint_name,
+    checkpoints, is_copy_without_checkpoints, last_env_steps, latest_checkpoint, read_json_lines,
+    read_metrics, read_metrics_as, run_is_locked, write_atomic,
 };
 pub use task_policy::{TaskPolicy, load_policy, task_success};
 pub use task_sac::{TaskEpochStats, TaskMetrics, TaskSac, TaskTimings, updates_due};
@@ -130,6 +132,14 @@ pub enum RlError {
         dir: String,
         /// Lines in its metrics file.
         lines: usize,
+    },
+    /// Another process writes into the run directory now.
+    #[error("{dir} is in use by {holder}: one writer at a time")]
+    Busy {
+        /// The run directory.
+        dir: String,
+        /// Who holds it, as its lock file names it.
+        holder: String,
     },
     /// A run that has written checkpoints has none that can be loaded.
     #[error("{dir}: none of its {tried} checkpoint(s) can be loaded; the newest")]

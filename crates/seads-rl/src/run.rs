@@ -244,6 +244,9 @@ impl<L: Learner> Run<L> {
                 }
             }
         }
+        if let Some(checkpoint) = &resumed {
+            crate::store::check_config(checkpoint, &config)?;
+        }
         let (mut metrics, torn) = read_metrics_text::<L::Metrics>(dir)?;
         // Checked before anything is written (see `is_copy_without_checkpoints`); a file that
         // held only a torn line is no data.
@@ -412,7 +415,8 @@ pub fn raise_budget(dir: &Path, env_steps: u64) -> Result<(), RlError> {
 pub fn load_config(dir: &Path) -> Result<TrainConfig, RlError> {
     let path = dir.join(CONFIG);
     let text = fs::read_to_string(&path).map_err(|e| RlError::io(&path, e))?;
-    TrainConfig::from_toml(&text).map_err(|e| RlError::Config(format!("{}: {e}", path.display())))
+    TrainConfig::from_user_toml(&text, None, None)
+        .map_err(|e| RlError::Config(format!("{}: {e}", path.display())))
 }
 
 impl Learner for Trainer {

@@ -21,6 +21,7 @@
 use std::fs;
 use std::io::Write as _;
 use std::path::{Path, PathBuf};
+use std::time::{Duration, Instant};
 
 use serde::Serialize;
 use serde::de::DeserializeOwned;
@@ -63,7 +64,31 @@ pub(crate) fn write_origin(dir: &Path, config: &crate::TrainConfig) -> Result<()
     };
     let path = dir.join(ORIGIN);
     let text = serde_json::to_string(&origin).map_err(|e| RlError::io(&path, e))?;
-    fs::write(&path, text).map_err(|e| RlError::io(&path, e))
+    fs::write(&path, text).map_err(|e| RlError::io(&path, e))?;
+    // The whole configuration the checkpoint was trained with, which a resume compares with
+    // the run's `config.toml`.
+    let path = dir.join(CONFIG);
+    fs::write(&path, config.to_toml()).map_err(|e| RlError::io(&path, e))
+}
+
+/// Refuses to resume from `checkpoint` with a `config` other than the one it was trained with
+/// (its `config.toml`), naming the first field that differs; the budget and thread counts may
+/// differ. A checkpoint written before it kept its configuration passes.
+pub(crate) fn check_config(checkpoint: &Path, config: &crate::TrainConfig) -> Result<(), RlError> {
+    let path = checkpoint.join(CONFIG);
+    let Ok(text) = fs::read_to_string(&path) else {
+        return Ok(());
+    };
+    let trained =
+        crate::TrainConfig::from_toml(&text).map_err(|e| RlError::unreadable(&path, e))?;
+    match crate::config_difference(config, &trained) {
+        None => Ok(()),
+        Some((field, now, then)) => Err(RlError::Config(format!(
+            "config.toml differs from the configuration that checkpoint {} was trained with: \
+             `{field}` is {now}, was {then} (only env_steps, with --env-steps, and thread counts may change)",
+            checkpoint.display()
+        ))),
+    }
 }
 
 /// Refuses a checkpoint written by a run of another environment or algorithm than `config`'s,
@@ -166,7 +191,74 @@ pub fn clean_leftovers(dir: &Path) -> Result<Vec<String>, RlError> {
     Ok(removed)
 }
 
+/// The lock file of a run directory.
+pub const RUN_LOCK: &str = "task.lock";
+
+/// The right to write into a run directory, held by one process at a time: an OS file lock on
+/// `task.lock`, which the operating system releases when the process dies, so it is never stale.
+/// Everything that writes into a run (training, resuming, sweep tasks, evaluations, plots) holds
+/// it; readers (status, reports) never take it. The file names the holder for a second writer.
+#[derive(Debug)]
+pub struct RunLock {
+    _file: fs::File,
+}
+
+impl RunLock {
+    /// Locks the run in `dir` (which must exist) for `holder` (a few words: what holds it),
+    /// waiting up to `patience` for another holder to let go; [`RlError::Busy`] if it does not.
+    pub fn acquire(dir: &Path, holder: &str, patience: Duration) -> Result<Self, RlError> {
+        let path = dir.join(RUN_LOCK);
+        let mut file = fs::File::options()
+            .create(true)
+            .truncate(false)
+            .read(true)
+            .write(true)
+            .open(&path)
+            .map_err(|e| RlError::io(&path, e))?;
+        let start = Instant::now();
+        loop {
+            match file.try_lock() {
+                Ok(()) => break,
+                Err(fs::TryLockError::WouldBlock) if start.elapsed() < patience => {
+                    std::thread::sleep(Duration::from_millis(50));
+                }
+                Err(fs::TryLockError::WouldBlock) => {
+                    let named = fs::read_to_string(&path).unwrap_or_default();
+                    let named = named.trim();
+                    return Err(RlError::Busy {
+                        dir: dir.display().to_string(),
+                        holder: if named.is_empty() {
+                            "another process".into()
+                        } else {
+                            named.to_owned()
+                        },
+                    });
+                }
+                Err(fs::TryLockError::Error(e)) => return Err(RlError::io(&path, e)),
+            }
+        }
+        let line = format!("pid {} ({holder})\n", std::process::id());
+        file.set_len(0)
+            .and_then(|()| file.write_all(line.as_bytes()))
+            .map_err(|e| RlError::io(&path, e))?;
+        Ok(Self { _file: file })
+    }
+}
+
+/// Whether some process holds the lock of the run in `dir` now (it is taken for an instant to
+/// look, so a writer waits a little before it gives up).
+pub fn run_is_locked(dir: &Path) -> bool {
+    let Ok(file) = fs::File::open(dir.join(RUN_LOCK)) else {
+        return false;
+    };
+    matches!(file.try_lock(), Err(fs::TryLockError::WouldBlock))
+}
+
 /// The name of the checkpoint of epoch `epoch`.
+///
+/// ```
+/// assert_eq!(seads_rl::checkpoint_name(1800), "epoch-001800");
+/// ```
 pub fn checkpoint_name(epoch: u64) -> String {
     format!("epoch-{epoch:06}")
 }

@@ -163,6 +163,41 @@ fn same_seed_same_run() {
     assert_ne!(first, run(4, 0));
 }
 
+/// No silent defaults on resume: a `config.toml` edited after a checkpoint (a seed, a learning
+/// rate) is refused, naming the field; raising the budget is allowed; an emptied one names no
+/// environment and is refused rather than trained as a preset.
+#[test]
+fn resume_refuses_a_config_edited_since_its_checkpoint() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("run");
+    let mut run = Run::<Trainer>::create(&path, small(12, 2500)).unwrap();
+    while run.trainer().epoch() < 10 {
+        run.step().unwrap();
+    }
+    drop(run);
+    let original = std::fs::read_to_string(path.join("config.toml")).unwrap();
+    for (from, to, field) in [
+        ("seed = 12", "seed = 13", "`seed` is 13, was 12"),
+        (
+            "lr = 0.0003",
+            "lr = 0.0005",
+            "`sac.lr` is 0.0005, was 0.0003",
+        ),
+    ] {
+        assert!(original.contains(from), "{original}");
+        std::fs::write(path.join("config.toml"), original.replacen(from, to, 1)).unwrap();
+        let err = Run::<Trainer>::resume(&path).err().expect("refused");
+        assert!(err.to_string().contains(field), "{err}");
+    }
+    std::fs::write(path.join("config.toml"), "").unwrap();
+    let err = Run::<Trainer>::resume(&path).err().expect("refused");
+    assert!(err.to_string().contains("names no `env`"), "{err}");
+    std::fs::write(path.join("config.toml"), &original).unwrap();
+    seads_rl::raise_budget(&path, 3000).unwrap();
+    let resumed = Run::<Trainer>::resume(&path).unwrap();
+    assert_eq!(resumed.trainer().epoch(), 10);
+}
+
 /// A killed run resumes from its last checkpoint: the state is restored exactly, evaluations
 /// logged after the checkpoint are dropped, and training continues to the budget.
 #[test]

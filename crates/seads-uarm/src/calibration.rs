@@ -15,6 +15,10 @@ use serde::{Deserialize, Serialize};
 
 use crate::UarmError;
 
+/// How far from its base (mm, on each axis) any point of a calibration may lie: the uArm Swift
+/// Pro reaches about 320 mm, so a corner or height beyond this is a unit or typing error.
+pub const REACH_MM: f64 = 1000.0;
+
 /// The measured corners and the height scale; everything else is derived (and validated) on load.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -47,10 +51,20 @@ impl Calibration {
     /// collinear, or not forming a convex quadrilateral in the right order).
     pub fn fit(file: CalibrationFile) -> Result<Self, UarmError> {
         let bad = |m: String| UarmError::Calibration(m);
-        if !(file.d_max_mm > 0.0 && file.d_max_mm.is_finite()) {
+        if file.d_max_mm.is_nan() || file.d_max_mm <= 0.0 || file.d_max_mm > REACH_MM {
             return Err(bad(format!(
-                "d_max_mm must be positive, got {}",
+                "d_max_mm must be positive and within the arm's reach ({REACH_MM} mm), got {}",
                 file.d_max_mm
+            )));
+        }
+        if let Some(far) = file
+            .corners
+            .iter()
+            .find(|c| c.iter().any(|v| v.is_nan() || v.abs() > REACH_MM))
+        {
+            return Err(bad(format!(
+                "corner {far:?} lies beyond the arm's reach ({REACH_MM} mm from its base on each \
+                 axis): were the corners recorded in another unit?"
             )));
         }
         let p: Vec<Vector3<f64>> = file
@@ -333,6 +347,22 @@ mod tests {
             }),
             Err(UarmError::Calibration(_))
         ));
+        // Absurd sizes (issue 32): a height scale of 1e300 mm, corners metres from the arm.
+        let err = Calibration::fit(CalibrationFile {
+            corners: good,
+            d_max_mm: 1e300,
+        })
+        .unwrap_err()
+        .to_string();
+        assert!(err.contains("reach"), "{err}");
+        let far = good.map(|c| c.map(|v| v * 20.0));
+        let err = Calibration::fit(CalibrationFile {
+            corners: far,
+            d_max_mm: 100.0,
+        })
+        .unwrap_err()
+        .to_string();
+        assert!(err.contains("beyond the arm's reach"), "{err}");
         let mut nan = good;
         nan[0][1] = f64::NAN;
         assert!(matches!(

@@ -87,6 +87,7 @@ pub fn evaluate_run(args: EvaluateArgs) -> Result<()> {
     }
     let config = seads_rl::load_config(&args.run)
         .with_context(|| format!("loading run {}", args.run.display()))?;
+    let _lock = crate::lock_run(&args.run)?;
     if config.algorithm.is_baseline() {
         if args.checkpoints.is_some() {
             bail!(BadInput(anyhow::anyhow!(

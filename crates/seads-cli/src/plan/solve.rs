@@ -108,6 +108,7 @@ pub fn solve_board(args: SolveArgs) -> Result<()> {
             list(&outcome.skill_steps)
         );
         match &outcome.failure {
+            None if outcome.executed.is_empty() => println!("the board is already solved"),
             None => println!("solved in {} manipulator steps", outcome.manipulator_steps),
             Some(why) => println!("not solved: {why}"),
         }

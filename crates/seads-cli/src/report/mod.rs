@@ -51,6 +51,8 @@ pub struct ReportArgs {
 
 /// Runs `seads report`.
 pub fn report(args: ReportArgs) -> Result<()> {
+    let inputs: Vec<&std::path::Path> = args.inputs.iter().map(PathBuf::as_path).collect();
+    crate::refuse_overwriting_input(&args.out, &inputs)?;
     let collection = runs::collect(&args.inputs).map_err(BadInput)?;
     let reference = args.reference.clone().or(collection.reference.clone());
     let (groups, unfinished) = runs::group(&collection.runs).map_err(BadInput)?;

@@ -254,7 +254,7 @@ impl Manifest {
                     );
                 }
             }
-            merge(&mut table, layer);
+            seads_rl::merge_toml(&mut table, layer);
         }
         table.insert("seed".into(), toml::Value::Integer(seed as i64));
         let config: TrainConfig =
@@ -275,17 +275,6 @@ impl Manifest {
 }
 
 /// Writes `layer` over `base`, table by table (a nested table is merged, any other value set).
-fn merge(base: &mut toml::Table, layer: &toml::Table) {
-    for (key, value) in layer {
-        match (base.get_mut(key), value) {
-            (Some(toml::Value::Table(b)), toml::Value::Table(l)) => merge(b, l),
-            _ => {
-                base.insert(key.clone(), value.clone());
-            }
-        }
-    }
-}
-
 fn is_name(name: &str) -> bool {
     !name.is_empty()
         && name

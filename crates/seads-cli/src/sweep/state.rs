@@ -1,18 +1,15 @@
 //! The state of one run of a sweep, read from its directory alone (never from Slurm), so that
 //! `seads sweep status` tells the same on a laptop, a login node or inside a job:
-//! - `task.lock` is locked (an OS file lock) while a task works on the run: a killed task
-//!   releases it, so "running" can never be stale;
+//! - `task.lock` is locked (the run's [`seads_rl::RunLock`], an OS file lock) while a task or any
+//!   other writer works on the run: a killed one releases it, so "running" can never be stale;
 //! - `task.json` records the last task's outcome: running, done or failed (with the error).
 
-use std::fs::File;
 use std::path::{Path, PathBuf};
-use std::time::{Duration, Instant};
+use std::time::Duration;
 
 use anyhow::{Context, Result};
 use serde::{Deserialize, Serialize};
 
-/// The lock file of a run directory.
-pub const LOCK: &str = "task.lock";
 /// The task record of a run directory.
 pub const RECORD: &str = "task.json";
 /// The log of the tasks' output (`seads sweep run` appends each task's stdout and stderr).
@@ -90,10 +87,11 @@ fn hostname() -> String {
         .unwrap_or_default()
 }
 
-/// The exclusive claim of a task on a run, held until dropped (or the process dies).
+/// The exclusive claim of a task on a run (its [`seads_rl::RunLock`]), held until dropped (or
+/// the process dies).
 #[derive(Debug)]
 pub struct Claim {
-    _file: File,
+    _lock: seads_rl::RunLock,
 }
 
 /// How long a Slurm task or a task started by hand waits for a run that another task holds:
@@ -124,38 +122,17 @@ impl Claim {
     /// Claims `run`, waiting up to `patience` for another task to release it; [`Taken`] if it
     /// does not.
     pub fn take(run: &Path, patience: Duration) -> Result<Self> {
-        let path = run.join(LOCK);
-        let file = File::options()
-            .create(true)
-            .truncate(false)
-            .write(true)
-            .open(&path)
-            .with_context(|| format!("opening {}", path.display()))?;
-        // `sweep status` holds the lock for an instant while it looks.
-        let start = Instant::now();
-        loop {
-            match file.try_lock() {
-                Ok(()) => return Ok(Self { _file: file }),
-                Err(std::fs::TryLockError::WouldBlock) if start.elapsed() < patience => {
-                    std::thread::sleep(Duration::from_millis(100));
-                }
-                Err(std::fs::TryLockError::WouldBlock) => {
-                    return Err(Taken(run.to_path_buf()).into());
-                }
-                Err(std::fs::TryLockError::Error(e)) => {
-                    return Err(e).with_context(|| format!("locking {}", path.display()));
-                }
-            }
+        match seads_rl::RunLock::acquire(run, "seads sweep task", patience) {
+            Ok(lock) => Ok(Self { _lock: lock }),
+            Err(seads_rl::RlError::Busy { .. }) => Err(Taken(run.to_path_buf()).into()),
+            Err(e) => Err(e).with_context(|| format!("locking {}", run.display())),
         }
     }
 }
 
 /// Whether a task holds `run` now.
 pub fn is_claimed(run: &Path) -> bool {
-    let Ok(file) = File::open(run.join(LOCK)) else {
-        return false;
-    };
-    matches!(file.try_lock(), Err(std::fs::TryLockError::WouldBlock))
+    seads_rl::run_is_locked(run)
 }
 
 /// Where a run stands.

@@ -50,7 +50,15 @@ pub fn s(p: &Path) -> &str {
 
 /// Starts `command` (a `seads` call) stopped at moment `point` of its run (`SEADS_CRASH_POINT`)
 /// and kills it there with SIGKILL.
-pub fn kill_at_moment(mut command: Command, point: usize) {
+pub fn kill_at_moment(command: Command, point: usize) {
+    let mut child = park_at_moment(command, point);
+    child.kill().expect("SIGKILL");
+    child.wait().expect("reaped");
+}
+
+/// Starts `command` with `SEADS_CRASH_POINT=point` and returns it once it waits at that moment,
+/// alive and holding whatever it holds there.
+pub fn park_at_moment(mut command: Command, point: usize) -> std::process::Child {
     let mut child = command
         .env("SEADS_CRASH_POINT", point.to_string())
         .stdout(Stdio::null())
@@ -62,6 +70,5 @@ pub fn kill_at_moment(mut command: Command, point: usize) {
         .lines()
         .any(|l| l.is_ok_and(|l| l.starts_with("seads: stopped at moment")));
     assert!(stopped, "the run never reached moment {point}");
-    child.kill().expect("SIGKILL");
-    child.wait().expect("reaped");
+    child
 }
