@@ -42,7 +42,7 @@ pub struct RunArgs {
 /// `seads run`.
 pub fn run(args: RunArgs) -> Result<()> {
     let (mut run, _lock) = if args.out.join("config.toml").exists() {
-        println!("resuming the run in {}", args.out.display());
+        outln!("resuming the run in {}", args.out.display());
         let lock = crate::lock_run(&args.out)?;
         let config = seads_rl::load_config(&args.out)?;
         crate::kernels::use_kernels(config.portable_numerics)?;
@@ -55,7 +55,7 @@ pub fn run(args: RunArgs) -> Result<()> {
         // Portable kernels: the same numbers on every machine of a kind (docs/RESULTS.md).
         config.portable_numerics = true;
         crate::kernels::use_kernels(true)?;
-        println!(
+        outln!(
             "training SEADS on {} for {} environment steps into {}",
             config.env,
             config.env_steps,
@@ -68,11 +68,11 @@ pub fn run(args: RunArgs) -> Result<()> {
     drop(run);
 
     let mut agent = crate::plan::load_agent(&args.out, None)?;
-    println!(
+    outln!(
         "\nsolving {} test boards per depth 1–5 by planning with the learned forward model:",
         args.boards
     );
-    println!(" depth   with re-planning   plan once   median steps (re-planning)");
+    outln!(" depth   with re-planning   plan once   median steps (re-planning)");
     let protocol = |replan| Protocol {
         kind: EvaluationKind::planning(replan),
         tasks: TaskSet::standard(args.boards),
@@ -87,7 +87,7 @@ pub fn run(args: RunArgs) -> Result<()> {
     for r in &replan {
         let key = r.depth;
         let steps = a.solution_steps[&key].map_or("-".to_owned(), |s| format!("{s:.0}"));
-        println!(
+        outln!(
             "{:>6}   {:>15.0}%   {:>8.0}%   {:>10}",
             r.depth,
             a.success_rate[&key] * 100.0,
@@ -98,8 +98,8 @@ pub fn run(args: RunArgs) -> Result<()> {
     let figures = args.out.join("figures");
     let written =
         crate::plot::write_figures(&args.out, &figures, None, args.boards, args.timeout, true)?;
-    println!("\nfigures ({}): {}", written.len(), figures.display());
-    println!(
+    outln!("\nfigures ({}): {}", written.len(), figures.display());
+    outln!(
         "next: seads solve --run {} --board \"…\" --replan   (see seads --help)",
         args.out.display()
     );

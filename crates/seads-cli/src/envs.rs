@@ -39,17 +39,26 @@ pub fn run_game(config: &seads_rl::TrainConfig) -> Result<Box<dyn seads_games::B
 pub fn envs(json: bool) -> Result<()> {
     let envs = list_envs();
     if json {
-        println!("{}", serde_json::to_string(&envs)?);
+        outln!("{}", serde_json::to_string(&envs)?);
         return Ok(());
     }
-    println!(
+    outln!(
         "{:<18} {:>7} {:>6} {:>6} {:>5}  description",
-        "name", "obs", "action", "skills", "T_max"
+        "name",
+        "obs",
+        "action",
+        "skills",
+        "T_max"
     );
     for e in envs {
-        println!(
+        outln!(
             "{:<18} {:>7} {:>6} {:>6} {:>5}  {}",
-            e.name, e.obs_dim, e.action_dim, e.num_skills, e.step_limit, e.description
+            e.name,
+            e.obs_dim,
+            e.action_dim,
+            e.num_skills,
+            e.step_limit,
+            e.description
         );
     }
     Ok(())
@@ -88,7 +97,7 @@ pub fn render(args: RenderArgs) -> Result<()> {
     env.reset()?;
     let title = format!("{} (seed {})", args.env, args.seed);
     crate::draw::render_scene(&env.scene(), &title, &args.out)?;
-    println!("wrote {}", args.out.display());
+    outln!("wrote {}", args.out.display());
     Ok(())
 }
 
@@ -164,11 +173,15 @@ pub fn env_bench(args: BenchArgs) -> Result<()> {
         steps_per_sec: steps as f64 / seconds,
     };
     if args.json {
-        println!("{}", serde_json::to_string(&report)?);
+        outln!("{}", serde_json::to_string(&report)?);
     } else {
-        println!(
+        outln!(
             "{}: {} steps on {} thread(s) in {:.3} s = {:.0} steps/s",
-            report.env, steps, report.threads, seconds, report.steps_per_sec
+            report.env,
+            steps,
+            report.threads,
+            seconds,
+            report.steps_per_sec
         );
     }
     Ok(())

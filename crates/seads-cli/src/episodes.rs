@@ -84,7 +84,7 @@ pub fn record(args: RecordArgs) -> Result<()> {
         writeln!(out, "{}", serde_json::to_string(&episode)?)?;
     }
     out.flush()?;
-    println!(
+    outln!(
         "recorded {} episodes of {} steps into {}",
         args.episodes,
         args.steps,
@@ -136,7 +136,7 @@ pub fn replay(args: ReplayArgs) -> Result<()> {
         if args.compare {
             let c = compare(&record, &replayed, m);
             differing += (c.board_mismatches > 0) as usize;
-            println!(
+            outln!(
                 "episode {episodes} (line {}): {} steps, max manipulator deviation {:.3e}, {} board and {} move mismatches",
                 number + 1,
                 c.steps,
@@ -152,7 +152,7 @@ pub fn replay(args: ReplayArgs) -> Result<()> {
         bail!("the board differs from the recording in {differing} of {episodes} episodes");
     }
     if !args.compare {
-        println!("replayed {episodes} episodes into {}", args.out.display());
+        outln!("replayed {episodes} episodes into {}", args.out.display());
     }
     Ok(())
 }

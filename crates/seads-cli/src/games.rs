@@ -74,9 +74,9 @@ pub fn run(cmd: GamesCommand) -> Result<()> {
 
 fn print_report<T: Serialize>(report: &T, json: bool, table: impl Fn(&T) -> String) -> Result<()> {
     if json {
-        println!("{}", serde_json::to_string(report)?);
+        outln!("{}", serde_json::to_string(report)?);
     } else {
-        println!("{}", table(report));
+        outln!("{}", table(report));
     }
     Ok(())
 }

@@ -1,6 +1,17 @@
 //! `seads`: the command line of the SEADS workspace — the only crate that prints.
 #![allow(clippy::print_stdout, clippy::print_stderr)] // printing is this crate's job
 
+/// `println!` that returns a failed write (a full disk behind stdout, `> /dev/full`) as this
+/// function's error, `writing to standard output: …`, instead of panicking. (A closed pipe
+/// ends the process quietly before any write fails: `die_quietly_on_closed_pipes`.)
+macro_rules! outln {
+    ($($arg:tt)*) => {{
+        use std::io::Write as _;
+        writeln!(std::io::stdout().lock(), $($arg)*)
+            .map_err(|e| anyhow::anyhow!("writing to standard output: {e}"))?;
+    }};
+}
+
 mod demo;
 mod draw;
 mod envs;

@@ -53,7 +53,7 @@ pub fn plot(args: PlotArgs) -> Result<()> {
         false,
     )?;
     for path in written {
-        println!("wrote {}", path.display());
+        outln!("wrote {}", path.display());
     }
     Ok(())
 }

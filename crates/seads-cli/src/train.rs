@@ -334,7 +334,7 @@ pub fn drive<L: Shown>(run: &mut Run<L>, quiet: bool) -> Result<()> {
                 format!("epoch {epoch:>6}  steps {steps:>9}  {headline}  {per_s:>6.0} steps/s");
             // A hidden bar (quiet, or output not a terminal) drops `println`: print directly.
             if bar.is_hidden() {
-                println!("{line}");
+                outln!("{line}");
             } else {
                 bar.println(line);
             }
@@ -348,13 +348,13 @@ pub fn drive<L: Shown>(run: &mut Run<L>, quiet: bool) -> Result<()> {
         ));
     }
     bar.finish_and_clear();
-    println!(
+    outln!(
         "trained {} epochs, {} steps in {:.0} s: {headline}; run directory {}",
         run.trainer().epoch(),
         run.trainer().steps(),
         run.wall_s(),
         run.dir().display()
     );
-    println!("time per phase: {}", run.trainer().phases());
+    outln!("time per phase: {}", run.trainer().phases());
     Ok(())
 }

@@ -104,7 +104,7 @@ fn record_corners(arm: &mut Swift, twin: Option<&Twin>, quiet: bool) -> Result<[
         match twin {
             Some(twin) => twin.move_by_hand(twin_screen_corners()[i]),
             None => {
-                println!(
+                outln!(
                     "Move the pen tip onto the {name} corner of the usable screen area, then press Enter."
                 );
                 let mut line = String::new();
@@ -115,9 +115,11 @@ fn record_corners(arm: &mut Swift, twin: Option<&Twin>, quiet: bool) -> Result<[
             .position()
             .with_context(|| format!("reading the {name} corner"))?;
         if !quiet {
-            println!(
+            outln!(
                 "{name}: X {:.1}  Y {:.1}  Z {:.1} mm",
-                corners[i][0], corners[i][1], corners[i][2]
+                corners[i][0],
+                corners[i][1],
+                corners[i][2]
             );
         }
     }
@@ -136,7 +138,7 @@ pub fn calibrate(args: CalibrateArgs) -> Result<()> {
     })
     .map_err(|e| BadInput(e.into()))?;
     calibration.save(&args.out)?;
-    println!(
+    outln!(
         "wrote {} (largest corner distance from the fitted plane {:.2} mm)",
         args.out.display(),
         calibration.plane_residual_mm
@@ -498,7 +500,7 @@ fn evaluate(
     let (solved, tasks) = results
         .iter()
         .fold((0, 0), |(s, t), r| (s + r.solved, t + r.tasks));
-    println!(
+    outln!(
         "solved {solved} of {tasks} boards with re-planning (per depth: {})",
         results
             .iter()

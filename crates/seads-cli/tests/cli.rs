@@ -1196,3 +1196,22 @@ fn training_runs_with_a_short_openmp_spin() {
     );
     assert_eq!(spin_of(Some(("OMP_WAIT_POLICY", "active")), "c"), None);
 }
+
+/// Output errors end with a message, not a panic (issue 32: `seads envs > /dev/full` panicked).
+#[test]
+fn a_full_stdout_is_an_error_message_not_a_panic() {
+    let full = std::fs::File::options()
+        .write(true)
+        .open("/dev/full")
+        .unwrap();
+    let output = std::process::Command::new(env!("CARGO_BIN_EXE_seads"))
+        .arg("envs")
+        .stdout(full)
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&output.stderr);
+    assert_eq!(output.status.code(), Some(1), "{stderr}");
+    assert!(stderr.contains("writing to standard output"), "{stderr}");
+    assert!(!stderr.contains("panicked"), "{stderr}");
+    assert_eq!(stderr.trim().lines().count(), 1, "{stderr}");
+}

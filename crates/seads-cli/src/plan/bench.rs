@@ -130,9 +130,11 @@ pub fn plan_bench(args: PlanBenchArgs) -> Result<()> {
         }
         row.mean_s = row.seconds.iter().sum::<f64>() / row.seconds.len() as f64;
         if !args.json {
-            println!(
+            outln!(
                 "depth {depth}: mean {:.3} s per plan over {} boards (plan lengths {:?})",
-                row.mean_s, args.boards, row.plan_lengths
+                row.mean_s,
+                args.boards,
+                row.plan_lengths
             );
         }
         report.depths.push(row);
@@ -141,16 +143,19 @@ pub fn plan_bench(args: PlanBenchArgs) -> Result<()> {
     let after = model.screen_counts();
     (report.screened, report.recomputed) = (after.0 - before.0, after.1 - before.1);
     if args.json {
-        println!("{}", serde_json::to_string(&report)?);
+        outln!("{}", serde_json::to_string(&report)?);
     } else {
-        println!(
+        outln!(
             "model hidden {:?}, agreement with the move table {:.5}, peak memory {:.0} MiB",
-            args.hidden, agreement, report.peak_rss_mib
+            args.hidden,
+            agreement,
+            report.peak_rss_mib
         );
         if !args.float32 {
-            println!(
+            outln!(
                 "8-bit screen: {} (state, skill) pairs, {} of them computed again in float32",
-                report.screened, report.recomputed
+                report.screened,
+                report.recomputed
             );
         }
     }

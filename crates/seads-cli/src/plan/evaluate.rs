@@ -123,21 +123,21 @@ pub fn evaluate_run(args: EvaluateArgs) -> Result<()> {
             .filter(|l| l.protocol() == crate::overtraining::protocol(&tasks, limits, l.replan))
             .collect();
         if args.json {
-            println!("{}", serde_json::to_string(&lines)?);
+            outln!("{}", serde_json::to_string(&lines)?);
         } else {
-            println!(
+            outln!(
                 "{added} new evaluation(s); {} in {}",
                 lines.len(),
                 args.run.join(crate::overtraining::FILE).display()
             );
-            println!("     epoch   env steps  mode            success per depth");
+            outln!("     epoch   env steps  mode            success per depth");
             for l in &lines {
                 let rates: Vec<String> = l
                     .results
                     .iter()
                     .map(|r| format!("{:.0}%", 100.0 * r.solved as f64 / r.tasks.max(1) as f64))
                     .collect();
-                println!(
+                outln!(
                     "{:>10}  {:>10}  {:<14}  {}",
                     l.epoch,
                     l.env_steps,
@@ -163,9 +163,9 @@ pub fn evaluate_run(args: EvaluateArgs) -> Result<()> {
     let results = record.results;
     let summary = summarise(&results);
     if args.json {
-        println!("{}", serde_json::to_string(&summary)?);
+        outln!("{}", serde_json::to_string(&summary)?);
     } else {
-        println!(
+        outln!(
             "{} (epoch {}), {}, {} boards per depth",
             agent.config.env,
             agent.epoch,
@@ -176,11 +176,11 @@ pub fn evaluate_run(args: EvaluateArgs) -> Result<()> {
             },
             args.boards
         );
-        println!(" depth  success  plan found  search s  median steps  median skill steps");
+        outln!(" depth  success  plan found  search s  median steps  median skill steps");
         for r in &results {
             let key = r.depth;
             let fmt = |v: Option<f64>| v.map_or("-".to_owned(), |x| format!("{x:.1}"));
-            println!(
+            outln!(
                 "{:>6}  {:>6.0}%  {:>9.0}%  {:>8.3}  {:>12}  {:>18}",
                 r.depth,
                 summary.success_rate[&key] * 100.0,
@@ -209,16 +209,16 @@ fn evaluate_policy(
     let results = record.results;
     let summary = summarise(&results);
     if args.json {
-        println!("{}", serde_json::to_string(&summary)?);
+        outln!("{}", serde_json::to_string(&summary)?);
     } else {
-        println!(
+        outln!(
             "{} ({}), its policy alone, {} boards per depth",
             args.run.display(),
             checkpoint.display(),
             args.boards
         );
         for r in &results {
-            println!("depth {}: {}/{} solved", r.depth, r.solved, r.tasks);
+            outln!("depth {}: {}/{} solved", r.depth, r.solved, r.tasks);
         }
     }
     Ok(())

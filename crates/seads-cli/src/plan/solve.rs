@@ -85,7 +85,7 @@ pub fn solve_board(args: SolveArgs) -> Result<()> {
             checkpoint: agent.checkpoint.display().to_string(),
             outcome: &outcome,
         };
-        println!("{}", serde_json::to_string(&report)?);
+        outln!("{}", serde_json::to_string(&report)?);
     } else {
         let list = |v: &[usize]| {
             v.iter()
@@ -94,7 +94,7 @@ pub fn solve_board(args: SolveArgs) -> Result<()> {
                 .join(" ")
         };
         if outcome.plan_found {
-            println!(
+            outln!(
                 "plan ({} skills): {}   search {:.3} s over {} plan(s)",
                 outcome.first_plan.len(),
                 list(&outcome.first_plan),
@@ -102,15 +102,15 @@ pub fn solve_board(args: SolveArgs) -> Result<()> {
                 outcome.plans
             );
         }
-        println!(
+        outln!(
             "executed skills: {}   manipulator steps per skill: {}",
             list(&outcome.executed),
             list(&outcome.skill_steps)
         );
         match &outcome.failure {
-            None if outcome.executed.is_empty() => println!("the board is already solved"),
-            None => println!("solved in {} manipulator steps", outcome.manipulator_steps),
-            Some(why) => println!("not solved: {why}"),
+            None if outcome.executed.is_empty() => outln!("the board is already solved"),
+            None => outln!("solved in {} manipulator steps", outcome.manipulator_steps),
+            Some(why) => outln!("not solved: {why}"),
         }
     }
     Ok(())

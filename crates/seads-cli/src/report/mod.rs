@@ -198,7 +198,7 @@ pub fn report(args: ReportArgs) -> Result<()> {
         );
     }
     write("report.md", &md)?;
-    println!(
+    outln!(
         "report of {} finished run(s) in {} groups: {} (and {} figure files)",
         collection.runs.len() - unfinished.len(),
         groups.len(),

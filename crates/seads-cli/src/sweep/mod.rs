@@ -182,21 +182,21 @@ fn plan(args: PlanArgs) -> Result<()> {
         Manifest::parse(&text, &args.manifest.display().to_string()).map_err(BadInput)?;
     let planned = Sweep::plan(&manifest, &text, &args.out).map_err(BadInput)?;
     if planned.created == 0 {
-        println!(
+        outln!(
             "sweep {:?} in {} is already planned ({} runs); nothing changed",
             manifest.name,
             args.out.display(),
             planned.runs
         );
     } else {
-        println!(
+        outln!(
             "planned sweep {:?}: {} runs ({} new) in {}",
             manifest.name,
             planned.runs,
             planned.created,
             args.out.display()
         );
-        println!(
+        outln!(
             "next: seads sweep run {}   or   seads sweep slurm {} --submit",
             args.out.display(),
             args.out.display()
@@ -229,16 +229,16 @@ fn slurm(args: SlurmArgs) -> Result<()> {
         seads,
     };
     let (array, report) = slurm::write_scripts(&dir, &sweep, &options)?;
-    println!("wrote {} and {}", array.display(), report.display());
+    outln!("wrote {} and {}", array.display(), report.display());
     if args.submit {
         let (array_id, report_id) = slurm::submit(&array, &report)?;
-        println!(
+        outln!(
             "submitted job array {array_id} ({} tasks) and report job {report_id}",
             sweep.runs.len()
         );
-        println!("follow with: seads sweep status {}", dir.display());
+        outln!("follow with: seads sweep status {}", dir.display());
     } else {
-        println!(
+        outln!(
             "submit with: sbatch {}, then sbatch --dependency=afterany:<array id> {}",
             array.display(),
             report.display()
@@ -306,14 +306,14 @@ fn status(args: StatusArgs) -> Result<()> {
             copied: count(Status::Copied),
             runs: &rows,
         };
-        println!("{}", serde_json::to_string(&report)?);
+        outln!("{}", serde_json::to_string(&report)?);
         return Ok(());
     }
-    println!(
+    outln!(
         " index  status   env                variant                   seed      steps / budget  tries"
     );
     for r in &rows {
-        println!(
+        outln!(
             "{:>6}  {:<7}  {:<17}  {:<24}  {:>4}  {:>9} / {:<9} {:>3}{}",
             r.index,
             r.status.name(),
@@ -330,7 +330,7 @@ fn status(args: StatusArgs) -> Result<()> {
         );
     }
     let copied = count(Status::Copied);
-    println!(
+    outln!(
         "sweep {:?}: {} runs: {} done, {} running, {} failed, {} pending{}",
         sweep.name,
         rows.len(),

@@ -88,7 +88,7 @@ pub fn run_sweep(
     } else {
         String::new()
     };
-    println!(
+    outln!(
         "sweep {:?}: {} runs{of_seeds}, {} to train or resume, {skipped_running} running elsewhere{of_copied}; {workers} worker(s) × {per_task} core(s)",
         sweep.name,
         sweep.runs.len(),
@@ -190,13 +190,13 @@ pub fn run_sweep(
     for f in finished.into_inner().expect("finished lock") {
         let run = dir.join(&sweep.runs[f.index].dir);
         match f.ok {
-            None => println!(
+            None => outln!(
                 "elsewhere {} (taken by another task meanwhile)",
                 run.display()
             ),
-            Some(true) => println!("done    {}", run.display()),
+            Some(true) => outln!("done    {}", run.display()),
             Some(false) => {
-                println!(
+                outln!(
                     "failed  {} (see {})",
                     run.display(),
                     run.join(LOG).display()
@@ -213,8 +213,8 @@ pub fn run_sweep(
         );
     }
     match seeds {
-        None => println!("sweep {:?} complete", sweep.name),
-        Some(_) => println!("sweep {:?}: the chosen seeds are complete", sweep.name),
+        None => outln!("sweep {:?} complete", sweep.name),
+        Some(_) => outln!("sweep {:?}: the chosen seeds are complete", sweep.name),
     }
     Ok(())
 }

@@ -36,7 +36,7 @@ pub fn run_task(dir: &Path, index: usize, cores: usize, patience: Duration) -> R
         .as_ref()
         .is_some_and(|r| r.outcome == Outcome::Done)
     {
-        println!("{}: already done", run.display());
+        outln!("{}: already done", run.display());
         return Ok(());
     }
     // Training it again from scratch would replace the data it holds; nothing is recorded, so
@@ -78,7 +78,7 @@ fn train_and_evaluate(sweep: &Sweep, run: &Path, cores: usize) -> Result<()> {
         }),
     )?;
     if !training.finished() {
-        println!(
+        outln!(
             "{}: training from epoch {} with {threads} libtorch thread(s) per training thread",
             run.display(),
             training.trainer().epoch()
@@ -88,7 +88,7 @@ fn train_and_evaluate(sweep: &Sweep, run: &Path, cores: usize) -> Result<()> {
     drop(training);
     let plan = &sweep.evaluation;
     if config.skill_model.kind == SkillModelKind::Vic {
-        println!(
+        outln!(
             "{}: a VIC agent cannot plan; no task evaluation",
             run.display()
         );
@@ -103,7 +103,7 @@ fn train_and_evaluate(sweep: &Sweep, run: &Path, cores: usize) -> Result<()> {
             plan.limits(),
             true,
         )?;
-        println!(
+        outln!(
             "{}: {added} checkpoint evaluation(s) over training",
             run.display()
         );
@@ -119,7 +119,7 @@ fn train_and_evaluate(sweep: &Sweep, run: &Path, cores: usize) -> Result<()> {
             let results = run_evaluation(&mut agent, run, &protocol, true)?.results;
             let solved: usize = results.iter().map(|r| r.solved).sum();
             let tasks: usize = results.iter().map(|r| r.tasks).sum();
-            println!(
+            outln!(
                 "{}: {} {solved}/{tasks} solved",
                 run.display(),
                 if replan {
@@ -146,7 +146,7 @@ fn train_and_evaluate_baseline<L: Shown>(sweep: &Sweep, run: &Path, cores: usize
     )?;
     let config = training.trainer().config().clone();
     if !training.finished() {
-        println!(
+        outln!(
             "{}: training the {} baseline from epoch {} with {} libtorch thread(s)",
             run.display(),
             config.algorithm.name().to_uppercase(),
@@ -169,7 +169,7 @@ fn train_and_evaluate_baseline<L: Shown>(sweep: &Sweep, run: &Path, cores: usize
         .results;
         let solved: usize = results.iter().map(|r| r.solved).sum();
         let tasks: usize = results.iter().map(|r| r.tasks).sum();
-        println!("{}: policy {solved}/{tasks} solved", run.display());
+        outln!("{}: policy {solved}/{tasks} solved", run.display());
     }
     Ok(())
 }
