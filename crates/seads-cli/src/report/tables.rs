@@ -91,9 +91,9 @@ pub fn coverage_markdown(cells: &[CoverageCell], reference: Option<&str>) -> Str
                     } else {
                         value
                     };
-                    let test = c
-                        .test
-                        .map_or(String::new(), |t| format!("; U = {}, p = {:.4}", t.u, t.p));
+                    let test = c.test.map_or(String::new(), |t| {
+                        format!("; U = {}, p = {:.4}, exact {:.4}", t.u, t.p, t.p_exact)
+                    });
                     let _ = write!(md, " {value} (n = {}{test}) |", c.summary.n);
                 }
             }
@@ -105,8 +105,8 @@ pub fn coverage_markdown(cells: &[CoverageCell], reference: Option<&str>) -> Str
         "\nMean ± sample standard deviation of the skill coverage at the end of training (distinct game \
          moves of the K skills, mean over 20 test initialisations). U and p: one-sided Mann–Whitney U \
          test that the variant is worse than `{}` (SciPy's `mannwhitneyu(variant, reference, \
-         alternative=\"less\")`: exact without ties for up to 8 values, tie-corrected normal otherwise); \
-         **bold**: p < 0.01.\n",
+         alternative=\"less\")`: exact without ties for up to 8 values, tie-corrected normal otherwise), \
+         and its exact permutation p with ties kept (SciPy's `permutation_test`); **bold**: both p < 0.01.\n",
         reference.unwrap_or("-")
     );
     md
@@ -114,21 +114,24 @@ pub fn coverage_markdown(cells: &[CoverageCell], reference: Option<&str>) -> Str
 
 /// Table 1 as CSV.
 pub fn coverage_csv(cells: &[CoverageCell]) -> String {
-    let mut csv = String::from("env,variant,skills,n,mean,std,min,max,u,p,significantly_worse\n");
+    let mut csv =
+        String::from("env,variant,skills,n,mean,std,min,max,u,p,p_exact,significantly_worse\n");
     for c in cells {
         let s = &c.summary;
-        let (u, p, sig) = c
-            .test
-            .map_or((String::new(), String::new(), String::new()), |t| {
+        let (u, p, p_exact, sig) = c.test.map_or(
+            (String::new(), String::new(), String::new(), String::new()),
+            |t| {
                 (
                     t.u.to_string(),
                     format!("{:.6}", t.p),
+                    format!("{:.6}", t.p_exact),
                     t.significant().to_string(),
                 )
-            });
+            },
+        );
         let _ = writeln!(
             csv,
-            "{},{},{},{},{:.4},{:.4},{:.4},{:.4},{u},{p},{sig}",
+            "{},{},{},{},{:.4},{:.4},{:.4},{:.4},{u},{p},{p_exact},{sig}",
             c.env, c.variant, c.skills, s.n, s.mean, s.std, s.min, s.max
         );
     }
@@ -278,9 +281,12 @@ pub fn success_comparison(groups: &[Group<'_>], reference: Option<&str>) -> Opti
         let (value, test) = match test {
             Some(t) if t.significant() => (
                 format!("**{value}**"),
-                format!("U = {}, p = {:.4}", t.u, t.p),
+                format!("U = {}, p = {:.4}, exact {:.4}", t.u, t.p, t.p_exact),
             ),
-            Some(t) => (value, format!("U = {}, p = {:.4}", t.u, t.p)),
+            Some(t) => (
+                value,
+                format!("U = {}, p = {:.4}, exact {:.4}", t.u, t.p, t.p_exact),
+            ),
             None => (value, String::from("–")),
         };
         let _ = writeln!(
@@ -296,8 +302,8 @@ pub fn success_comparison(groups: &[Group<'_>], reference: Option<&str>) -> Opti
         md,
         "\nShare of all test tasks (every depth) solved at the end of training, mean ± sample \
          standard deviation over the runs; SEADS with re-planning, a baseline's policy acting alone. \
-         U and p: one-sided Mann–Whitney U test that the variant solves less than `{}`; **bold**: \
-         p < 0.01.\n",
+         U and p: one-sided Mann–Whitney U test that the variant solves less than `{}` (SciPy's p, \
+         and the exact permutation p with ties kept); **bold**: both p < 0.01.\n",
         reference.unwrap_or("-")
     );
     Some(md)
