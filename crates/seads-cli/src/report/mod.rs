@@ -4,6 +4,7 @@
 //! training time went, coverage and success curves and length box plots — written to
 //! `report.md`, CSV files and PNG + SVG figures.
 
+mod curves;
 mod failed_tasks;
 mod failures;
 mod figures;
@@ -70,6 +71,10 @@ pub fn report(args: ReportArgs) -> Result<()> {
     };
     let cells = tables::coverage_cells(&groups, reference.as_deref());
     write("table1.csv", &tables::coverage_csv(&cells))?;
+    let over_training = curves::coverage_over_training(&groups, reference.as_deref());
+    if let Some((_, csv)) = &over_training {
+        write("coverage-over-training.csv", csv)?;
+    }
     let (success_md, success_csv) = tables::success_tables(&groups);
     write("success.csv", &success_csv)?;
     let (length_md, length_csv) = tables::length_tables(&groups);
@@ -127,6 +132,11 @@ pub fn report(args: ReportArgs) -> Result<()> {
     let _ = writeln!(md, "## Skill coverage at the end of training (Table 1)\n");
     md += &tables::coverage_markdown(&cells, reference.as_deref());
     let _ = writeln!(md, "\nAs CSV: `table1.csv`.\n");
+    if let Some((curve_md, _)) = &over_training {
+        let _ = writeln!(md, "## Skill coverage over training\n");
+        md += curve_md;
+        let _ = writeln!(md, "\nAs CSV: `coverage-over-training.csv`.\n");
+    }
     let _ = writeln!(md, "## Task success at the end of training\n");
     md += &success_md;
     md += &evaluation_notes(&collection.runs);
