@@ -1215,3 +1215,65 @@ fn a_full_stdout_is_an_error_message_not_a_panic() {
     assert!(!stderr.contains("panicked"), "{stderr}");
     assert_eq!(stderr.trim().lines().count(), 1, "{stderr}");
 }
+
+/// Reports never hide damage (issue 32): a run whose metrics start with a garbage line, or whose
+/// evaluation file is garbage, or whose configuration cannot be read, is listed as damaged with
+/// why and left out of the tables, not counted as "not started" or dropped without a word.
+#[test]
+fn a_report_lists_damaged_runs_with_why() {
+    let dir = tempfile::tempdir().unwrap();
+    let copy = |name: &str| {
+        let to = dir.path().join(name);
+        let status = std::process::Command::new("cp")
+            .arg("-r")
+            .arg(tiny_run().join("run"))
+            .arg(&to)
+            .status()
+            .unwrap();
+        assert!(status.success());
+        to
+    };
+    let (good, metrics, evaluation, config) = (
+        copy("good"),
+        copy("metrics"),
+        copy("evaluation"),
+        copy("config"),
+    );
+    let text = std::fs::read_to_string(metrics.join("metrics.jsonl")).unwrap();
+    std::fs::write(metrics.join("metrics.jsonl"), format!("garbage\n{text}")).unwrap();
+    std::fs::write(evaluation.join("evaluation-replan.json"), "{ not json").unwrap();
+    std::fs::write(config.join("config.toml"), "env = 3").unwrap();
+    let out = dir.path().join("report");
+    let s = |p: &std::path::Path| p.to_str().unwrap().to_owned();
+    let output = seads(&[
+        "report",
+        &s(&good),
+        &s(&metrics),
+        &s(&evaluation),
+        &s(&config),
+        "--out",
+        &s(&out),
+    ]);
+    assert!(output.status.success(), "{output:?}");
+    let md = std::fs::read_to_string(out.join("report.md")).unwrap();
+    assert!(
+        md.contains("1 finished, 0 unfinished and 3 damaged"),
+        "{md}"
+    );
+    for (run, why) in [
+        (&metrics, "metrics.jsonl"),
+        (&evaluation, "evaluation-replan.json"),
+        (&config, "config.toml"),
+    ] {
+        let line = md
+            .lines()
+            .find(|l| l.starts_with("- damaged") && l.contains(&s(run)))
+            .unwrap_or_else(|| panic!("{} is not listed as damaged:\n{md}", run.display()));
+        assert!(line.contains(why), "{line}");
+    }
+    assert!(md.contains("| good |"), "{md}");
+    assert!(
+        !md.contains("| metrics |"),
+        "a damaged run is in no table: {md}"
+    );
+}

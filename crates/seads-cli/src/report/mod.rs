@@ -102,12 +102,19 @@ pub fn report(args: ReportArgs) -> Result<()> {
         collection.sweeps.join(", ")
     };
     let _ = writeln!(md, "# Report: {title}\n");
+    let damaged = collection
+        .runs
+        .iter()
+        .filter(|r| !r.damage.is_empty())
+        .count()
+        + collection.unreadable.len();
+    let finished = groups.iter().map(|g| g.runs.len()).sum::<usize>();
     let _ = writeln!(
         md,
-        "Written by `seads report` from {} run(s): {} finished, {} unfinished (left out of every table and figure).\n",
-        collection.runs.len(),
-        collection.runs.len() - unfinished.len(),
-        unfinished.len()
+        "Written by `seads report` from {} run(s): {finished} finished, {} unfinished and {damaged} \
+         damaged (left out of every table and figure).\n",
+        collection.runs.len() + collection.unreadable.len(),
+        unfinished.len(),
     );
     let mut not_started = 0;
     for run in &unfinished {
@@ -126,7 +133,22 @@ pub fn report(args: ReportArgs) -> Result<()> {
     if not_started > 0 {
         let _ = writeln!(md, "- not started: {not_started} run(s)");
     }
-    if !unfinished.is_empty() {
+    for run in collection.runs.iter().filter(|r| !r.damage.is_empty()) {
+        let _ = writeln!(
+            md,
+            "- damaged, left out of every table: `{}`: {}",
+            run.dir.display(),
+            run.damage.join("; ")
+        );
+    }
+    for (dir, why) in &collection.unreadable {
+        let _ = writeln!(
+            md,
+            "- damaged, left out of every table: `{}`: {why}",
+            dir.display()
+        );
+    }
+    if !unfinished.is_empty() || damaged > 0 {
         md.push('\n');
     }
     let _ = writeln!(md, "## Skill coverage at the end of training (Table 1)\n");
@@ -208,9 +230,11 @@ pub fn report(args: ReportArgs) -> Result<()> {
         );
     }
     write("report.md", &md)?;
+    if damaged > 0 {
+        eprintln!("seads: {damaged} damaged run(s) left out; report.md lists them with why");
+    }
     outln!(
-        "report of {} finished run(s) in {} groups: {} (and {} figure files)",
-        collection.runs.len() - unfinished.len(),
+        "report of {finished} finished run(s) in {} groups: {} (and {} figure files)",
         groups.len(),
         args.out.join("report.md").display(),
         figures.len()

@@ -42,6 +42,9 @@ pub struct RunData {
     /// Evaluation files taken as the end of training although they do not record their
     /// checkpoint (written before evaluations did).
     pub unrecorded_evaluations: usize,
+    /// Files of the run that could not be read, with why: such a run is left out of every
+    /// table and listed as damaged.
+    pub damage: Vec<String>,
 }
 
 impl RunData {
@@ -65,12 +68,30 @@ impl RunData {
 
     fn load(dir: &Path, variant: String, copy_to: PathBuf) -> Result<Self> {
         let config = seads_rl::load_config(dir)?;
+        let mut damage = Vec::new();
+        // No metrics file: not started. A file that cannot be read is damage, never "not started".
+        let started = dir.join("metrics.jsonl").exists();
         let (metrics, task_metrics) = match config.algorithm {
-            Algorithm::Seads => (seads_rl::read_metrics(dir).unwrap_or_default(), Vec::new()),
-            Algorithm::Sac | Algorithm::Hac => (
-                Vec::new(),
-                seads_rl::read_metrics_as::<TaskMetrics>(dir).unwrap_or_default(),
-            ),
+            Algorithm::Seads => match seads_rl::read_metrics(dir) {
+                Ok(m) => (m, Vec::new()),
+                Err(e) => {
+                    if started {
+                        damage.push(format!("{e:#}"));
+                    }
+                    (Vec::new(), Vec::new())
+                }
+            },
+            Algorithm::Sac | Algorithm::Hac => {
+                match seads_rl::read_metrics_as::<TaskMetrics>(dir) {
+                    Ok(m) => (Vec::new(), m),
+                    Err(e) => {
+                        if started {
+                            damage.push(format!("{e:#}"));
+                        }
+                        (Vec::new(), Vec::new())
+                    }
+                }
+            }
         };
         // The last epoch of training: an evaluation of the end of training names it.
         let last_epoch = match config.algorithm {
@@ -81,8 +102,13 @@ impl RunData {
         let mut unrecorded_evaluations = 0;
         let mut evaluation = |kind: EvaluationKind| -> Result<Option<Vec<DepthResult>>> {
             let file = kind.results_file(&STANDARD_DEPTHS, None);
-            let Some(record) = crate::plan::read_evaluation(&dir.join(&file))? else {
-                return Ok(None);
+            let record = match crate::plan::read_evaluation(&dir.join(&file)) {
+                Ok(Some(record)) => record,
+                Ok(None) => return Ok(None),
+                Err(e) => {
+                    damage.push(format!("{e:#}"));
+                    return Ok(None);
+                }
             };
             match record.checkpoint {
                 Some(c) if Some(c.epoch) != last_epoch => {
@@ -114,6 +140,7 @@ impl RunData {
             policy,
             evaluation_notes,
             unrecorded_evaluations,
+            damage,
             over_training: crate::overtraining::read(dir)?,
             processors: crate::provenance::Provenance::processors(dir)
                 .with_context(|| format!("reading the provenance of {}", dir.display()))?,
@@ -134,6 +161,8 @@ pub struct Collection {
     pub sweeps: Vec<String>,
     /// Their directories.
     pub sweep_dirs: Vec<PathBuf>,
+    /// Run directories whose configuration cannot be read, with why (left out, listed).
+    pub unreadable: Vec<(PathBuf, String)>,
 }
 
 /// Reads the sweeps and runs in `inputs`.
@@ -143,16 +172,21 @@ pub fn collect(inputs: &[PathBuf]) -> Result<Collection> {
         reference: None,
         sweeps: Vec::new(),
         sweep_dirs: Vec::new(),
+        unreadable: Vec::new(),
     };
     for input in inputs {
         if input.join(crate::sweep::INDEX).is_file() {
             let sweep = Sweep::load(input)?;
             for run in &sweep.runs {
-                collection.runs.push(RunData::load(
-                    &input.join(&run.dir),
+                let dir = input.join(&run.dir);
+                match RunData::load(
+                    &dir,
                     run.variant.clone(),
                     Path::new(&sweep.name).join(&run.dir),
-                )?);
+                ) {
+                    Ok(data) => collection.runs.push(data),
+                    Err(e) => collection.unreadable.push((dir, format!("{e:#}"))),
+                }
             }
             collection.reference.get_or_insert(sweep.reference.clone());
             collection.sweeps.push(sweep.name);
@@ -162,9 +196,12 @@ pub fn collect(inputs: &[PathBuf]) -> Result<Collection> {
                 || input.display().to_string(),
                 |n| n.to_string_lossy().into_owned(),
             );
-            collection
-                .runs
-                .push(RunData::load(input, name.clone(), PathBuf::from(name))?);
+            match RunData::load(input, name.clone(), PathBuf::from(name)) {
+                Ok(data) => collection.runs.push(data),
+                Err(e) => collection
+                    .unreadable
+                    .push((input.clone(), format!("{e:#}"))),
+            }
         } else if input.is_dir() {
             bail!(
                 "{} is neither a sweep (sweep.json) nor a run directory (config.toml)",
@@ -175,7 +212,13 @@ pub fn collect(inputs: &[PathBuf]) -> Result<Collection> {
         }
     }
     if collection.runs.is_empty() {
-        bail!("no runs to report on");
+        match collection.unreadable.first() {
+            Some((dir, why)) => bail!(
+                "no runs to report on: {} cannot be read: {why}",
+                dir.display()
+            ),
+            None => bail!("no runs to report on"),
+        }
     }
     Ok(collection)
 }
@@ -192,12 +235,15 @@ pub struct Group<'a> {
 
 /// Finished runs grouped by environment, then variant (in the order first seen); the runs of a
 /// group must share the environment's options (board size, spacing, depths), since a row of
-/// the table is one environment. Unfinished runs are returned apart.
+/// the table is one environment. Unfinished runs are returned apart; damaged runs are in neither.
 pub fn group(runs: &[RunData]) -> Result<(Vec<Group<'_>>, Vec<&RunData>)> {
     let mut groups: Vec<Group<'_>> = Vec::new();
     let mut unfinished = Vec::new();
     let mut env_configs: BTreeMap<(String, String), (String, PathBuf)> = BTreeMap::new();
     for run in runs {
+        if !run.damage.is_empty() {
+            continue; // listed apart by the report, in no table
+        }
         if !run.finished() {
             unfinished.push(run);
             continue;

@@ -172,6 +172,7 @@ mod tests {
             },
             evaluation_notes: Vec::new(),
             unrecorded_evaluations: 0,
+            damage: Vec::new(),
         }
     }
 
