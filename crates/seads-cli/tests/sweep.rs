@@ -707,3 +707,33 @@ fn killing_sweep_run_at_any_point_loses_nothing() {
         }
     }
 }
+
+/// A sweep degrades per run (issue 32): one run whose task record cannot be read shows as
+/// `damaged` with why, while `sweep status` lists the others as before (it failed whole).
+#[test]
+fn an_unreadable_task_record_damages_its_run_only() {
+    let tmp = tempfile::tempdir().unwrap();
+    let manifest = write_manifest(tmp.path(), MANIFEST);
+    let sweep = tmp.path().join("sweep");
+    seads_ok(&["sweep", "plan", s(&manifest), "--out", s(&sweep)]);
+    let broken = sweep.join("runs/lightsout-cursor/seads/seed-1");
+    std::fs::write(broken.join("task.json"), "{ not a record").unwrap();
+    let status = status_json(&sweep);
+    assert_eq!(status["damaged"], 1, "{status}");
+    assert_eq!(status["pending"], 3, "{status}");
+    let runs = status["runs"].as_array().unwrap();
+    let damaged: Vec<&serde_json::Value> =
+        runs.iter().filter(|r| r["status"] == "damaged").collect();
+    assert_eq!(damaged.len(), 1);
+    assert!(
+        damaged[0]["dir"]
+            .as_str()
+            .unwrap()
+            .ends_with("seads/seed-1")
+            && damaged[0]["error"].as_str().unwrap().contains("task.json"),
+        "{status}"
+    );
+    let text =
+        String::from_utf8_lossy(&seads_ok(&["sweep", "status", s(&sweep)]).stdout).into_owned();
+    assert!(text.contains("1 damaged"), "{text}");
+}

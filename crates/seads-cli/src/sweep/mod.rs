@@ -280,7 +280,10 @@ fn status(args: StatusArgs) -> Result<()> {
             env_steps,
             budget,
             attempts: record.as_ref().map_or(0, |r| r.attempts),
-            error: record.and_then(|r| r.error),
+            error: match status {
+                Status::Damaged => state::damage(&dir),
+                _ => record.and_then(|r| r.error),
+            },
         });
     }
     let count = |s: Status| rows.iter().filter(|r| r.status == s).count();
@@ -294,6 +297,7 @@ fn status(args: StatusArgs) -> Result<()> {
             failed: usize,
             pending: usize,
             copied: usize,
+            damaged: usize,
             runs: &'a [RunStatus],
         }
         let report = Report {
@@ -304,6 +308,7 @@ fn status(args: StatusArgs) -> Result<()> {
             failed: count(Status::Failed),
             pending: count(Status::Pending),
             copied: count(Status::Copied),
+            damaged: count(Status::Damaged),
             runs: &rows,
         };
         outln!("{}", serde_json::to_string(&report)?);
@@ -330,8 +335,9 @@ fn status(args: StatusArgs) -> Result<()> {
         );
     }
     let copied = count(Status::Copied);
+    let damaged = count(Status::Damaged);
     outln!(
-        "sweep {:?}: {} runs: {} done, {} running, {} failed, {} pending{}",
+        "sweep {:?}: {} runs: {} done, {} running, {} failed, {} pending{}{}",
         sweep.name,
         rows.len(),
         count(Status::Done),
@@ -340,6 +346,11 @@ fn status(args: StatusArgs) -> Result<()> {
         count(Status::Pending),
         if copied > 0 {
             format!(", {copied} copied in without checkpoints")
+        } else {
+            String::new()
+        },
+        if damaged > 0 {
+            format!(", {damaged} damaged (left alone; see their errors)")
         } else {
             String::new()
         }

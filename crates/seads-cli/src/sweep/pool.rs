@@ -75,6 +75,13 @@ pub fn run_sweep(
             Status::Done => {}
             Status::Copied => copied += 1,
             Status::Running => skipped_running += 1,
+            Status::Damaged => {
+                eprintln!(
+                    "seads: {}: damaged, left alone: {}",
+                    run.display(),
+                    super::state::damage(&run).unwrap_or_default()
+                );
+            }
             Status::Failed | Status::Pending => todo.push(i),
         }
     }
@@ -129,7 +136,7 @@ pub fn run_sweep(
                     // since this one listed it: leave it to that one.
                     if matches!(
                         status(&run)?.0,
-                        Status::Running | Status::Done | Status::Copied
+                        Status::Running | Status::Done | Status::Copied | Status::Damaged
                     ) {
                         let mut finished = finished.lock().expect("finished lock");
                         finished.push(Finished { index, ok: None });

@@ -150,16 +150,20 @@ pub enum Status {
     /// Its data was copied in without checkpoints (`seads report --copy-runs`, copied back into
     /// a sweep): reported as it is, never trained further.
     Copied,
+    /// Its task record cannot be read: shown with why ([`damage`]), left alone by `sweep run`
+    /// while the other runs go on.
+    Damaged,
 }
 
 impl Status {
     /// Every status, in the order of the summary.
-    pub const ALL: [Status; 5] = [
+    pub const ALL: [Status; 6] = [
         Self::Done,
         Self::Running,
         Self::Failed,
         Self::Pending,
         Self::Copied,
+        Self::Damaged,
     ];
 
     /// Lower-case name.
@@ -170,6 +174,7 @@ impl Status {
             Self::Failed => "failed",
             Self::Pending => "pending",
             Self::Copied => "copied",
+            Self::Damaged => "damaged",
         }
     }
 }
@@ -178,7 +183,11 @@ impl Status {
 /// checkpoints are removed; one whose data was copied in without them, with no record of a
 /// finished task, is [`Status::Copied`].
 pub fn status(run: &Path) -> Result<(Status, Option<Record>)> {
-    let record = Record::read(run)?;
+    let record = match Record::read(run) {
+        Ok(record) => record,
+        Err(_) if is_claimed(run) => return Ok((Status::Running, None)),
+        Err(_) => return Ok((Status::Damaged, None)),
+    };
     let status = if is_claimed(run) {
         Status::Running
     } else {
@@ -190,6 +199,11 @@ pub fn status(run: &Path) -> Result<(Status, Option<Record>)> {
         }
     };
     Ok((status, record))
+}
+
+/// Why `run` is [`Status::Damaged`]: its task record cannot be read (`None` if it can).
+pub fn damage(run: &Path) -> Option<String> {
+    Record::read(run).err().map(|e| format!("{e:#}"))
 }
 
 #[cfg(test)]
