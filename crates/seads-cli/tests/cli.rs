@@ -688,41 +688,6 @@ fn replay_reports_bad_lines_with_their_number() {
     assert_eq!(std::fs::read(&good).unwrap(), before, "the input is intact");
 }
 
-/// `uarm train --boards 0` is refused (issue 32: it reported "solved 0 of 0 boards"), as is an
-/// absurd calibration file.
-#[test]
-fn uarm_refuses_no_boards_and_absurd_calibrations() {
-    let dir = tempfile::tempdir().unwrap();
-    let out = dir.path().join("run");
-    for command in ["train", "evaluate"] {
-        let output = seads(&[
-            "uarm", command, "--port", "sim", "--boards", "0", "--run", "x", "--out", "y",
-        ]);
-        assert_eq!(output.status.code(), Some(2), "{command}");
-        assert!(!out.exists());
-    }
-    let cal = dir.path().join("cal.toml");
-    std::fs::write(
-        &cal,
-        "corners = [[180.0, -60.0, 20.0], [180.0, 60.0, 20.0], [300.0, 60.0, 20.0], [300.0, -60.0, 20.0]]\nd_max_mm = 1e300\n",
-    )
-    .unwrap();
-    check_bad_input(
-        &[
-            "uarm",
-            "train",
-            "--port",
-            "sim",
-            "--calibration",
-            cal.to_str().unwrap(),
-            "--out",
-            out.to_str().unwrap(),
-        ],
-        "reach",
-    );
-    assert!(!out.exists(), "a refused calibration writes nothing");
-}
-
 #[test]
 fn uarm_twin_calibrates_and_trains() {
     let dir = tempfile::tempdir().unwrap();
@@ -951,6 +916,28 @@ fn uarm_rejects_bad_input() {
         ],
         "line",
     );
+    // Issue 32: absurd sizes (a height scale of 1e300 mm) and no test boards.
+    std::fs::write(
+        &cal,
+        "corners = [[180.0, -60.0, 20.0], [180.0, 60.0, 20.0], [300.0, 60.0, 20.0], [300.0, -60.0, 20.0]]\nd_max_mm = 1e300\n",
+    )
+    .unwrap();
+    for (extra, needle) in [
+        (["--calibration", cal.to_str().unwrap()], "reach"),
+        (["--boards", "0"], "--boards"),
+    ] {
+        let mut args = vec![
+            "uarm",
+            "train",
+            "--port",
+            "sim",
+            "--out",
+            run.to_str().unwrap(),
+        ];
+        args.extend(extra);
+        check_bad_input(&args, needle);
+    }
+    assert!(!run.exists(), "a refused command writes nothing");
     // Issue 13: `sim:abc` became seed 0, and every port starting with `sim` the twin.
     check_bad_input(
         &[

@@ -360,10 +360,7 @@ fn summaries_order_depths_numerically() {
 fn a_solved_board_is_solved_without_a_skill() {
     let lo = &*LIGHTSOUT;
     for replan in [false, true] {
-        let mut env =
-            seads_embodiment::make_env("lightsout-cursor", &EnvConfig::default()).unwrap();
-        env.seed(1);
-        env.reset().unwrap();
+        let mut env = test_env(1, 1);
         env.set_board(lo.goal()).unwrap();
         let config = SolveConfig {
             replan,
