@@ -69,29 +69,12 @@ impl RunData {
     fn load(dir: &Path, variant: String, copy_to: PathBuf) -> Result<Self> {
         let config = seads_rl::load_config(dir)?;
         let mut damage = Vec::new();
-        // No metrics file: not started. A file that cannot be read is damage, never "not started".
-        let started = dir.join("metrics.jsonl").exists();
         let (metrics, task_metrics) = match config.algorithm {
-            Algorithm::Seads => match seads_rl::read_metrics(dir) {
-                Ok(m) => (m, Vec::new()),
-                Err(e) => {
-                    if started {
-                        damage.push(format!("{e:#}"));
-                    }
-                    (Vec::new(), Vec::new())
-                }
-            },
-            Algorithm::Sac | Algorithm::Hac => {
-                match seads_rl::read_metrics_as::<TaskMetrics>(dir) {
-                    Ok(m) => (Vec::new(), m),
-                    Err(e) => {
-                        if started {
-                            damage.push(format!("{e:#}"));
-                        }
-                        (Vec::new(), Vec::new())
-                    }
-                }
-            }
+            Algorithm::Seads => (metrics_or_damage::<Metrics>(dir, &mut damage), Vec::new()),
+            Algorithm::Sac | Algorithm::Hac => (
+                Vec::new(),
+                metrics_or_damage::<TaskMetrics>(dir, &mut damage),
+            ),
         };
         // The last epoch of training: an evaluation of the end of training names it.
         let last_epoch = match config.algorithm {
@@ -148,6 +131,20 @@ impl RunData {
             metrics,
             task_metrics,
         })
+    }
+}
+
+/// The metrics lines of the run in `dir`; none without a metrics file (not started), and none
+/// with the reason added to `damage` when the file exists but cannot be read.
+fn metrics_or_damage<M: seads_rl::MetricsLine>(dir: &Path, damage: &mut Vec<String>) -> Vec<M> {
+    match seads_rl::read_metrics_as::<M>(dir) {
+        Ok(lines) => lines,
+        Err(e) => {
+            if dir.join("metrics.jsonl").exists() {
+                damage.push(format!("{e:#}"));
+            }
+            Vec::new()
+        }
     }
 }
 
