@@ -55,25 +55,67 @@ pub fn record(args: RecordArgs) -> Result<()> {
             Some(agent)
         }
     };
+    // One episode is held in memory (its steps and its JSON line) before it is written.
+    let spec = env.spec();
+    let episode_bytes = args.steps as f64 * (spec.obs_dim + spec.action_dim) as f64 * 24.0;
+    let memory = seads_rl::machine_memory_bytes();
+    if episode_bytes > memory as f64 {
+        bail!(BadInput(anyhow::anyhow!(
+            "--steps {} needs about {:.1} GiB per episode, more than this machine's {:.1} GiB",
+            args.steps,
+            episode_bytes / f64::from(1u32 << 30),
+            memory as f64 / f64::from(1u32 << 30)
+        )));
+    }
     env.seed(args.seed);
     let mut rng = ChaCha8Rng::seed_from_u64(args.seed);
+    // Written beside the output and renamed over it when complete: never a half-written file.
+    let name = args
+        .out
+        .file_name()
+        .map_or_else(|| "episodes".into(), |n| n.to_string_lossy().into_owned());
+    let tmp = args.out.with_file_name(format!(".{name}.tmp"));
+    let result = write_episodes(&args, &tmp, env.as_mut(), agent.as_ref(), &mut rng);
+    if let Err(e) = result {
+        let _ = std::fs::remove_file(&tmp);
+        return Err(e);
+    }
+    std::fs::rename(&tmp, &args.out)
+        .with_context(|| format!("renaming {} to {}", tmp.display(), args.out.display()))?;
+    outln!(
+        "recorded {} episodes of {} steps into {}",
+        args.episodes,
+        args.steps,
+        args.out.display()
+    );
+    Ok(())
+}
+
+/// Records the episodes of `args` into the file `path`, synced to disk.
+fn write_episodes(
+    args: &RecordArgs,
+    path: &std::path::Path,
+    env: &mut dyn seads_embodiment::Environment,
+    agent: Option<&seads_rl::Agent>,
+    rng: &mut ChaCha8Rng,
+) -> Result<()> {
     let (low, high) = (
         env.spec().action_low.clone(),
         env.spec().action_high.clone(),
     );
-    let file = std::fs::File::create(&args.out)
-        .with_context(|| format!("creating {}", args.out.display()))?;
+    let file =
+        std::fs::File::create(path).with_context(|| format!("creating {}", path.display()))?;
     let mut out = BufWriter::new(file);
     for i in 0..args.episodes {
         let mut episode = match &agent {
-            None => record_episode(env.as_mut(), args.steps, |_, action| {
+            None => record_episode(env, args.steps, |_, action| {
                 for (a, (l, h)) in action.iter_mut().zip(low.iter().zip(&high)) {
                     *a = rng.random_range(*l..=*h);
                 }
             })?,
             Some(agent) => {
                 let skill = i % agent.policy.num_skills();
-                let mut episode = record_episode(env.as_mut(), args.steps, |obs, action| {
+                let mut episode = record_episode(env, args.steps, |obs, action| {
                     agent.policy.act(obs, &[skill], action)
                 })?;
                 episode.skill = Some(skill);
@@ -81,15 +123,13 @@ pub fn record(args: RecordArgs) -> Result<()> {
             }
         };
         episode.env = args.env.clone();
-        writeln!(out, "{}", serde_json::to_string(&episode)?)?;
+        writeln!(out, "{}", serde_json::to_string(&episode)?)
+            .with_context(|| format!("writing {}", path.display()))?;
     }
-    out.flush()?;
-    outln!(
-        "recorded {} episodes of {} steps into {}",
-        args.episodes,
-        args.steps,
-        args.out.display()
-    );
+    out.into_inner()
+        .map_err(|e| e.into_error())
+        .and_then(|f| f.sync_all())
+        .with_context(|| format!("writing {}", path.display()))?;
     Ok(())
 }
 

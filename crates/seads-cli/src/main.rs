@@ -281,6 +281,21 @@ fn die_quietly_on_closed_pipes() {
     }
 }
 
+/// An error and its causes on one line (as `{:#}` joins them), each cut at its first line:
+/// libtorch's messages carry a C++ stack trace on the lines after the first.
+fn one_line(err: &anyhow::Error) -> String {
+    err.chain()
+        .filter_map(|cause| {
+            let text = cause.to_string();
+            text.lines()
+                .map(str::trim)
+                .find(|l| !l.is_empty())
+                .map(str::to_owned)
+        })
+        .collect::<Vec<_>>()
+        .join(": ")
+}
+
 fn main() -> ExitCode {
     keep_freed_memory();
     die_quietly_on_closed_pipes();
@@ -313,7 +328,7 @@ fn main() -> ExitCode {
     match result {
         Ok(()) => ExitCode::SUCCESS,
         Err(err) => {
-            eprintln!("error: {err:#}");
+            eprintln!("error: {}", one_line(&err));
             if err.is::<BadInput>() {
                 ExitCode::from(2)
             } else if err.is::<sweep::Taken>() {

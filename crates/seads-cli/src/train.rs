@@ -137,6 +137,13 @@ pub fn resume<L: Learner>(
     dir: &std::path::Path,
     run: Result<Run<L>, seads_rl::RlError>,
 ) -> Result<Run<L>> {
+    // A run damaged beyond repair is bad input, as any malformed input file is.
+    let run = run.map_err(|e| match e {
+        seads_rl::RlError::Damaged { .. }
+        | seads_rl::RlError::CheckpointsMissing { .. }
+        | seads_rl::RlError::NoCheckpoint { .. } => BadInput(e.into()).into(),
+        other => anyhow::Error::from(other),
+    });
     let run = run.with_context(|| format!("resuming {}", dir.display()))?;
     for repair in run.repairs() {
         eprintln!("seads: {}: {repair}", dir.display());

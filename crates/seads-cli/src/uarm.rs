@@ -166,8 +166,8 @@ pub struct UarmTrainArgs {
     /// Seed of the run.
     #[arg(long, default_value_t = 1)]
     seed: u64,
-    /// Test boards per solution depth 1–5 in the final evaluation (at least 1).
-    #[arg(long, value_parser = clap::builder::RangedU64ValueParser::<usize>::new().range(1..), default_value_t = 20)]
+    /// Test boards per solution depth 1–5 in the final evaluation (1 to 200000).
+    #[arg(long, value_parser = clap::builder::RangedU64ValueParser::<usize>::new().range(1..=200_000), default_value_t = 20)]
     boards: usize,
     /// Time limit per search in the final evaluation, seconds.
     #[arg(long, default_value_t = 60.0, value_parser = crate::positive_finite)]
@@ -385,8 +385,8 @@ pub struct UarmEvaluateArgs {
     /// `evaluation-replan-epoch-<EPOCH>.json`.
     #[arg(long)]
     checkpoint: Option<u64>,
-    /// Test boards per solution depth 1–5 (at least 1).
-    #[arg(long, value_parser = clap::builder::RangedU64ValueParser::<usize>::new().range(1..), default_value_t = 20)]
+    /// Test boards per solution depth 1–5 (1 to 200000).
+    #[arg(long, value_parser = clap::builder::RangedU64ValueParser::<usize>::new().range(1..=200_000), default_value_t = 20)]
     boards: usize,
     /// Time limit per search, seconds.
     #[arg(long, default_value_t = 60.0, value_parser = crate::positive_finite)]

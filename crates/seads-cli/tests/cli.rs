@@ -1264,3 +1264,121 @@ fn a_report_lists_damaged_runs_with_why() {
         "a damaged run is in no table: {md}"
     );
 }
+
+/// A checkpoint whose weights have other shapes than its config says is a malformed input:
+/// exit 2 and one line, libtorch's C++ stack trace cut off.
+#[test]
+fn a_checkpoint_of_other_shapes_is_one_line_of_bad_input() {
+    let dir = tempfile::tempdir().unwrap();
+    let run = dir.path().join("run");
+    let status = std::process::Command::new("cp")
+        .arg("-r")
+        .arg(tiny_run().join("run"))
+        .arg(&run)
+        .status()
+        .unwrap();
+    assert!(status.success());
+    let latest = std::fs::read_to_string(run.join("checkpoints/latest")).unwrap();
+    let weights = run
+        .join("checkpoints")
+        .join(latest.trim())
+        .join("forward_model.safetensors");
+    // The same tensor names, each of shape [1, 1] (safetensors: a little-endian header length,
+    // the JSON header, the data).
+    let bytes = std::fs::read(&weights).unwrap();
+    let length = u64::from_le_bytes(bytes[..8].try_into().unwrap()) as usize;
+    let header: serde_json::Map<String, serde_json::Value> =
+        serde_json::from_slice(&bytes[8..8 + length]).unwrap();
+    let mut shrunk = serde_json::Map::new();
+    let names: Vec<&String> = header.keys().filter(|k| *k != "__metadata__").collect();
+    for (i, name) in names.iter().enumerate() {
+        shrunk.insert(
+            (*name).clone(),
+            serde_json::json!({"dtype": "F32", "shape": [1, 1], "data_offsets": [4 * i, 4 * i + 4]}),
+        );
+    }
+    let text = serde_json::to_vec(&shrunk).unwrap();
+    let mut file = (text.len() as u64).to_le_bytes().to_vec();
+    file.extend(&text);
+    file.extend(vec![0u8; 4 * names.len()]);
+    std::fs::write(&weights, file).unwrap();
+    check_bad_input(
+        &["evaluate", "--run", s(&run), "--boards", "1", "--quiet"],
+        "forward_model",
+    );
+}
+
+/// What a process did with a command line: its exit code, or `None` if it was still working
+/// after `patience` (then it is killed), and its stderr.
+fn run_for(args: &[String], patience: std::time::Duration) -> (Option<i32>, String) {
+    use std::io::Read as _;
+    use std::os::unix::process::ExitStatusExt;
+    let mut child = std::process::Command::new(env!("CARGO_BIN_EXE_seads"))
+        .args(args)
+        .stdout(std::process::Stdio::null())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    let start = std::time::Instant::now();
+    let status = loop {
+        if let Some(status) = child.try_wait().unwrap() {
+            break Some(status);
+        }
+        if start.elapsed() > patience {
+            let _ = child.kill();
+            let _ = child.wait();
+            break None;
+        }
+        std::thread::sleep(std::time::Duration::from_millis(20));
+    };
+    let mut stderr = String::new();
+    let _ = child.stderr.take().unwrap().read_to_string(&mut stderr);
+    if let Some(status) = status {
+        assert_eq!(status.signal(), None, "{args:?} died of a signal: {stderr}");
+    }
+    (status.and_then(|s| s.code()), stderr)
+}
+
+proptest::proptest! {
+    #![proptest_config(proptest::prelude::ProptestConfig::with_cases(40))]
+    /// Any value of a numeric option (negative, zero, NaN, infinite, huge, past 64 bits, not a
+    /// number) ends in success, an error or bad input with a message, never a panic, an abort
+    /// or a memory kill; a command that accepts a huge value may still be working at the end.
+    #[test]
+    fn numeric_options_never_panic(
+        option in 0usize..9,
+        value in proptest::sample::select(vec![
+            "0", "1", "-1", "nan", "inf", "-inf", "1e300", "1e-300", "4294967297",
+            "9223372036854775807", "18446744073709551615", "18446744073709551616", "abc", "",
+        ]),
+    ) {
+        let dir = tempfile::tempdir().unwrap();
+        let out = dir.path().join("out");
+        let out = out.to_str().unwrap();
+        let run = tiny_run().join("run");
+        let run = run.to_str().unwrap();
+        let board = vec!["0"; 25].join(",");
+        let templates: [&[&str]; 9] = [
+            &["record", "--env", "lightsout-cursor", "--episodes", "1", "--steps", "V", "--out", out],
+            &["record", "--env", "lightsout-cursor", "--episodes", "V", "--steps", "1", "--out", out],
+            &["env-bench", "--env", "lightsout-cursor", "--steps", "V", "--threads", "1"],
+            &["env-bench", "--env", "lightsout-cursor", "--steps", "10", "--threads", "V"],
+            &["render", "--env", "lightsout-cursor", "--board-size", "V", "--out", "x.png"],
+            &["render", "--env", "lightsout-cursor", "--spacing", "V", "--out", "x.png"],
+            &["evaluate", "--run", run, "--boards", "V", "--quiet", "--timeout", "1"],
+            &["solve", "--run", run, "--board", &board, "--timeout", "V"],
+            &["uarm", "calibrate", "--port", "sim", "--d-max-mm", "V", "--out", out],
+        ];
+        let args: Vec<String> = templates[option]
+            .iter()
+            .map(|a| if *a == "V" { value.to_owned() } else { (*a).to_owned() })
+            .map(|a| if a == "x.png" { format!("{out}.png") } else { a })
+            .collect();
+        let (code, stderr) = run_for(&args, std::time::Duration::from_secs(3));
+        proptest::prop_assert!(!stderr.contains("panicked"), "{args:?}: {stderr}");
+        proptest::prop_assert!(matches!(code, None | Some(0..=2)), "{args:?}: {code:?} {stderr}");
+        if code == Some(2) {
+            proptest::prop_assert_eq!(stderr.trim().lines().count(), 1, "{:?}: {}", args, stderr);
+        }
+    }
+}

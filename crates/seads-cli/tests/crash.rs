@@ -303,3 +303,101 @@ fn a_second_writer_is_refused_while_the_run_trains() {
     first.wait().unwrap();
     resume(&out);
 }
+
+/// Resume has one rule for damage: a `latest` pointer that names no checkpoint of the run (bytes
+/// that are not text, a directory, a path leading outside the run) is ignored with a word on
+/// stderr and the newest checkpoint is taken, ending as the run that was never damaged; a
+/// removed `metrics.jsonl` or emptied `checkpoints/` is refused with exit 2 in one line, and
+/// nothing is retrained or changed.
+#[test]
+fn damaged_runs_are_repaired_with_a_word_or_refused_never_retrained() {
+    let base = baseline();
+    let point = 1 + base
+        .moments
+        .iter()
+        .enumerate()
+        .filter(|(_, m)| *m == "latest-written")
+        .nth(3)
+        .unwrap()
+        .0;
+    let dir = tempfile::tempdir().unwrap();
+    let killed = dir.path().join("killed");
+    start_and_kill(&base.config, &killed, point);
+    let copy = |name: &str| {
+        let to = dir.path().join(name);
+        let status = Command::new("cp")
+            .arg("-r")
+            .arg(&killed)
+            .arg(&to)
+            .status()
+            .unwrap();
+        assert!(status.success());
+        to
+    };
+    let outside = dir.path().join("outside");
+    std::fs::create_dir_all(outside.join("epoch-000010")).unwrap();
+    type Damage = fn(&Path, &Path);
+    let repaired: [(&str, Damage); 3] = [
+        ("not-text", |run, _| {
+            std::fs::write(run.join("checkpoints/latest"), [0xff, 0xfe, 0x00]).unwrap();
+        }),
+        ("directory", |run, _| {
+            std::fs::remove_file(run.join("checkpoints/latest")).unwrap();
+            std::fs::create_dir(run.join("checkpoints/latest")).unwrap();
+        }),
+        ("leads-outside", |run, outside| {
+            assert!(outside.join("epoch-000010").is_dir());
+            std::fs::write(run.join("checkpoints/latest"), "../../outside/epoch-000010").unwrap();
+        }),
+    ];
+    for (name, damage) in repaired {
+        let run = copy(name);
+        damage(&run, &outside);
+        let stderr = String::from_utf8_lossy(&resume(&run).stderr).into_owned();
+        assert!(
+            stderr.contains("ignored the latest pointer"),
+            "{name}: {stderr}"
+        );
+        assert_eq!(metrics(&run), base.metrics, "{name}");
+    }
+    assert_eq!(std::fs::read_dir(&outside).unwrap().count(), 1);
+    let refused: [(&str, Damage, &str); 2] = [
+        (
+            "no-metrics",
+            |run, _| std::fs::remove_file(run.join("metrics.jsonl")).unwrap(),
+            "metrics.jsonl is missing",
+        ),
+        (
+            "emptied",
+            |run, _| {
+                std::fs::remove_dir_all(run.join("checkpoints")).unwrap();
+                std::fs::create_dir(run.join("checkpoints")).unwrap();
+            },
+            "holds no checkpoint",
+        ),
+    ];
+    for (name, damage, says) in refused {
+        let run = copy(name);
+        damage(&run, &outside);
+        let before = std::fs::read(run.join("metrics.jsonl")).ok();
+        let output = Command::new(SEADS)
+            .args(["train", "--quiet", "--resume"])
+            .arg(&run)
+            .output()
+            .unwrap();
+        let stderr = String::from_utf8_lossy(&output.stderr);
+        assert_eq!(output.status.code(), Some(2), "{name}: {stderr}");
+        assert_eq!(stderr.trim().lines().count(), 1, "{name}: {stderr}");
+        assert!(stderr.contains(says), "{name}: {stderr}");
+        assert_eq!(
+            std::fs::read(run.join("metrics.jsonl")).ok(),
+            before,
+            "{name}"
+        );
+        assert_eq!(
+            std::fs::read_dir(run.join("checkpoints")).unwrap().count() > 0,
+            name == "no-metrics",
+            "{name}: nothing is retrained"
+        );
+    }
+}

@@ -737,3 +737,75 @@ fn an_unreadable_task_record_damages_its_run_only() {
         String::from_utf8_lossy(&seads_ok(&["sweep", "status", s(&sweep)]).stdout).into_owned();
     assert!(text.contains("1 damaged"), "{text}");
 }
+
+/// A sweep degrades per run and repairs what can be made again: a deleted run directory is
+/// planned again from the manifest and trained; a finished run whose evaluation file is gone is
+/// pending and finished again (the file made anew, the metrics untouched); one whose evaluation
+/// file cannot be read is damaged, named, and left alone.
+#[test]
+fn a_deleted_run_is_planned_again_and_done_needs_readable_outputs() {
+    let tmp = tempfile::tempdir().unwrap();
+    let manifest = write_manifest(tmp.path(), &seads_only_without_evaluation_over_training());
+    let sweep = tmp.path().join("sweep");
+    seads_ok(&["sweep", "plan", s(&manifest), "--out", s(&sweep)]);
+    let run = |seed: u64| sweep.join(format!("runs/lightsout-cursor/seads/seed-{seed}"));
+    let of_seed = |seed: u64| {
+        let status = status_json(&sweep);
+        let row = status["runs"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .find(|r| r["seed"].as_u64() == Some(seed))
+            .unwrap()
+            .clone();
+        (
+            row["status"].as_str().unwrap().to_owned(),
+            row["error"].as_str().unwrap_or_default().to_owned(),
+        )
+    };
+    std::fs::remove_dir_all(run(2)).unwrap();
+    let (status, why) = of_seed(2);
+    assert_eq!(status, "pending");
+    assert!(why.contains("deleted"), "{why}");
+    seads_ok(&["sweep", "run", s(&sweep), "--quiet"]);
+    assert_eq!(of_seed(1).0, "done");
+    assert_eq!(of_seed(2).0, "done");
+    let evaluation = std::fs::read_dir(run(1))
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .find(|p| {
+            let name = p.file_name().unwrap().to_string_lossy().into_owned();
+            name.starts_with("evaluation") && name.ends_with(".json")
+        })
+        .expect("an evaluation file");
+    // An evaluation without its clock readings.
+    let outcome = |path: &Path| {
+        let mut v: serde_json::Value =
+            serde_json::from_slice(&std::fs::read(path).unwrap()).unwrap();
+        for r in v["results"].as_array_mut().unwrap() {
+            r.as_object_mut().unwrap().remove("planning_s").unwrap();
+        }
+        v
+    };
+    let (made, metrics) = (
+        outcome(&evaluation),
+        std::fs::read(run(1).join("metrics.jsonl")).unwrap(),
+    );
+    std::fs::remove_file(&evaluation).unwrap();
+    let (status, why) = of_seed(1);
+    assert_eq!(status, "pending");
+    assert!(why.contains("is gone"), "{why}");
+    seads_ok(&["sweep", "run", s(&sweep), "--quiet"]);
+    assert_eq!(of_seed(1).0, "done");
+    assert_eq!(outcome(&evaluation), made);
+    assert_eq!(
+        std::fs::read(run(1).join("metrics.jsonl")).unwrap(),
+        metrics
+    );
+    std::fs::write(&evaluation, "{ torn").unwrap();
+    let (status, why) = of_seed(1);
+    assert_eq!(status, "damaged");
+    assert!(why.contains("cannot be read"), "{why}");
+    seads_ok(&["sweep", "run", s(&sweep), "--quiet"]);
+    assert_eq!(std::fs::read(&evaluation).unwrap(), b"{ torn");
+}

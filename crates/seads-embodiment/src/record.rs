@@ -59,7 +59,8 @@ pub fn record_episode(
     let initial_obs = state_of(env);
     let mut obs = env.observation();
     let mut action = vec![0.0; env.spec().action_dim];
-    let mut records = Vec::with_capacity(steps);
+    // Grows as it goes: a step count too large for memory fails at the limit, not up front.
+    let mut records = Vec::with_capacity(steps.min(1 << 16));
     for _ in 0..steps {
         act(&obs, &mut action);
         let outcome = env.step(&action)?;

@@ -62,6 +62,27 @@ impl TaskSet {
         }
     }
 
+    /// The most tasks one evaluation may have: at well under a second each, more would run for
+    /// weeks, and their seeds and results must fit into memory.
+    pub const MAX_TASKS: usize = 1_000_000;
+
+    /// Why this task set cannot be evaluated (no board, no depth, or more than
+    /// [`MAX_TASKS`](Self::MAX_TASKS) tasks), or `None`.
+    pub fn problem(&self) -> Option<String> {
+        if self.boards == 0 || self.depths.is_empty() {
+            return Some("an evaluation needs at least 1 board and 1 depth".into());
+        }
+        match self.depths.len().checked_mul(self.boards) {
+            Some(n) if n <= Self::MAX_TASKS => None,
+            _ => Some(format!(
+                "{} boards at each of {} depth(s) are more than the {} tasks one evaluation may have",
+                self.boards,
+                self.depths.len(),
+                Self::MAX_TASKS
+            )),
+        }
+    }
+
     /// The environment seeds of the tasks, the same for every depth: one board per seed and
     /// depth.
     pub fn seeds(&self) -> Vec<u64> {

@@ -446,8 +446,71 @@ impl TrainConfig {
                 env_names().join(", ")
             )));
         }
-        seads_embodiment::make_env(&self.env, &self.env_config)?;
-        self.validate_values()
+        let env = seads_embodiment::make_env(&self.env, &self.env_config)?;
+        self.validate_values()?;
+        self.check_memory(env.spec(), machine_memory_bytes())
+    }
+
+    /// Bytes a run of this configuration holds at least (a lower bound, so that a refusal is
+    /// never wrong), estimated from the environment's sizes before anything is allocated: the
+    /// networks with gradients and Adam's two moments (critics twice, with targets), one
+    /// update's activations, the episode buffer and an epoch's episodes, relabelling's cost
+    /// matrix and the baselines' replay buffer. In `f64`, so that no size overflows.
+    pub fn memory_estimate(&self, spec: &seads_embodiment::EnvSpec) -> f64 {
+        let f = |v: usize| v as f64;
+        let skills = f(self.num_skills.unwrap_or(spec.num_skills));
+        let (obs, act, board) = (f(spec.obs_dim), f(spec.action_dim), f(spec.symbolic_len));
+        let steps = f(spec.step_limit.unwrap_or(1).max(1));
+        // Weights of a multilayer perceptron from `input` through `hidden` to `output`.
+        let mlp = |input: f64, hidden: &[i64], output: f64| {
+            let mut sizes = vec![input];
+            sizes.extend(hidden.iter().map(|&h| h.max(0) as f64));
+            sizes.push(output);
+            sizes.windows(2).map(|w| (w[0] + 1.0) * w[1]).sum::<f64>()
+        };
+        let width = |hidden: &[i64]| hidden.iter().map(|&h| h.max(0) as f64).sum::<f64>();
+        let actor = mlp(obs + skills, &self.sac.hidden, 2.0 * act);
+        let critic = mlp(obs + skills + act, &self.sac.hidden, 1.0);
+        let forward_model = mlp(board + skills, &self.skill_model.hidden, board);
+        let weights = 4.0 * actor + 10.0 * critic + 4.0 * forward_model;
+        let activations = f(self.sac.batch_size) * width(&self.sac.hidden) * 3.0
+            + f(self.skill_model.batch_size) * width(&self.skill_model.hidden);
+        let episodes = (f(self.buffer_capacity) + f(self.episodes_per_epoch)) * steps;
+        let transitions = if self.algorithm.is_baseline() {
+            f(self.baseline.replay_capacity)
+        } else {
+            0.0
+        };
+        let relabelling = 2.0 * f(self.sampled_episodes) * skills;
+        4.0 * (weights + activations + (episodes + transitions) * (obs + act) + relabelling)
+    }
+
+    /// Refuses a configuration whose [`memory_estimate`](Self::memory_estimate) exceeds
+    /// `available` bytes (the machine's memory), naming the sizes to lower.
+    pub fn check_memory(
+        &self,
+        spec: &seads_embodiment::EnvSpec,
+        available: u64,
+    ) -> Result<(), RlError> {
+        let need = self.memory_estimate(spec);
+        if need.is_finite() && need <= available as f64 {
+            return Ok(());
+        }
+        let gib = |b: f64| {
+            let g = b / f64::from(1u32 << 30);
+            if g < 1e6 {
+                format!("{g:.1}")
+            } else {
+                format!("{g:.1e}")
+            }
+        };
+        Err(RlError::Config(format!(
+            "this configuration needs at least {} GiB, more than this machine's {} GiB \
+             (lower num_skills, the hidden sizes, buffer_capacity, episodes_per_epoch, the batch \
+             sizes or baseline.replay_capacity)",
+            gib(need),
+            gib(available as f64)
+        )))
     }
 
     /// Checks every value except the environment (robot environments are not in the registry;
@@ -567,7 +630,19 @@ impl TrainConfig {
     }
 }
 
-/// A TOML error as one line: "line L, column C: message".
+/// The machine's memory in bytes (`MemTotal` of `/proc/meminfo`), or `u64::MAX` where it
+/// cannot be read: a configuration is refused only where its size is known to be too large.
+pub fn machine_memory_bytes() -> u64 {
+    std::fs::read_to_string("/proc/meminfo")
+        .ok()
+        .and_then(|text| {
+            let line = text.lines().find(|l| l.starts_with("MemTotal:"))?;
+            let kib: u64 = line.split_whitespace().nth(1)?.parse().ok()?;
+            kib.checked_mul(1024)
+        })
+        .unwrap_or(u64::MAX)
+}
+
 /// Lays `layer` over `base`: a key of `layer` replaces `base`'s, except that two tables merge,
 /// key by key. How a partial configuration fills from its preset, and how a study's variant
 /// overrides its preset.
@@ -644,6 +719,7 @@ fn one_line_toml_error(text: &str, e: &toml::de::Error) -> String {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use proptest::prelude::*;
 
     #[test]
     fn a_user_config_must_name_its_env_and_fills_from_its_preset() {
@@ -693,6 +769,93 @@ mod tests {
                 TrainConfig::from_user_toml(bad, None, None).is_err(),
                 "{bad}"
             );
+        }
+    }
+
+    /// The estimate for the LightsOutCursor preset, by hand: obs 28, action 3, K 25, T 10,
+    /// 25 fields, hidden [256, 256] everywhere. Actor (54·256 + 257·256 + 257·6 = 81158),
+    /// critic (57·256 + 257·256 + 257 = 80641), forward model (51·256 + 257·256 + 257·25 =
+    /// 85273): 4·81158 + 10·80641 + 4·85273 = 1472134 weights; activations 128·512·3 + 32·512 =
+    /// 212992; episodes (2048 + 32)·10·31 = 644800; relabelling 2·256·25 = 12800; 4 bytes each.
+    #[test]
+    fn the_memory_estimate_of_the_preset_is_the_hand_computed_one() {
+        let config = TrainConfig::preset("lightsout-cursor").unwrap();
+        let env = seads_embodiment::make_env(&config.env, &config.env_config).unwrap();
+        assert_eq!(config.memory_estimate(env.spec()), 9_370_904.0);
+        assert!(config.check_memory(env.spec(), 9_370_904).is_ok());
+        let refused = config.check_memory(env.spec(), 9_370_903).unwrap_err();
+        assert!(refused.to_string().contains("num_skills"), "{refused}");
+    }
+
+    fn size() -> impl Strategy<Value = usize> {
+        prop_oneof![
+            0..4usize,
+            1..5000usize,
+            (1usize << 20)..(1usize << 44),
+            Just(usize::MAX)
+        ]
+    }
+
+    fn layer() -> impl Strategy<Value = i64> {
+        prop_oneof![
+            -2..4i64,
+            1..2048i64,
+            (1i64 << 20)..(1i64 << 40),
+            Just(i64::MAX)
+        ]
+    }
+
+    fn real() -> impl Strategy<Value = f64> {
+        prop_oneof![
+            Just(f64::NAN),
+            Just(f64::INFINITY),
+            Just(f64::NEG_INFINITY),
+            Just(-0.0),
+            0.0..1.0f64,
+            any::<f64>()
+        ]
+    }
+
+    proptest! {
+        #![proptest_config(ProptestConfig::with_cases(300))]
+        /// Any values of the sizes and rates are checked without a panic, and what is accepted
+        /// has positive sizes, finite rates and fits into the machine's memory.
+        #[test]
+        fn any_config_values_are_checked_without_panic_and_accepted_only_if_they_fit(
+            num_skills in size(),
+            sac_hidden in prop::collection::vec(layer(), 0..4),
+            model_hidden in prop::collection::vec(layer(), 0..4),
+            (episodes, capacity, sampled) in (size(), size(), size()),
+            (sac_batch, model_batch, replay) in (size(), size(), size()),
+            (lr, alpha, gamma, p) in (real(), real(), real(), real()),
+            baseline in any::<bool>(),
+        ) {
+            let mut config = TrainConfig::preset("lightsout-cursor").unwrap();
+            config.num_skills = Some(num_skills);
+            config.sac.hidden = sac_hidden;
+            config.skill_model.hidden = model_hidden;
+            config.episodes_per_epoch = episodes;
+            config.buffer_capacity = capacity;
+            config.sampled_episodes = sampled;
+            config.recent_episodes = sampled.min(capacity);
+            config.sac.batch_size = sac_batch;
+            config.skill_model.batch_size = model_batch;
+            config.sac.lr = lr;
+            config.sac.alpha = alpha;
+            config.sac.gamma = gamma;
+            config.relabel.sac_p = p;
+            if baseline {
+                config = TrainConfig { algorithm: Algorithm::Sac, ..config };
+                config.baseline.replay_capacity = replay;
+            }
+            if config.validate().is_ok() {
+                let env = seads_embodiment::make_env(&config.env, &config.env_config).unwrap();
+                prop_assert!(config.memory_estimate(env.spec()) <= machine_memory_bytes() as f64);
+                prop_assert!(config.sac.hidden.iter().all(|&h| h > 0));
+                prop_assert!(lr.is_finite() && lr > 0.0 && alpha.is_finite() && alpha > 0.0);
+                prop_assert!((0.0..=1.0).contains(&gamma) && (0.0..=1.0).contains(&p));
+                prop_assert!(num_skills > 0 && sac_batch > 0 && episodes > 0);
+            }
         }
     }
 

@@ -56,7 +56,8 @@ use std::path::Path;
 pub use agent::{Agent, AgentPolicy, find_checkpoint};
 pub use buffers::{RelabelBatch, RelabelObserver, Relabelling};
 pub use config::{
-    Algorithm, BaselineConfig, HacConfig, RelabelConfig, TrainConfig, config_difference, merge_toml,
+    Algorithm, BaselineConfig, HacConfig, RelabelConfig, TrainConfig, config_difference,
+    machine_memory_bytes, merge_toml,
 };
 pub use episode::{Episode, policy_input, run_episodes, skill_coverage};
 pub use hac::{Hac, HacPolicy};
@@ -66,9 +67,9 @@ pub use run::{Hook, Learner, Metrics, Moment, Run, RunEvent, load_config, raise_
 pub use sac::{Sac, SacConfig, SacLosses, TransitionBatch, checkpoint_files};
 pub use seeds::{Purpose, derived_seed, stream, train_env_seed};
 pub use store::{
-    MetricsLine, RUN_LOCK, RunLock, append_json_line, check_origin, checkpoint_id, checkpoint_name,
-    checkpoints, is_copy_without_checkpoints, last_env_steps, latest_checkpoint, read_json_lines,
-    read_metrics, read_metrics_as, run_is_locked, write_atomic,
+    METRICS, MetricsLine, RUN_LOCK, RunLock, append_json_line, check_origin, checkpoint_id,
+    checkpoint_name, checkpoints, is_copy_without_checkpoints, last_env_steps, latest_checkpoint,
+    read_json_lines, read_metrics, read_metrics_as, run_is_locked, write_atomic,
 };
 pub use task_policy::{TaskPolicy, load_policy, task_success};
 pub use task_sac::{TaskEpochStats, TaskMetrics, TaskSac, TaskTimings, updates_due};
@@ -132,6 +133,15 @@ pub enum RlError {
         dir: String,
         /// Lines in its metrics file.
         lines: usize,
+    },
+    /// A run directory is damaged in a way resuming cannot repair without losing or inventing
+    /// history (its metrics file or its checkpoints were removed): resuming refuses.
+    #[error("{dir}: {reason}; resuming refuses (restore it, or train a new run)")]
+    Damaged {
+        /// The run directory.
+        dir: String,
+        /// What is damaged.
+        reason: String,
     },
     /// Another process writes into the run directory now.
     #[error("{dir} is in use by {holder}: one writer at a time")]

@@ -16,9 +16,9 @@ use std::time::Instant;
 use serde::{Deserialize, Serialize};
 
 use crate::store::{
-    CHECKPOINTS, CONFIG, LATEST, METRICS, MetricsLine, append_metrics, check_origin,
-    checkpoint_name, checkpoints, clean_leftovers, commit_dir, hidden_sibling, latest_pointer,
-    read_metrics_text, write_atomic, write_metrics, write_origin,
+    CHECKPOINTS, CONFIG, LATEST, Latest, METRICS, MetricsLine, append_metrics, check_origin,
+    checkpoint_name, checkpoints, clean_leftovers, commit_dir, hidden_sibling, read_metrics_text,
+    write_atomic, write_metrics, write_origin,
 };
 use crate::{EpochStats, RlError, Timings, TrainConfig, Trainer};
 
@@ -201,8 +201,25 @@ impl<L: Learner> Run<L> {
     ) -> Result<Self, RlError> {
         let config = load_config(dir)?;
         let copied = crate::store::is_copy_without_checkpoints(dir);
-        // A directory planned by a sweep holds only its config: the run starts here.
+        let latest = crate::store::read_latest(dir)?;
+        let written = if dir.join(CHECKPOINTS).is_dir() {
+            checkpoints(dir)?
+        } else {
+            Vec::new()
+        };
+        let damaged = |reason: String| RlError::Damaged {
+            dir: dir.display().to_string(),
+            reason,
+        };
+        // A directory planned by a sweep holds only its config: the run starts here. One whose
+        // metrics are gone but whose checkpoints remain has lost its history.
         if !dir.join(METRICS).exists() {
+            if latest != Latest::Absent || !written.is_empty() {
+                return Err(damaged(format!(
+                    "{METRICS} is missing but {CHECKPOINTS}/ holds checkpoints, so the run's \
+                     history is lost"
+                )));
+            }
             fs::create_dir_all(dir.join(CHECKPOINTS)).map_err(|e| RlError::io(dir, e))?;
             write_metrics::<L::Metrics>(dir, &[])?;
         }
@@ -212,14 +229,22 @@ impl<L: Learner> Run<L> {
             .collect();
         let mut trainer = build(config.clone())?;
         let mut candidates: Vec<PathBuf> = Vec::new();
-        let pointer = latest_pointer(dir)?;
-        let had_pointer = pointer.is_some();
-        candidates.extend(pointer);
-        let written = if dir.join(CHECKPOINTS).is_dir() {
-            checkpoints(dir)?
-        } else {
-            Vec::new()
-        };
+        let had_pointer = latest != Latest::Absent;
+        match latest {
+            Latest::Names(path) => candidates.push(path),
+            Latest::Unusable(why) => {
+                repairs.push(format!("ignored the latest pointer: {why}"));
+                // A directory in the pointer's place would stop the next checkpoint's pointer.
+                let pointer = dir.join(CHECKPOINTS).join(LATEST);
+                if pointer.is_dir() {
+                    let aside = dir.join(CHECKPOINTS).join(format!("{LATEST}.damaged"));
+                    let _ = fs::remove_dir_all(&aside);
+                    fs::rename(&pointer, &aside).map_err(|e| RlError::io(&pointer, e))?;
+                    repairs.push(format!("moved that directory aside to {}", aside.display()));
+                }
+            }
+            Latest::Absent => {}
+        }
         for (_, path) in written.iter().rev() {
             if !candidates.contains(path) {
                 candidates.push(path.clone());
@@ -258,6 +283,17 @@ impl<L: Learner> Run<L> {
         }
         if torn {
             repairs.push(format!("dropped a torn last line of {METRICS}"));
+        }
+        // The first checkpoint follows the evaluation of epoch `checkpoint_every` at once, so
+        // an evaluation after that epoch means a checkpoint was written: none left means they
+        // were removed, and starting afresh would throw the run away.
+        let last_evaluated = metrics.last().map_or(0, |m| m.epoch());
+        if resumed.is_none() && written.is_empty() && last_evaluated > config.checkpoint_every {
+            return Err(damaged(format!(
+                "{METRICS} reaches epoch {last_evaluated} but {CHECKPOINTS}/ holds no checkpoint \
+                 (one is written every {} epochs), so they were removed",
+                config.checkpoint_every
+            )));
         }
         if resumed.is_none() && (had_pointer || !written.is_empty()) {
             let tried = failures.len();

@@ -290,14 +290,49 @@ pub fn checkpoints(dir: &Path) -> Result<Vec<(u64, PathBuf)>, RlError> {
     Ok(out)
 }
 
-/// The checkpoint `checkpoints/latest` names, if the pointer exists; the folder may be missing.
-pub fn latest_pointer(dir: &Path) -> Result<Option<PathBuf>, RlError> {
+/// What `checkpoints/latest` holds.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub enum Latest {
+    /// There is no pointer.
+    Absent,
+    /// The pointer names this checkpoint folder of the run (which may be missing).
+    Names(PathBuf),
+    /// The pointer exists but names no checkpoint of this run: why (bytes that are not a
+    /// checkpoint name, a path leading elsewhere, a directory in its place).
+    Unusable(String),
+}
+
+/// Reads `checkpoints/latest`. Only a checkpoint name (`epoch-NNNNNN`) is followed, so the
+/// pointer never leads outside the run.
+pub fn read_latest(dir: &Path) -> Result<Latest, RlError> {
     let pointer = dir.join(CHECKPOINTS).join(LATEST);
-    match fs::read_to_string(&pointer) {
-        Ok(name) => Ok(Some(dir.join(CHECKPOINTS).join(name.trim()))),
-        Err(e) if e.kind() == std::io::ErrorKind::NotFound => Ok(None),
+    match fs::read(&pointer) {
+        Ok(bytes) => Ok(match std::str::from_utf8(&bytes).map(str::trim) {
+            Ok(name) if checkpoint_epoch(name).is_some() => {
+                Latest::Names(dir.join(CHECKPOINTS).join(name))
+            }
+            Ok(name) => Latest::Unusable(format!(
+                "{} names {name:?}, which is not a checkpoint of this run",
+                pointer.display()
+            )),
+            Err(_) => Latest::Unusable(format!("{} is not text", pointer.display())),
+        }),
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => Ok(Latest::Absent),
+        Err(_) if pointer.is_dir() => Ok(Latest::Unusable(format!(
+            "{} is a directory, not a pointer",
+            pointer.display()
+        ))),
         Err(e) => Err(RlError::io(&pointer, e)),
     }
+}
+
+/// The checkpoint `checkpoints/latest` names, if the pointer exists and names one of the run's
+/// checkpoints; the folder may be missing.
+pub fn latest_pointer(dir: &Path) -> Result<Option<PathBuf>, RlError> {
+    Ok(match read_latest(dir)? {
+        Latest::Names(path) => Some(path),
+        Latest::Absent | Latest::Unusable(_) => None,
+    })
 }
 
 /// The latest checkpoint of the run in `dir`, if any: the one `latest` names, or, if that is

@@ -82,8 +82,15 @@ pub fn evaluate_run(args: EvaluateArgs) -> Result<()> {
             .max_expanded
             .map(|m| m.try_into().unwrap_or(usize::MAX)),
     };
-    if args.boards == 0 {
-        bail!(BadInput(anyhow::anyhow!("--boards must be at least 1")));
+    let asked = TaskSet {
+        depths: depths.clone(),
+        ..TaskSet::standard(args.boards)
+    };
+    if let Some(problem) = asked.problem() {
+        bail!(BadInput(anyhow::anyhow!(
+            "--boards {}: {problem}",
+            args.boards
+        )));
     }
     let config = seads_rl::load_config(&args.run)
         .with_context(|| format!("loading run {}", args.run.display()))?;

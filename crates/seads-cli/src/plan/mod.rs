@@ -34,6 +34,13 @@ pub fn load_agent(run: &Path, checkpoint: Option<u64>) -> Result<Agent> {
             config.algorithm.name()
         )));
     }
+    // A checkpoint that is there but cannot be read or does not fit is a malformed input.
     Agent::load(run, checkpoint)
+        .map_err(|e| match e {
+            seads_rl::RlError::Checkpoint { .. }
+            | seads_rl::RlError::Unreadable { .. }
+            | seads_rl::RlError::SkillModel(_) => anyhow::Error::from(BadInput(e.into())),
+            other => anyhow::Error::from(other),
+        })
         .with_context(|| format!("loading the agent of run {}", run.display()))
 }

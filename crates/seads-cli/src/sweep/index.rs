@@ -83,6 +83,37 @@ impl Sweep {
         Ok(dir.join(&run.dir))
     }
 
+    /// The directory of run `index`, planned again from the sweep's `manifest.toml` if it was
+    /// deleted (its `config.toml` is gone); the second value says whether it was.
+    pub fn ensure_run_dir(&self, dir: &Path, index: usize) -> Result<(PathBuf, bool)> {
+        let run = self.run_dir(dir, index)?;
+        if run.join("config.toml").exists() {
+            return Ok((run, false));
+        }
+        let path = dir.join(MANIFEST);
+        let text = std::fs::read_to_string(&path).with_context(|| {
+            format!("reading {} to plan {} again", path.display(), run.display())
+        })?;
+        let planned = Manifest::parse(&text, &path.display().to_string())?.expand()?;
+        let Some(planned) = planned
+            .into_iter()
+            .nth(index)
+            .filter(|p| p.rel_dir() == self.runs[index].dir)
+        else {
+            bail!(
+                "{} does not plan run {index} ({}) as the index does; plan the sweep again",
+                path.display(),
+                self.runs[index].dir
+            );
+        };
+        std::fs::create_dir_all(&run).with_context(|| format!("creating {}", run.display()))?;
+        seads_rl::write_atomic(
+            &run.join("config.toml"),
+            planned.config.to_toml().as_bytes(),
+        )?;
+        Ok((run, true))
+    }
+
     /// Writes the sweep of `manifest` into `out`. Planning the same manifest again writes
     /// nothing (only run directories that were deleted are made again); a different manifest
     /// in the same folder is an error, and nothing is written. Validation errors come back as

@@ -193,6 +193,9 @@ impl Manifest {
                  evaluation.timeout above 0"
             );
         }
+        if let Some(problem) = seads_planner::TaskSet::standard(e.boards).problem() {
+            bail!("evaluation.boards = {}: {problem}", e.boards);
+        }
         // Expanding checks every override against the configuration's keys and values.
         self.expand()?;
         Ok(())

@@ -281,7 +281,9 @@ fn status(args: StatusArgs) -> Result<()> {
             budget,
             attempts: record.as_ref().map_or(0, |r| r.attempts),
             error: match status {
-                Status::Damaged => state::damage(&dir),
+                Status::Damaged | Status::Pending => {
+                    state::damage(&dir).or_else(|| record.and_then(|r| r.error))
+                }
                 _ => record.and_then(|r| r.error),
             },
         });

@@ -82,7 +82,12 @@ pub fn run_sweep(
                     super::state::damage(&run).unwrap_or_default()
                 );
             }
-            Status::Failed | Status::Pending => todo.push(i),
+            Status::Failed | Status::Pending => {
+                if sweep.ensure_run_dir(dir, i)?.1 {
+                    eprintln!("seads: {}: was deleted; planned again", run.display());
+                }
+                todo.push(i);
+            }
         }
     }
     let workers = workers.max(1);

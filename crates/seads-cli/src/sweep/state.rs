@@ -43,6 +43,10 @@ pub struct Record {
     /// The error of a failed task.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub error: Option<String>,
+    /// The files a finished task's results rest on, relative to the run: its metrics and the
+    /// evaluations it wrote.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub outputs: Vec<String>,
 }
 
 impl Record {
@@ -60,9 +64,16 @@ impl Record {
         }
     }
 
-    /// Writes a record of this process with `outcome` into `run`.
+    /// Writes a record of this process with `outcome` into `run`; a `Done` record lists the
+    /// run's metrics and evaluation files as its outputs.
     pub fn write(run: &Path, outcome: Outcome, attempts: u32, error: Option<String>) -> Result<()> {
+        let outputs = if outcome == Outcome::Done {
+            present_outputs(run)
+        } else {
+            Vec::new()
+        };
         let record = Self {
+            outputs,
             outcome,
             host: hostname(),
             pid: std::process::id(),
@@ -78,6 +89,67 @@ impl Record {
         )?;
         Ok(())
     }
+}
+
+/// The metrics file and every evaluation file of `run` that exist, sorted.
+fn present_outputs(run: &Path) -> Vec<String> {
+    let mut outputs: Vec<String> = std::fs::read_dir(run)
+        .into_iter()
+        .flatten()
+        .filter_map(|e| e.ok()?.file_name().into_string().ok())
+        .filter(|n| n.starts_with("evaluation") && n.ends_with(".json"))
+        .collect();
+    outputs.sort();
+    outputs.insert(0, seads_rl::METRICS.to_owned());
+    outputs
+}
+
+/// What is wrong with the outputs of a run whose task finished.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub enum Missing {
+    /// A file is gone: the task is to be run again, which writes it anew.
+    Gone(String),
+    /// A file cannot be read: named with why, left for the user (remove it to have it redone).
+    Unreadable(String),
+}
+
+/// Checks that the outputs of a finished task are readable: those its record lists, or for a
+/// record from before outputs were listed, the metrics and the evaluation files present.
+pub fn check_outputs(run: &Path, record: &Record) -> std::result::Result<(), Missing> {
+    let listed = if record.outputs.is_empty() {
+        present_outputs(run)
+    } else {
+        record.outputs.clone()
+    };
+    for name in listed {
+        let path = run.join(&name);
+        let readable = if name == seads_rl::METRICS {
+            match seads_rl::read_json_lines::<serde_json::Value>(&path) {
+                Ok((lines, false)) if !lines.is_empty() => Ok(()),
+                Ok(_) => Err("it is empty or ends in a torn line".to_owned()),
+                Err(e) => Err(format!("{e}")),
+            }
+        } else {
+            std::fs::read_to_string(&path)
+                .map_err(|e| e.to_string())
+                .and_then(|t| {
+                    serde_json::from_str::<serde_json::Value>(&t)
+                        .map(|_| ())
+                        .map_err(|e| e.to_string())
+                })
+        };
+        match readable {
+            Ok(()) => {}
+            Err(_) if !path.exists() => return Err(Missing::Gone(name)),
+            Err(why) => {
+                return Err(Missing::Unreadable(format!(
+                    "{} cannot be read ({why}); remove it to have it made again",
+                    path.display()
+                )));
+            }
+        }
+    }
+    Ok(())
 }
 
 /// The host name, for the record (empty if unknown).
@@ -192,7 +264,11 @@ pub fn status(run: &Path) -> Result<(Status, Option<Record>)> {
         Status::Running
     } else {
         match record.as_ref().map(|r| r.outcome) {
-            Some(Outcome::Done) => Status::Done,
+            Some(Outcome::Done) => match check_outputs(run, record.as_ref().expect("done")) {
+                Ok(()) => Status::Done,
+                Err(Missing::Gone(_)) => Status::Pending,
+                Err(Missing::Unreadable(_)) => Status::Damaged,
+            },
             _ if seads_rl::is_copy_without_checkpoints(run) => Status::Copied,
             Some(Outcome::Failed) => Status::Failed,
             Some(Outcome::Running) | None => Status::Pending,
@@ -201,9 +277,22 @@ pub fn status(run: &Path) -> Result<(Status, Option<Record>)> {
     Ok((status, record))
 }
 
-/// Why `run` is [`Status::Damaged`]: its task record cannot be read (`None` if it can).
+/// Why `run` is [`Status::Damaged`] (its task record, or an output of its finished task,
+/// cannot be read), or why a finished run is pending again (an output is gone, or the whole
+/// directory, planned again when it runs); `None` if nothing is.
 pub fn damage(run: &Path) -> Option<String> {
-    Record::read(run).err().map(|e| format!("{e:#}"))
+    if !run.exists() {
+        return Some("deleted: planned again from the manifest when it runs".into());
+    }
+    match Record::read(run) {
+        Err(e) => Some(format!("{e:#}")),
+        Ok(Some(record)) if record.outcome == Outcome::Done => match check_outputs(run, &record) {
+            Ok(()) => None,
+            Err(Missing::Gone(name)) => Some(format!("{name} is gone: to be made again")),
+            Err(Missing::Unreadable(why)) => Some(why),
+        },
+        Ok(_) => None,
+    }
 }
 
 #[cfg(test)]
@@ -254,6 +343,33 @@ mod tests {
         let planned = tempfile::tempdir().unwrap();
         std::fs::write(planned.path().join("metrics.jsonl"), "").unwrap();
         assert_eq!(status(planned.path()).unwrap().0, Status::Pending);
+        // Done needs readable outputs: a gone evaluation is made again, an unreadable one is
+        // damage, named.
+        std::fs::write(run.join("metrics.jsonl"), "{\"epoch\":1}\n").unwrap();
+        std::fs::write(run.join("evaluation-replan.json"), "{}").unwrap();
+        Record::write(run, Outcome::Done, 1, None).unwrap();
+        let record = Record::read(run).unwrap().unwrap();
+        assert_eq!(record.outputs, ["metrics.jsonl", "evaluation-replan.json"]);
+        assert_eq!(status(run).unwrap().0, Status::Done);
+        assert_eq!(damage(run), None);
+        std::fs::write(run.join("evaluation-replan.json"), "{").unwrap();
+        assert_eq!(status(run).unwrap().0, Status::Damaged);
+        assert!(
+            damage(run)
+                .unwrap()
+                .contains("evaluation-replan.json cannot be read")
+        );
+        std::fs::remove_file(run.join("evaluation-replan.json")).unwrap();
+        assert_eq!(status(run).unwrap().0, Status::Pending);
+        assert!(
+            damage(run)
+                .unwrap()
+                .contains("evaluation-replan.json is gone")
+        );
+        std::fs::write(run.join("evaluation-replan.json"), "{}").unwrap();
+        std::fs::write(run.join("metrics.jsonl"), "{\"epoch\":1}\n{\"ep").unwrap();
+        assert_eq!(status(run).unwrap().0, Status::Damaged);
+        std::fs::write(run.join("metrics.jsonl"), "{\"epoch\":1}\n").unwrap();
         // Held by a task, it is running whatever its files say.
         let _claim = Claim::take(run, PATIENCE).unwrap();
         assert_eq!(status(run).unwrap().0, Status::Running);

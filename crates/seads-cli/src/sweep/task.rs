@@ -12,7 +12,7 @@ use crate::train::Shown;
 use seads_skillmodel::SkillModelKind;
 
 use super::index::Sweep;
-use super::state::{Claim, Outcome, Record};
+use super::state::{Claim, Missing, Outcome, Record, check_outputs};
 use crate::overtraining::{Selection, evaluate_checkpoints};
 use crate::plan::{load_agent, run_evaluation, run_policy_evaluation};
 use seads_planner::{EvaluationKind, Protocol, TaskSet};
@@ -29,15 +29,27 @@ pub fn thread_split(cores: usize) -> (usize, usize) {
 /// the run's `task.json` before they are returned.
 pub fn run_task(dir: &Path, index: usize, cores: usize, patience: Duration) -> Result<()> {
     let sweep = Sweep::load(dir).map_err(crate::BadInput)?;
-    let run = sweep.run_dir(dir, index).map_err(crate::BadInput)?;
+    sweep.run_dir(dir, index).map_err(crate::BadInput)?;
+    let (run, replanned) = sweep.ensure_run_dir(dir, index)?;
+    if replanned {
+        outln!(
+            "{}: was deleted; planned again from the manifest",
+            run.display()
+        );
+    }
     let claim = Claim::take(&run, patience)?;
     let previous = Record::read(&run)?;
-    if previous
-        .as_ref()
-        .is_some_and(|r| r.outcome == Outcome::Done)
-    {
-        outln!("{}: already done", run.display());
-        return Ok(());
+    if let Some(done) = previous.as_ref().filter(|r| r.outcome == Outcome::Done) {
+        match check_outputs(&run, done) {
+            Ok(()) => {
+                outln!("{}: already done", run.display());
+                return Ok(());
+            }
+            Err(Missing::Gone(name)) => {
+                outln!("{}: {name} is gone; finishing the run again", run.display());
+            }
+            Err(Missing::Unreadable(why)) => bail!(crate::BadInput(anyhow::anyhow!(why))),
+        }
     }
     // Training it again from scratch would replace the data it holds; nothing is recorded, so
     // the run stays "copied".
