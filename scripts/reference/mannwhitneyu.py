@@ -10,7 +10,7 @@ beside SciPy's p for small samples.
 The cases are the shapes a Table 1 comparison takes: five or ten final skill coverages per
 variant, often tied at the maximum (25.0 or 12.0), plus samples beyond 8 values and small
 samples without ties. Writes data/reference/mannwhitneyu.json, checked by the unit tests of
-crates/seads-cli/src/report/stats.rs.
+crates/seads-study/src/report/stats.rs.
 
 Run in any Python with SciPy (it was run with SciPy 1.17.1, NumPy 2.x):
     python3 -m venv /tmp/scipyenv && /tmp/scipyenv/bin/pip install scipy

@@ -67,7 +67,6 @@ fn root() -> PathBuf {
         .to_path_buf()
 }
 
-/// Runs a command in the repository root and fails if it fails.
 /// `cargo package` of every library crate (the workspace without xtask and the tests crate).
 const PACKAGE: [&str; 6] = [
     "package",
@@ -78,6 +77,7 @@ const PACKAGE: [&str; 6] = [
     "seads-tests",
 ];
 
+/// Runs a command in the repository root and fails if it fails.
 fn step(program: &str, args: &[&str]) -> Result<()> {
     step_with_env(program, args, &[])
 }

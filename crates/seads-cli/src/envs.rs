@@ -15,26 +15,6 @@ pub fn build_env(name: &str, config: &EnvConfig) -> Result<Box<dyn Environment>>
     make_env(name, config).map_err(|e| BadInput(e.into()).into())
 }
 
-/// The number of skills K of a run: its `num_skills`, else the moves of its environment's game
-/// (for a robot run, whose environment is not in the registry, the tablet's LightsOut 5×5).
-pub fn run_skills(config: &seads_rl::TrainConfig) -> usize {
-    config
-        .num_skills
-        .unwrap_or_else(|| match make_env(&config.env, &config.env_config) {
-            Ok(env) => env.spec().num_skills,
-            Err(_) => seads_uarm::BOARD_SIZE * seads_uarm::BOARD_SIZE,
-        })
-}
-
-/// The board game of a run's environment (for a robot run, the tablet's LightsOut 5×5).
-pub fn run_game(config: &seads_rl::TrainConfig) -> Result<Box<dyn seads_games::BoardGame>> {
-    let game = match make_env(&config.env, &config.env_config) {
-        Ok(env) => env.spec().game.build(env.spec().board_size),
-        Err(_) => seads_games::GameKind::LightsOut.build(seads_uarm::BOARD_SIZE),
-    };
-    game.with_context(|| format!("building the game of {}", config.env))
-}
-
 /// `seads envs`: every registered environment with its dimensions.
 pub fn envs(json: bool) -> Result<()> {
     let envs = list_envs();
@@ -96,7 +76,7 @@ pub fn render(args: RenderArgs) -> Result<()> {
     env.seed(args.seed);
     env.reset()?;
     let title = format!("{} (seed {})", args.env, args.seed);
-    crate::draw::render_scene(&env.scene(), &title, &args.out)?;
+    seads_study::draw::render_scene(&env.scene(), &title, &args.out)?;
     outln!("wrote {}", args.out.display());
     Ok(())
 }

@@ -13,7 +13,6 @@ macro_rules! outln {
 }
 
 mod demo;
-mod draw;
 mod envs;
 mod episodes;
 mod games;
@@ -21,7 +20,6 @@ mod kernels;
 mod overtraining;
 mod plan;
 mod plot;
-mod provenance;
 mod report;
 mod sweep;
 mod train;
@@ -87,6 +85,29 @@ enum Command {
 #[derive(Debug, thiserror::Error)]
 #[error(transparent)]
 pub struct BadInput(#[from] pub anyhow::Error);
+
+/// The binary, as provenance records it: version and the commit it was built from (`build.rs`).
+pub fn build() -> seads_study::provenance::Build<'static> {
+    seads_study::provenance::Build {
+        version: env!("CARGO_PKG_VERSION"),
+        commit: env!("VERGEN_GIT_SHA"),
+        dirty: env!("VERGEN_GIT_DIRTY") == "true",
+    }
+}
+
+/// Any error as bad input (exit 2).
+pub fn bad_input(e: impl Into<anyhow::Error>) -> BadInput {
+    BadInput(e.into())
+}
+
+/// A study library error as the binary's: input the user must fix is bad input (exit 2).
+pub fn study_error(e: seads_study::StudyError) -> anyhow::Error {
+    if e.is_invalid() {
+        BadInput(e.into()).into()
+    } else {
+        e.into()
+    }
+}
 
 /// Takes the run directory `dir` for this command, the one writer it may have at a time (see
 /// [`seads_rl::RunLock`]); another writer holding it is exit 2, naming it. Waits a moment, for a
@@ -331,7 +352,12 @@ fn main() -> ExitCode {
             eprintln!("error: {}", one_line(&err));
             if err.is::<BadInput>() {
                 ExitCode::from(2)
-            } else if err.is::<sweep::Taken>() {
+            } else if err.chain().any(|c| {
+                matches!(
+                    c.downcast_ref::<seads_study::StudyError>(),
+                    Some(seads_study::StudyError::Taken(_))
+                )
+            }) {
                 ExitCode::from(sweep::TAKEN_EXIT)
             } else {
                 ExitCode::FAILURE

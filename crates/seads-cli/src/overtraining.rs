@@ -7,53 +7,14 @@ use std::path::Path;
 
 use anyhow::{Context, Result, anyhow};
 use indicatif::{ProgressBar, ProgressStyle};
-use seads_planner::{DepthResult, EvaluationKind, Protocol, SearchLimits, TaskSet};
+use seads_planner::{Protocol, SearchLimits, TaskSet};
 use seads_rl::Agent;
-use serde::{Deserialize, Serialize};
 
 use crate::BadInput;
 use crate::plan::evaluate_agent;
-
-/// The file, in the run directory.
-pub const FILE: &str = "evaluation-over-training.jsonl";
-
-/// One line: a checkpoint evaluated in one mode.
-#[derive(Debug, Clone, Serialize, Deserialize)]
-pub struct CheckpointEvaluation {
-    /// Epoch of the checkpoint.
-    pub epoch: u64,
-    /// Environment steps of training at the checkpoint.
-    pub env_steps: u64,
-    /// With re-planning.
-    pub replan: bool,
-    /// Boards per depth.
-    pub boards: usize,
-    /// Seconds per search.
-    pub timeout_s: f64,
-    /// States expanded per search, if bounded.
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub max_expanded: Option<usize>,
-    /// Per depth.
-    pub results: Vec<DepthResult>,
-}
-
-impl CheckpointEvaluation {
-    /// The protocol the line was evaluated with: test boards, the protocol's seeds, its
-    /// depths those of its results.
-    pub fn protocol(&self) -> Protocol {
-        Protocol {
-            kind: EvaluationKind::planning(self.replan),
-            tasks: TaskSet {
-                depths: self.results.iter().map(|r| r.depth).collect(),
-                ..TaskSet::standard(self.boards)
-            },
-            limits: Some(SearchLimits {
-                timeout_s: self.timeout_s,
-                max_expanded: self.max_expanded,
-            }),
-        }
-    }
-}
+use seads_study::evaluation::{
+    CheckpointEvaluation, OVER_TRAINING, over_training_protocol, read_over_training,
+};
 
 /// Which checkpoints: `all`, every N-th kept one (the last always), or the listed epochs.
 #[derive(Debug, Clone, PartialEq, Eq)]
@@ -126,25 +87,6 @@ impl std::str::FromStr for Selection {
     }
 }
 
-/// Reads the lines of `run`'s file (none if it does not exist; a torn last line is ignored).
-pub fn read(run: &Path) -> Result<Vec<CheckpointEvaluation>> {
-    let path = run.join(FILE);
-    if !path.exists() {
-        return Ok(Vec::new());
-    }
-    Ok(seads_rl::read_json_lines(&path)?.0)
-}
-
-/// The protocol of over-training evaluations of `tasks` with `limits`, with or without
-/// re-planning.
-pub fn protocol(tasks: &TaskSet, limits: SearchLimits, replan: bool) -> Protocol {
-    Protocol {
-        kind: EvaluationKind::planning(replan),
-        tasks: tasks.clone(),
-        limits: Some(limits),
-    }
-}
-
 /// Evaluates the selected checkpoints of `run` in both modes on `tasks` (test boards, the
 /// protocol's seeds), unless the file holds them evaluated with the same protocol already.
 /// Returns the number of lines appended.
@@ -168,11 +110,16 @@ pub fn evaluate_checkpoints(
             run.display()
         ))
     })?;
-    let done: Vec<(u64, Protocol)> = read(run)?.iter().map(|l| (l.epoch, l.protocol())).collect();
+    let done: Vec<(u64, Protocol)> = read_over_training(run)?
+        .iter()
+        .map(|l| (l.epoch, l.protocol()))
+        .collect();
     let todo: Vec<(u64, &Path, bool)> = chosen
         .iter()
         .flat_map(|(epoch, dir)| [true, false].map(|replan| (*epoch, dir.as_path(), replan)))
-        .filter(|(epoch, _, replan)| !done.contains(&(*epoch, protocol(tasks, limits, *replan))))
+        .filter(|(epoch, _, replan)| {
+            !done.contains(&(*epoch, over_training_protocol(tasks, limits, *replan)))
+        })
         .collect();
     let per = tasks.len() as u64;
     let bar = if quiet {
@@ -187,7 +134,7 @@ pub fn evaluate_checkpoints(
         .expect("valid template")
         .progress_chars("=> "),
     );
-    let path = run.join(FILE);
+    let path = run.join(OVER_TRAINING);
     let mut loaded: Option<(u64, Agent)> = None;
     for (epoch, dir, replan) in &todo {
         if loaded.as_ref().is_none_or(|(e, _)| e != epoch) {
@@ -195,7 +142,7 @@ pub fn evaluate_checkpoints(
         }
         let agent = &mut loaded.as_mut().expect("just loaded").1;
         bar.set_prefix(format!("epoch {epoch}"));
-        let results = evaluate_agent(agent, &protocol(tasks, limits, *replan), &bar)?;
+        let results = evaluate_agent(agent, &over_training_protocol(tasks, limits, *replan), &bar)?;
         let env_steps = seads_rl::checkpoint_id(run, dir)?
             .env_steps
             .ok_or_else(|| {

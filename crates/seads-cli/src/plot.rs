@@ -13,10 +13,11 @@ use seads_games::Split;
 use seads_planner::DepthResult;
 use seads_rl::{Agent, AgentPolicy, COVERAGE_SEED, find_checkpoint, read_metrics};
 
-use crate::draw::{draw_paths, draw_scene, plot_err, render_to, skill_colour};
 use crate::envs::build_env;
-use crate::plan::{load_agent, read_evaluation, run_evaluation};
+use crate::plan::{load_agent, run_evaluation};
 use seads_planner::{EvaluationKind, Protocol, STANDARD_DEPTHS, SearchLimits, TaskSet};
+use seads_study::draw::{draw_paths, draw_scene, plot_err, render_to, skill_colour};
+use seads_study::evaluation::read_evaluation;
 
 /// Arguments of `seads plot`.
 #[derive(Debug, Args)]
@@ -70,7 +71,7 @@ pub fn write_figures(
     std::fs::create_dir_all(out).with_context(|| format!("creating {}", out.display()))?;
     let mut written = Vec::new();
     let mut both = |name: &str, f: &dyn Fn(&Path) -> Result<()>| -> Result<()> {
-        written.extend(crate::draw::png_and_svg(out, name, f)?);
+        written.extend(seads_study::draw::png_and_svg(out, name, f)?);
         Ok(())
     };
     let metrics = read_metrics(run)?;

@@ -312,9 +312,14 @@ pub fn drive<L: Shown>(run: &mut Run<L>, quiet: bool) -> Result<()> {
     let budget = run.trainer().config().env_steps;
     if !run.finished() {
         let portable = run.trainer().config().portable_numerics;
-        crate::provenance::Provenance::here(run.trainer().epoch(), run.trainer().steps(), portable)
-            .append(run.dir())
-            .context("recording the run's provenance")?;
+        seads_study::provenance::Provenance::here(
+            run.trainer().epoch(),
+            run.trainer().steps(),
+            portable,
+            &crate::build(),
+        )
+        .append(run.dir())
+        .context("recording the run's provenance")?;
     }
     let bar = if quiet {
         ProgressBar::hidden()

@@ -489,13 +489,13 @@ fn evaluate(
         }
     }
     bar.finish_and_clear();
-    let (id, named) = crate::plan::checkpoint_of(run, &checkpoint)?;
+    let (id, named) = seads_study::evaluation::checkpoint_of(run, &checkpoint)?;
     let record = EvaluationRecord {
         checkpoint: Some(id),
         protocol: Some(protocol),
         results: results.into_values().collect(),
     };
-    crate::plan::save_evaluation(run, &record, named, None)?;
+    seads_study::evaluation::save_evaluation(run, &record, named, None)?;
     let results = record.results;
     let (solved, tasks) = results
         .iter()

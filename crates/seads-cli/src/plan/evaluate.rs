@@ -125,9 +125,12 @@ pub fn evaluate_run(args: EvaluateArgs) -> Result<()> {
         )?;
         // The lines of this protocol only: the file may hold evaluations with other depths,
         // boards or limits.
-        let lines: Vec<_> = crate::overtraining::read(&args.run)?
+        let lines: Vec<_> = seads_study::evaluation::read_over_training(&args.run)?
             .into_iter()
-            .filter(|l| l.protocol() == crate::overtraining::protocol(&tasks, limits, l.replan))
+            .filter(|l| {
+                l.protocol()
+                    == seads_study::evaluation::over_training_protocol(&tasks, limits, l.replan)
+            })
             .collect();
         if args.json {
             outln!("{}", serde_json::to_string(&lines)?);
@@ -135,7 +138,9 @@ pub fn evaluate_run(args: EvaluateArgs) -> Result<()> {
             outln!(
                 "{added} new evaluation(s); {} in {}",
                 lines.len(),
-                args.run.join(crate::overtraining::FILE).display()
+                args.run
+                    .join(seads_study::evaluation::OVER_TRAINING)
+                    .display()
             );
             outln!("     epoch   env steps  mode            success per depth");
             for l in &lines {

@@ -7,12 +7,13 @@ use anyhow::{Context, Result, anyhow};
 use indicatif::ProgressBar;
 use seads_games::BoardGame;
 use seads_planner::{
-    CheckpointId, DepthResult, Evaluation, EvaluationKind, EvaluationRecord, PlannerConfig,
-    Protocol, SolveConfig, TaskRecord, TaskSet, evaluate,
+    DepthResult, Evaluation, EvaluationKind, EvaluationRecord, PlannerConfig, Protocol,
+    SolveConfig, TaskRecord, TaskSet, evaluate,
 };
 use seads_rl::{Agent, TrainConfig};
 
 use crate::BadInput;
+use seads_study::evaluation::{checkpoint_of, save_evaluation};
 
 /// Evaluates the agent with `protocol` (a planning kind), advancing `bar` by one per task.
 pub fn evaluate_agent(
@@ -54,53 +55,6 @@ fn evaluate_agent_with(
         each(task);
     })
     .map_err(|e| BadInput(e.into()).into())
-}
-
-/// Which checkpoint `agent` is, and `None` where it is the run's latest (whose evaluation takes
-/// the plain file names) or `Some(epoch)` for an earlier one.
-pub fn checkpoint_of(run: &Path, checkpoint: &Path) -> Result<(CheckpointId, Option<u64>)> {
-    let id = seads_rl::checkpoint_id(run, checkpoint)?;
-    let latest = seads_rl::latest_checkpoint(run)?;
-    let named = (latest.as_deref() != Some(checkpoint)).then_some(id.epoch);
-    Ok((id, named))
-}
-
-/// Writes an evaluation's record (and its tasks' lines, if any) into the run directory, under
-/// the names its protocol and checkpoint give.
-pub fn save_evaluation(
-    run: &Path,
-    record: &EvaluationRecord,
-    named_epoch: Option<u64>,
-    task_lines: Option<&str>,
-) -> Result<()> {
-    let protocol = record
-        .protocol
-        .as_ref()
-        .ok_or_else(|| anyhow!("an evaluation is saved with its protocol"))?;
-    let (kind, depths) = (protocol.kind, &protocol.tasks.depths);
-    seads_rl::write_atomic(
-        &run.join(kind.results_file(depths, named_epoch)),
-        record.to_json().as_bytes(),
-    )?;
-    if let Some(lines) = task_lines {
-        seads_rl::write_atomic(
-            &run.join(kind.tasks_file(depths, named_epoch)),
-            lines.as_bytes(),
-        )?;
-    }
-    Ok(())
-}
-
-/// Reads an evaluation file, `None` if there is none; an unreadable one is an error naming it.
-pub fn read_evaluation(path: &Path) -> Result<Option<EvaluationRecord>> {
-    let text = match std::fs::read_to_string(path) {
-        Ok(text) => text,
-        Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok(None),
-        Err(e) => return Err(e).with_context(|| format!("reading {}", path.display())),
-    };
-    EvaluationRecord::from_json(&text)
-        .map(Some)
-        .map_err(|e| BadInput(anyhow!("{}: not an evaluation file: {e}", path.display())).into())
 }
 
 /// Evaluates the agent with `protocol` and saves the record and one line per task into the run

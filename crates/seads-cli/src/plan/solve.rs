@@ -70,7 +70,7 @@ pub fn solve_board(args: SolveArgs) -> Result<()> {
             "{}: {} in {} steps",
             agent.config.env, status, outcome.manipulator_steps
         );
-        crate::draw::render_solution(&before, &outcome.runs, &title, out)?;
+        seads_study::draw::render_solution(&before, &outcome.runs, &title, out)?;
     }
     if args.json {
         #[derive(Serialize)]

@@ -1,11 +1,7 @@
 //! `seads sweep`: studies over many seeds and variants — plan them from a manifest, run them on
 //! this machine or as a Slurm job array, and see where each run stands.
 
-mod index;
-mod manifest;
 mod pool;
-mod slurm;
-mod state;
 pub(crate) mod task;
 
 use std::path::PathBuf;
@@ -15,11 +11,12 @@ use anyhow::{Context, Result, anyhow};
 use clap::{Args, Subcommand};
 use serde::Serialize;
 
-pub use index::{INDEX, MANIFEST, Sweep};
+pub use index::Sweep;
 pub use manifest::Manifest;
-pub use state::{Status, TAKEN_EXIT, Taken};
+pub use state::{Status, TAKEN_EXIT};
 
 use crate::BadInput;
+use seads_study::sweep::{index, manifest, slurm, state};
 
 /// `seads sweep …`.
 #[derive(Debug, Subcommand)]
@@ -179,8 +176,8 @@ fn plan(args: PlanArgs) -> Result<()> {
     let text = std::fs::read_to_string(&args.manifest)
         .map_err(|e| BadInput(anyhow!("reading {}: {e}", args.manifest.display())))?;
     let manifest =
-        Manifest::parse(&text, &args.manifest.display().to_string()).map_err(BadInput)?;
-    let planned = Sweep::plan(&manifest, &text, &args.out).map_err(BadInput)?;
+        Manifest::parse(&text, &args.manifest.display().to_string()).map_err(crate::bad_input)?;
+    let planned = Sweep::plan(&manifest, &text, &args.out).map_err(crate::bad_input)?;
     if planned.created == 0 {
         outln!(
             "sweep {:?} in {} is already planned ({} runs); nothing changed",
@@ -212,7 +209,7 @@ fn slurm(args: SlurmArgs) -> Result<()> {
             args.dir.display()
         ))
     })?;
-    let sweep = Sweep::load(&dir).map_err(BadInput)?;
+    let sweep = Sweep::load(&dir).map_err(crate::bad_input)?;
     let seads = match args.seads {
         Some(path) => std::fs::canonicalize(&path)
             .map_err(|_| BadInput(anyhow!("--seads {} does not exist", path.display())))?,
@@ -263,7 +260,7 @@ struct RunStatus {
 }
 
 fn status(args: StatusArgs) -> Result<()> {
-    let sweep = Sweep::load(&args.dir).map_err(BadInput)?;
+    let sweep = Sweep::load(&args.dir).map_err(crate::bad_input)?;
     let mut rows = Vec::new();
     for (index, run) in sweep.runs.iter().enumerate() {
         let dir = args.dir.join(&run.dir);

@@ -64,7 +64,7 @@ pub fn run_sweep(
     cores: usize,
     quiet: bool,
 ) -> Result<()> {
-    let sweep = Sweep::load(dir).map_err(crate::BadInput)?;
+    let sweep = Sweep::load(dir).map_err(crate::bad_input)?;
     let chosen = selected(&sweep, seeds)?;
     let mut todo = Vec::new();
     let mut skipped_running = 0;

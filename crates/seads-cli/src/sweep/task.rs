@@ -28,8 +28,8 @@ pub fn thread_split(cores: usize) -> (usize, usize) {
 /// another task that holds the run. A run already done is left as it is. Errors are recorded in
 /// the run's `task.json` before they are returned.
 pub fn run_task(dir: &Path, index: usize, cores: usize, patience: Duration) -> Result<()> {
-    let sweep = Sweep::load(dir).map_err(crate::BadInput)?;
-    sweep.run_dir(dir, index).map_err(crate::BadInput)?;
+    let sweep = Sweep::load(dir).map_err(crate::bad_input)?;
+    sweep.run_dir(dir, index).map_err(crate::bad_input)?;
     let (run, replanned) = sweep.ensure_run_dir(dir, index)?;
     if replanned {
         outln!(

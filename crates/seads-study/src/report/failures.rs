@@ -6,7 +6,7 @@ use std::collections::BTreeMap;
 use std::fmt::Write as _;
 use std::path::Path;
 
-use anyhow::Result;
+use crate::Result;
 use serde::Deserialize;
 
 use super::runs::Group;

@@ -6,13 +6,13 @@
 
 use std::fmt::Write as _;
 
-use anyhow::{Context, Result};
+use crate::{Context as _, Result};
 use seads_games::{BoardGame, MoveId};
 
 use super::csv_field;
 use super::failures::{TaskLine, read_tasks};
 use super::runs::Group;
-use crate::envs::run_game;
+use crate::run_game;
 
 /// The rows shown in report.md; `failed-tasks.csv` has them all.
 const SHOWN: usize = 40;
@@ -42,7 +42,7 @@ impl std::fmt::Display for Effect {
 fn effect(game: &dyn BoardGame, before: &str, after: &str) -> Result<Effect> {
     let parse = |text: &str| {
         game.parse(text)
-            .with_context(|| format!("board {text:?} in a per-task file"))
+            .doing(|| format!("board {text:?} in a per-task file"))
     };
     let (before, after) = (parse(before)?, parse(after)?);
     if before == after {
@@ -178,9 +178,9 @@ pub fn failed_task_tables(groups: &[Group<'_>]) -> Result<Option<(String, String
         let game = run_game(&first.config)?;
         for (run, lines) in &tasks {
             for line in lines {
-                if let Some(task) = FailedTask::of(game.as_ref(), line).with_context(|| {
-                    format!("reading the per-task file of {}", run.dir.display())
-                })? {
+                if let Some(task) = FailedTask::of(game.as_ref(), line)
+                    .doing(|| format!("reading the per-task file of {}", run.dir.display()))?
+                {
                     rows.push([
                         g.env.clone(),
                         g.variant.clone(),

@@ -14,6 +14,18 @@ use serde::{Deserialize, Serialize};
 /// The file in a run directory.
 pub const PROVENANCE: &str = "provenance.jsonl";
 
+/// The binary that trains: its version and the commit it was built from (the `seads` binary
+/// stamps them at build time).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Build<'a> {
+    /// The seads version.
+    pub version: &'a str,
+    /// The git commit.
+    pub commit: &'a str,
+    /// Whether tracked files differed from that commit.
+    pub dirty: bool,
+}
+
 /// One training process of a run.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct Provenance {
@@ -42,15 +54,15 @@ pub struct Provenance {
 }
 
 impl Provenance {
-    /// This process, about to train from `epoch` and `env_steps`.
-    pub fn here(epoch: u64, env_steps: u64, portable_numerics: bool) -> Self {
+    /// This process of the binary `build`, about to train from `epoch` and `env_steps`.
+    pub fn here(epoch: u64, env_steps: u64, portable_numerics: bool, build: &Build) -> Self {
         let (cpu_vendor, cpu_model, avx512) = cpu();
         Self {
             epoch,
             env_steps,
-            seads: env!("CARGO_PKG_VERSION").to_string(),
-            commit: env!("VERGEN_GIT_SHA").to_string(),
-            dirty: env!("VERGEN_GIT_DIRTY") == "true",
+            seads: build.version.to_owned(),
+            commit: build.commit.to_owned(),
+            dirty: build.dirty,
             cpu_vendor,
             cpu_model,
             avx512,

@@ -4,7 +4,8 @@
 
 use std::collections::BTreeMap;
 
-use anyhow::{Result, anyhow, bail};
+use crate::Result;
+use crate::error::{fail, failure};
 use seads_embodiment::env_names;
 use seads_rl::TrainConfig;
 use serde::{Deserialize, Serialize};
@@ -118,10 +119,10 @@ impl Manifest {
     /// Parses and validates a manifest; `origin` names it in errors.
     pub fn parse(text: &str, origin: &str) -> Result<Self> {
         let manifest: Self = toml::from_str(text)
-            .map_err(|e| anyhow!("{origin}: {}", e.message().trim().replace('\n', " ")))?;
+            .map_err(|e| failure!("{origin}: {}", e.message().trim().replace('\n', " ")))?;
         manifest
             .validate()
-            .map_err(|e| anyhow!("{origin}: {e:#}"))?;
+            .map_err(|e| failure!("{origin}: {e:#}"))?;
         Ok(manifest)
     }
 
@@ -135,7 +136,7 @@ impl Manifest {
 
     fn validate(&self) -> Result<()> {
         if !is_name(&self.name) {
-            bail!(
+            fail!(
                 "the study name {:?} must be letters, digits, '-' or '_'",
                 self.name
             );
@@ -143,7 +144,7 @@ impl Manifest {
         let known = env_names();
         for env in &self.environments {
             if !known.contains(&env.as_str()) {
-                bail!(
+                fail!(
                     "unknown environment {env:?}; valid environments: {}",
                     known.join(", ")
                 );
@@ -152,17 +153,17 @@ impl Manifest {
         let mut names = std::collections::BTreeSet::new();
         for v in &self.variants {
             if !is_name(&v.name) {
-                bail!(
+                fail!(
                     "variant name {:?} must be letters, digits, '-' or '_'",
                     v.name
                 );
             }
             if !names.insert(v.name.as_str()) {
-                bail!("duplicate variant name {:?}", v.name);
+                fail!("duplicate variant name {:?}", v.name);
             }
             for env in v.env_overrides.keys() {
                 if !self.environments.contains(env) {
-                    bail!(
+                    fail!(
                         "variant {:?} overrides environment {env:?}, which the study does not train",
                         v.name
                     );
@@ -172,29 +173,29 @@ impl Manifest {
         if let Some(reference) = &self.reference
             && !names.contains(reference.as_str())
         {
-            bail!("the reference variant {reference:?} is not a variant of the study");
+            fail!("the reference variant {reference:?} is not a variant of the study");
         }
         let mut seeds = self.seeds.clone();
         seeds.sort_unstable();
         seeds.dedup();
         if seeds.len() != self.seeds.len() {
-            bail!("a seed is listed twice");
+            fail!("a seed is listed twice");
         }
         if self.environments.is_empty() || self.seeds.is_empty() || self.variants.is_empty() {
-            bail!(
+            fail!(
                 "the manifest expands to no run: it needs at least one environment, one seed and one variant"
             );
         }
         let e = &self.evaluation;
         if e.boards == 0 || !(e.timeout.is_finite() && e.timeout > 0.0) || e.max_expanded == Some(0)
         {
-            bail!(
+            fail!(
                 "evaluation.boards and evaluation.max_expanded must be at least 1 and \
                  evaluation.timeout above 0"
             );
         }
         if let Some(problem) = seads_planner::TaskSet::standard(e.boards).problem() {
-            bail!("evaluation.boards = {}: {problem}", e.boards);
+            fail!("evaluation.boards = {}: {problem}", e.boards);
         }
         // Expanding checks every override against the configuration's keys and values.
         self.expand()?;
@@ -239,7 +240,7 @@ impl Manifest {
             .iter()
             .find(|(name, _)| *name == env)
             .map(|(_, text)| *text)
-            .ok_or_else(|| anyhow!("environment {env:?} has no preset"))?;
+            .ok_or_else(|| failure!("environment {env:?} has no preset"))?;
         let mut table: toml::Table = toml::from_str(preset)?;
         let layers = [
             ("overrides", &self.overrides),
@@ -251,7 +252,7 @@ impl Manifest {
         {
             for key in AXIS_KEYS {
                 if layer.contains_key(key) {
-                    bail!(
+                    fail!(
                         "variant {:?}: {what} may not set `{key}` (the study's axes set it)",
                         variant.name
                     );
@@ -264,7 +265,7 @@ impl Manifest {
             toml::Value::Table(table)
                 .try_into()
                 .map_err(|e: toml::de::Error| {
-                    anyhow!(
+                    failure!(
                         "variant {:?} on {env}: {}",
                         variant.name,
                         e.message().trim().replace('\n', " ")
@@ -272,7 +273,7 @@ impl Manifest {
                 })?;
         config
             .validate()
-            .map_err(|e| anyhow!("variant {:?} on {env}: {e}", variant.name))?;
+            .map_err(|e| failure!("variant {:?} on {env}: {e}", variant.name))?;
         Ok(config)
     }
 }

@@ -4,11 +4,12 @@
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
-use anyhow::{Context, Result, anyhow, bail};
+use crate::error::{fail, failure};
+use crate::{Context as _, Result};
 use seads_planner::{DepthResult, EvaluationKind, STANDARD_DEPTHS};
 use seads_rl::{Algorithm, Metrics, TaskMetrics, TrainConfig};
 
-use crate::overtraining::CheckpointEvaluation;
+use crate::evaluation::CheckpointEvaluation;
 use crate::sweep::Sweep;
 
 /// One run, as read from its directory.
@@ -85,7 +86,7 @@ impl RunData {
         let mut unrecorded_evaluations = 0;
         let mut evaluation = |kind: EvaluationKind| -> Result<Option<Vec<DepthResult>>> {
             let file = kind.results_file(&STANDARD_DEPTHS, None);
-            let record = match crate::plan::read_evaluation(&dir.join(&file)) {
+            let record = match crate::evaluation::read_evaluation(&dir.join(&file)) {
                 Ok(Some(record)) => record,
                 Ok(None) => return Ok(None),
                 Err(e) => {
@@ -124,9 +125,9 @@ impl RunData {
             evaluation_notes,
             unrecorded_evaluations,
             damage,
-            over_training: crate::overtraining::read(dir)?,
+            over_training: crate::evaluation::read_over_training(dir)?,
             processors: crate::provenance::Provenance::processors(dir)
-                .with_context(|| format!("reading the provenance of {}", dir.display()))?,
+                .doing(|| format!("reading the provenance of {}", dir.display()))?,
             config,
             metrics,
             task_metrics,
@@ -200,21 +201,21 @@ pub fn collect(inputs: &[PathBuf]) -> Result<Collection> {
                     .push((input.clone(), format!("{e:#}"))),
             }
         } else if input.is_dir() {
-            bail!(
+            fail!(
                 "{} is neither a sweep (sweep.json) nor a run directory (config.toml)",
                 input.display()
             );
         } else {
-            bail!("{} does not exist", input.display());
+            fail!("{} does not exist", input.display());
         }
     }
     if collection.runs.is_empty() {
         match collection.unreadable.first() {
-            Some((dir, why)) => bail!(
+            Some((dir, why)) => fail!(
                 "no runs to report on: {} cannot be read: {why}",
                 dir.display()
             ),
-            None => bail!("no runs to report on"),
+            None => fail!("no runs to report on"),
         }
     }
     Ok(collection)
@@ -249,7 +250,7 @@ pub fn group(runs: &[RunData]) -> Result<(Vec<Group<'_>>, Vec<&RunData>)> {
         let options = toml::to_string(&run.config.env_config)?;
         match env_configs.get(&key) {
             Some((other, first)) if *other != options => {
-                return Err(anyhow!(
+                return Err(failure!(
                     "variant {:?} mixes different {} environments in one table row: {} and {} differ in their env_config",
                     run.variant,
                     run.config.env,
@@ -282,7 +283,7 @@ pub fn group(runs: &[RunData]) -> Result<(Vec<Group<'_>>, Vec<&RunData>)> {
 /// (`provenance.jsonl`).
 pub fn data_files(run: &Path) -> Result<Vec<PathBuf>> {
     let mut files = Vec::new();
-    for entry in std::fs::read_dir(run).with_context(|| format!("reading {}", run.display()))? {
+    for entry in std::fs::read_dir(run).doing(|| format!("reading {}", run.display()))? {
         let path = entry?.path();
         let name = path
             .file_name()

@@ -5,7 +5,7 @@
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
-use anyhow::Result;
+use crate::{Result, StudyError};
 use plotters::coord::Shift;
 use plotters::prelude::*;
 
@@ -122,7 +122,7 @@ fn band_figure(
             .background_style(WHITE.mix(0.9))
             .draw()
             .map_err(plot_err)?;
-        anyhow::Ok(())
+        Ok::<(), StudyError>(())
     })
 }
 
@@ -327,7 +327,7 @@ fn box_figure(
                 }))
                 .map_err(plot_err)?;
         }
-        anyhow::Ok(())
+        Ok::<(), StudyError>(())
     })
 }
 

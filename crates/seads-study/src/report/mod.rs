@@ -1,25 +1,24 @@
-//! `seads report`: tables, tests and figures over any set of sweeps and runs — the paper's
-//! Table 1 with its Mann–Whitney tests, task success and lengths, failed tasks and the skills
-//! that deviated from the model's predictions (each failed task's wrong moves too), where the
-//! training time went, coverage and success curves and length box plots — written to
-//! `report.md`, CSV files and PNG + SVG figures.
+//! Reports over any set of sweeps and runs: the paper's Table 1 with its Mann–Whitney tests,
+//! task success and lengths, failed tasks and the skills that deviated from the model's
+//! predictions (each failed task's wrong moves too), where the training time went, coverage and
+//! success curves and length box plots, written to `report.md`, CSV files and PNG + SVG figures
+//! by [`write_report`].
 
 mod curves;
 mod failed_tasks;
 mod failures;
 mod figures;
 mod runs;
-mod stats;
+pub mod stats;
 mod tables;
 mod walltime;
 
 use std::fmt::Write as _;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
-use anyhow::{Context, Result, anyhow};
-use clap::Args;
+use crate::{Context as _, Result, StudyError};
 
-use crate::BadInput;
+pub use runs::data_files;
 
 /// A CSV field, quoted when it holds a comma or a quote (RFC 4180).
 fn csv_field(text: &str) -> String {
@@ -30,43 +29,52 @@ fn csv_field(text: &str) -> String {
     }
 }
 
-/// Arguments of `seads report`.
-#[derive(Debug, Args)]
-pub struct ReportArgs {
-    /// Sweep directories (from `seads sweep plan`) and run directories, in any mix. A run outside
-    /// a sweep is its own variant, named by its directory.
-    #[arg(required = true)]
-    inputs: Vec<PathBuf>,
-    /// Folder for report.md, the CSV tables and the figures.
-    #[arg(long)]
-    out: PathBuf,
-    /// The variant the others are tested against (default: the first sweep's reference).
-    #[arg(long)]
-    reference: Option<String>,
-    /// Also copy what the report rests on into REPORT_DIR/runs/: each run's config.toml,
-    /// metrics.jsonl and evaluation files (never checkpoints), so that the folder can be
-    /// committed as data and reported again from itself.
-    #[arg(long)]
-    copy_runs: bool,
+/// What to report.
+#[derive(Debug, Clone)]
+pub struct ReportOptions {
+    /// Sweep directories and run directories, in any mix; a run outside a sweep is its own
+    /// variant, named by its directory.
+    pub inputs: Vec<PathBuf>,
+    /// The variant the others are tested against (`None`: the first sweep's reference).
+    pub reference: Option<String>,
+    /// Also copy what the report rests on into `OUT/runs/`: each run's config, metrics and
+    /// evaluation files (never checkpoints), with each sweep's index and manifest.
+    pub copy_runs: bool,
 }
 
-/// Runs `seads report`.
-pub fn report(args: ReportArgs) -> Result<()> {
-    let inputs: Vec<&std::path::Path> = args.inputs.iter().map(PathBuf::as_path).collect();
-    crate::refuse_overwriting_input(&args.out, &inputs)?;
-    let collection = runs::collect(&args.inputs).map_err(BadInput)?;
-    let reference = args.reference.clone().or(collection.reference.clone());
-    let (groups, unfinished) = runs::group(&collection.runs).map_err(BadInput)?;
+/// What a report holds, for the front end to tell.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct ReportSummary {
+    /// Finished runs in the tables.
+    pub finished: usize,
+    /// Groups (environment × variant).
+    pub groups: usize,
+    /// Runs left out because a file of theirs cannot be read (`report.md` lists them).
+    pub damaged: usize,
+    /// Figure files written (PNG and SVG).
+    pub figures: usize,
+    /// The report itself.
+    pub report: PathBuf,
+}
+
+/// Writes the report of `options` into the folder `out`: `report.md`, the CSV tables and the
+/// figures (and the runs' data with [`ReportOptions::copy_runs`]). An input that is not a sweep
+/// or run, or a reference that is no variant, is [`StudyError::Invalid`].
+pub fn write_report(options: &ReportOptions, out: &Path) -> Result<ReportSummary> {
+    let collection = runs::collect(&options.inputs)?;
+    let reference = options.reference.clone().or(collection.reference.clone());
+    let (groups, unfinished) = runs::group(&collection.runs)?;
     if let Some(r) = &reference
-        && args.reference.is_some()
+        && options.reference.is_some()
         && !collection.runs.iter().any(|run| run.variant == *r)
     {
-        return Err(BadInput(anyhow!("--reference {r:?} is not a variant of these runs")).into());
+        return Err(StudyError::invalid(format!(
+            "--reference {r:?} is not a variant of these runs"
+        )));
     }
-    std::fs::create_dir_all(&args.out)
-        .with_context(|| format!("creating {}", args.out.display()))?;
+    std::fs::create_dir_all(out).doing(|| format!("creating {}", out.display()))?;
     let write = |name: &str, text: &str| -> Result<()> {
-        seads_rl::write_atomic(&args.out.join(name), text.as_bytes())?;
+        seads_rl::write_atomic(&out.join(name), text.as_bytes())?;
         Ok(())
     };
     let cells = tables::coverage_cells(&groups, reference.as_deref());
@@ -91,9 +99,9 @@ pub fn report(args: ReportArgs) -> Result<()> {
         write("failed-tasks.csv", csv)?;
     }
     let k_of = |g: &runs::Group<'_>| tables::skills(g.runs[0]);
-    let mut figures = figures::coverage_figures(&args.out, &groups, &k_of)?;
-    figures.extend(figures::success_figures(&args.out, &groups)?);
-    figures.extend(figures::length_figures(&args.out, &groups)?);
+    let mut figures = figures::coverage_figures(out, &groups, &k_of)?;
+    figures.extend(figures::success_figures(out, &groups)?);
+    figures.extend(figures::length_figures(out, &groups)?);
 
     let mut md = String::new();
     let title = if collection.sweeps.is_empty() {
@@ -200,25 +208,22 @@ pub fn report(args: ReportArgs) -> Result<()> {
             .map_or(String::new(), |n| n.to_string_lossy().into_owned());
         let _ = writeln!(md, "![{name}]({name})\n");
     }
-    if args.copy_runs {
+    if options.copy_runs {
         // A sweep's index and manifest come along, so that the copy is a sweep again.
         for (name, dir) in collection.sweeps.iter().zip(&collection.sweep_dirs) {
-            let dest = args.out.join("runs").join(name);
-            std::fs::create_dir_all(&dest)
-                .with_context(|| format!("creating {}", dest.display()))?;
+            let dest = out.join("runs").join(name);
+            std::fs::create_dir_all(&dest).doing(|| format!("creating {}", dest.display()))?;
             for file in [crate::sweep::INDEX, crate::sweep::MANIFEST] {
                 let bytes = std::fs::read(dir.join(file))
-                    .with_context(|| format!("reading {}", dir.join(file).display()))?;
+                    .doing(|| format!("reading {}", dir.join(file).display()))?;
                 seads_rl::write_atomic(&dest.join(file), &bytes)?;
             }
         }
         for run in &collection.runs {
-            let dest = args.out.join("runs").join(&run.copy_to);
-            std::fs::create_dir_all(&dest)
-                .with_context(|| format!("creating {}", dest.display()))?;
+            let dest = out.join("runs").join(&run.copy_to);
+            std::fs::create_dir_all(&dest).doing(|| format!("creating {}", dest.display()))?;
             for file in runs::data_files(&run.dir)? {
-                let bytes =
-                    std::fs::read(&file).with_context(|| format!("reading {}", file.display()))?;
+                let bytes = std::fs::read(&file).doing(|| format!("reading {}", file.display()))?;
                 let name = file.file_name().expect("a file has a name");
                 seads_rl::write_atomic(&dest.join(name), &bytes)?;
             }
@@ -230,16 +235,13 @@ pub fn report(args: ReportArgs) -> Result<()> {
         );
     }
     write("report.md", &md)?;
-    if damaged > 0 {
-        eprintln!("seads: {damaged} damaged run(s) left out; report.md lists them with why");
-    }
-    outln!(
-        "report of {finished} finished run(s) in {} groups: {} (and {} figure files)",
-        groups.len(),
-        args.out.join("report.md").display(),
-        figures.len()
-    );
-    Ok(())
+    Ok(ReportSummary {
+        finished,
+        groups: groups.len(),
+        damaged,
+        figures: figures.len(),
+        report: out.join("report.md"),
+    })
 }
 
 /// Which evaluation files the end-of-training tables left out (they evaluated an earlier

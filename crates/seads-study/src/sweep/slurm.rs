@@ -6,7 +6,8 @@
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
-use anyhow::{Context, Result, bail};
+use crate::error::fail;
+use crate::{Context as _, Result};
 
 use super::index::Sweep;
 
@@ -90,7 +91,7 @@ pub fn write_scripts(
     let (array, report) = scripts(dir, sweep, options);
     let folder = dir.join(SLURM_DIR);
     std::fs::create_dir_all(folder.join("logs"))
-        .with_context(|| format!("creating {}", folder.display()))?;
+        .doing(|| format!("creating {}", folder.display()))?;
     let paths = (folder.join("array.sbatch"), folder.join("report.sbatch"));
     seads_rl::write_atomic(&paths.0, array.as_bytes())?;
     seads_rl::write_atomic(&paths.1, report.as_bytes())?;
@@ -104,9 +105,9 @@ fn sbatch(script: &Path, extra: &[String]) -> Result<String> {
         .args(extra)
         .arg(script)
         .output()
-        .context("running sbatch (is Slurm installed and SLURM_CONF set?)")?;
+        .doing(|| "running sbatch (is Slurm installed and SLURM_CONF set?)".to_owned())?;
     if !output.status.success() {
-        bail!(
+        fail!(
             "sbatch {} failed: {}",
             script.display(),
             String::from_utf8_lossy(&output.stderr).trim()
@@ -116,7 +117,7 @@ fn sbatch(script: &Path, extra: &[String]) -> Result<String> {
     // `--parsable` prints "id" or "id;cluster".
     let id = text.trim().split(';').next().unwrap_or("").to_owned();
     if id.is_empty() {
-        bail!("sbatch printed no job id");
+        fail!("sbatch printed no job id");
     }
     Ok(id)
 }

@@ -3,7 +3,7 @@
 
 use std::sync::Once;
 
-use anyhow::Result;
+use crate::{Result, StudyError};
 use plotters::coord::Shift;
 use plotters::coord::types::RangedCoordf64;
 use plotters::prelude::*;
@@ -26,13 +26,15 @@ pub fn register_font() {
     });
 }
 
-/// Converts a plotters drawing error into `anyhow`.
-pub fn plot_err<E: std::error::Error + Send + Sync>(e: DrawingAreaErrorKind<E>) -> anyhow::Error {
-    anyhow::anyhow!("drawing failed: {e}")
+/// A plotters drawing error as a [`StudyError::Plot`].
+pub fn plot_err<E: std::error::Error + Send + Sync>(e: DrawingAreaErrorKind<E>) -> StudyError {
+    StudyError::Plot(e.to_string())
 }
 
 /// Writes a figure to `$out` (PNG, or SVG by extension) of `$size` pixels: `$draw` is called
-/// with the white drawing area and returns `anyhow::Result<()>`.
+/// with the white drawing area and returns a `Result` whose error converts into the caller's.
+/// (A macro, not a function: the two backends are different types.)
+#[macro_export]
 macro_rules! render_to {
     ($out:expr, $size:expr, $draw:expr) => {{
         let out: &std::path::Path = $out;
@@ -53,21 +55,21 @@ macro_rules! render_to {
             ($draw)(&area)?;
             area.present().map_err($crate::draw::plot_err)?;
         }
-        anyhow::Ok(())
+        Ok(())
     }};
 }
-pub(crate) use render_to;
+pub use render_to;
 
 /// Draws the figure `name` twice into `out`, as `name.png` and `name.svg`; returns both paths.
-pub fn png_and_svg(
+pub fn png_and_svg<E: Into<crate::BoxError>>(
     out: &std::path::Path,
     name: &str,
-    draw: &dyn Fn(&std::path::Path) -> anyhow::Result<()>,
-) -> anyhow::Result<Vec<std::path::PathBuf>> {
+    draw: &dyn Fn(&std::path::Path) -> std::result::Result<(), E>,
+) -> crate::Result<Vec<std::path::PathBuf>> {
     let mut written = Vec::new();
     for ext in ["png", "svg"] {
         let path = out.join(format!("{name}.{ext}"));
-        anyhow::Context::with_context(draw(&path), || format!("drawing {}", path.display()))?;
+        draw(&path).map_err(|e| StudyError::file(format!("drawing {}", path.display()), e))?;
         written.push(path);
     }
     Ok(written)

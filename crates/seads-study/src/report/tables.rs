@@ -26,7 +26,7 @@ pub struct CoverageCell {
 
 /// Skills of a run: the configured K, or the game's moves.
 pub fn skills(run: &RunData) -> usize {
-    crate::envs::run_skills(&run.config)
+    crate::run_skills(&run.config)
 }
 
 /// The cells of Table 1, in group order.

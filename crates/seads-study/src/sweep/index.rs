@@ -3,7 +3,8 @@
 
 use std::path::{Path, PathBuf};
 
-use anyhow::{Context, Result, anyhow, bail};
+use crate::error::{fail, failure};
+use crate::{Context as _, Result};
 use serde::{Deserialize, Serialize};
 
 use super::manifest::{EvaluationPlan, Manifest};
@@ -56,25 +57,25 @@ impl Sweep {
     /// Loads the sweep in `dir`; a missing folder or one that is not a sweep is a clear error.
     pub fn load(dir: &Path) -> Result<Self> {
         if !dir.is_dir() {
-            bail!("sweep directory {} does not exist", dir.display());
+            fail!("sweep directory {} does not exist", dir.display());
         }
         let path = dir.join(INDEX);
         if !path.is_file() {
-            bail!(
+            fail!(
                 "{} is not a sweep directory (no {INDEX}; make one with `seads sweep plan`)",
                 dir.display()
             );
         }
-        let text = std::fs::read_to_string(&path)
-            .with_context(|| format!("reading {}", path.display()))?;
+        let text =
+            std::fs::read_to_string(&path).doing(|| format!("reading {}", path.display()))?;
         serde_json::from_str(&text)
-            .map_err(|e| anyhow!("{}: not a sweep index: {e}", path.display()))
+            .map_err(|e| failure!("{}: not a sweep index: {e}", path.display()))
     }
 
     /// The absolute-or-relative path of run `index`.
     pub fn run_dir(&self, dir: &Path, index: usize) -> Result<PathBuf> {
         let run = self.runs.get(index).ok_or_else(|| {
-            anyhow!(
+            failure!(
                 "run index {index} is out of range: the sweep has {} runs (0 to {})",
                 self.runs.len(),
                 self.runs.len().saturating_sub(1)
@@ -91,22 +92,21 @@ impl Sweep {
             return Ok((run, false));
         }
         let path = dir.join(MANIFEST);
-        let text = std::fs::read_to_string(&path).with_context(|| {
-            format!("reading {} to plan {} again", path.display(), run.display())
-        })?;
+        let text = std::fs::read_to_string(&path)
+            .doing(|| format!("reading {} to plan {} again", path.display(), run.display()))?;
         let planned = Manifest::parse(&text, &path.display().to_string())?.expand()?;
         let Some(planned) = planned
             .into_iter()
             .nth(index)
             .filter(|p| p.rel_dir() == self.runs[index].dir)
         else {
-            bail!(
+            fail!(
                 "{} does not plan run {index} ({}) as the index does; plan the sweep again",
                 path.display(),
                 self.runs[index].dir
             );
         };
-        std::fs::create_dir_all(&run).with_context(|| format!("creating {}", run.display()))?;
+        std::fs::create_dir_all(&run).doing(|| format!("creating {}", run.display()))?;
         seads_rl::write_atomic(
             &run.join("config.toml"),
             planned.config.to_toml().as_bytes(),
@@ -139,14 +139,14 @@ impl Sweep {
         if out.join(INDEX).exists() {
             let existing = Sweep::load(out)?;
             if existing != sweep {
-                bail!(
+                fail!(
                     "{} already holds a different sweep ({:?}); plan into another directory",
                     out.display(),
                     existing.name
                 );
             }
         } else if out.exists() && std::fs::read_dir(out)?.next().is_some() {
-            bail!(
+            fail!(
                 "{} exists and is not empty; plan a sweep into a new directory",
                 out.display()
             );
@@ -158,7 +158,7 @@ impl Sweep {
             let planned = run.config.to_toml();
             match std::fs::read_to_string(&config) {
                 Ok(text) if text == planned => {}
-                Ok(_) => bail!(
+                Ok(_) => fail!(
                     "{} differs from the manifest's configuration; it was changed after planning",
                     config.display()
                 ),
@@ -168,7 +168,7 @@ impl Sweep {
         let created = missing.len();
         for (run, planned) in missing {
             let dir = out.join(run.rel_dir());
-            std::fs::create_dir_all(&dir).with_context(|| format!("creating {}", dir.display()))?;
+            std::fs::create_dir_all(&dir).doing(|| format!("creating {}", dir.display()))?;
             seads_rl::write_atomic(&dir.join("config.toml"), planned.as_bytes())?;
         }
         if !out.join(INDEX).exists() {

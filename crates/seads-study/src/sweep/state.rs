@@ -7,7 +7,7 @@
 use std::path::{Path, PathBuf};
 use std::time::Duration;
 
-use anyhow::{Context, Result};
+use crate::{Context as _, Result};
 use serde::{Deserialize, Serialize};
 
 /// The task record of a run directory.
@@ -55,12 +55,12 @@ impl Record {
         let path = run.join(RECORD);
         match std::fs::read_to_string(&path) {
             Ok(text) => {
-                Ok(Some(serde_json::from_str(&text).with_context(|| {
+                Ok(Some(serde_json::from_str(&text).doing(|| {
                     format!("{} is not a task record", path.display())
                 })?))
             }
             Err(e) if e.kind() == std::io::ErrorKind::NotFound => Ok(None),
-            Err(e) => Err(e).with_context(|| format!("reading {}", path.display())),
+            Err(e) => Err(e).doing(|| format!("reading {}", path.display())),
         }
     }
 
@@ -197,7 +197,7 @@ impl Claim {
         match seads_rl::RunLock::acquire(run, "seads sweep task", patience) {
             Ok(lock) => Ok(Self { _lock: lock }),
             Err(seads_rl::RlError::Busy { .. }) => Err(Taken(run.to_path_buf()).into()),
-            Err(e) => Err(e).with_context(|| format!("locking {}", run.display())),
+            Err(e) => Err(e).doing(|| format!("locking {}", run.display())),
         }
     }
 }
@@ -309,7 +309,10 @@ mod tests {
         // A second claim waits for the first, and gets it once it is released.
         let path = dir.path().to_path_buf();
         let impatient = Claim::take(dir.path(), Duration::from_millis(200)).unwrap_err();
-        assert!(impatient.is::<Taken>(), "{impatient:#}");
+        assert!(
+            matches!(impatient, crate::StudyError::Taken(_)),
+            "{impatient}"
+        );
         let waiter = std::thread::spawn(move || Claim::take(&path, PATIENCE).map(|_| ()));
         std::thread::sleep(Duration::from_millis(300));
         assert!(!waiter.is_finished());

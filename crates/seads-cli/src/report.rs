@@ -1,0 +1,54 @@
+//! `seads report`: tables, tests and figures over any set of sweeps and runs
+//! ([`seads_study::report`]), written to `report.md`, CSV files and PNG + SVG figures.
+
+use std::path::PathBuf;
+
+use anyhow::Result;
+use clap::Args;
+use seads_study::report::{ReportOptions, write_report};
+
+/// Arguments of `seads report`.
+#[derive(Debug, Args)]
+pub struct ReportArgs {
+    /// Sweep directories (from `seads sweep plan`) and run directories, in any mix. A run outside
+    /// a sweep is its own variant, named by its directory.
+    #[arg(required = true)]
+    inputs: Vec<PathBuf>,
+    /// Folder for report.md, the CSV tables and the figures.
+    #[arg(long)]
+    out: PathBuf,
+    /// The variant the others are tested against (default: the first sweep's reference).
+    #[arg(long)]
+    reference: Option<String>,
+    /// Also copy what the report rests on into REPORT_DIR/runs/: each run's config.toml,
+    /// metrics.jsonl and evaluation files (never checkpoints), so that the folder can be
+    /// committed as data and reported again from itself.
+    #[arg(long)]
+    copy_runs: bool,
+}
+
+/// Runs `seads report`.
+pub fn report(args: ReportArgs) -> Result<()> {
+    let inputs: Vec<&std::path::Path> = args.inputs.iter().map(PathBuf::as_path).collect();
+    crate::refuse_overwriting_input(&args.out, &inputs)?;
+    let options = ReportOptions {
+        inputs: args.inputs.clone(),
+        reference: args.reference.clone(),
+        copy_runs: args.copy_runs,
+    };
+    let summary = write_report(&options, &args.out).map_err(crate::study_error)?;
+    if summary.damaged > 0 {
+        eprintln!(
+            "seads: {} damaged run(s) left out; report.md lists them with why",
+            summary.damaged
+        );
+    }
+    outln!(
+        "report of {} finished run(s) in {} groups: {} (and {} figure files)",
+        summary.finished,
+        summary.groups,
+        summary.report.display(),
+        summary.figures
+    );
+    Ok(())
+}

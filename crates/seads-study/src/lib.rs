@@ -1,0 +1,67 @@
+//! Studies of SEADS runs: many runs of environments × variants × seeds, planned, run, tracked
+//! and reported as the paper's tables and figures.
+//!
+//! - [`sweep`]: a [`Manifest`](sweep::Manifest) (TOML) expands into a planned
+//!   [`Sweep`](sweep::Sweep) on disk, one run directory per run; [`sweep::status`] reads where a
+//!   run stands from its directory alone; [`sweep::slurm`] writes a Slurm job array for it.
+//! - [`evaluation`]: the files an evaluation of a run writes, named by its protocol and
+//!   checkpoint, and the evaluations over training.
+//! - [`report`]: Table 1 with the one-sided Mann–Whitney test (exact p too), task success,
+//!   solution lengths, failure analysis, wall time and figures, from sweeps and runs.
+//! - [`provenance`]: which code on which processor trained which part of a run.
+//!
+//! The `seads` command (`seads sweep`, `seads report`) is the front end; this crate never prints.
+//!
+//! ```
+//! use seads_study::sweep::{Manifest, Sweep};
+//!
+//! let manifest = Manifest::parse(
+//!     r#"
+//!     name = "two-seeds"
+//!     environments = ["lightsout-cursor"]
+//!     seeds = [1, 2]
+//!     [[variant]]
+//!     name = "seads"
+//!     "#,
+//!     "example",
+//! )?;
+//! let runs = manifest.expand()?;
+//! assert_eq!(runs.len(), 2);
+//! assert_eq!(runs[1].rel_dir(), "runs/lightsout-cursor/seads/seed-2");
+//!
+//! let dir = tempfile::tempdir()?;
+//! let planned = Sweep::plan(&manifest, "…", dir.path())?;
+//! assert_eq!((planned.runs, planned.created), (2, 2));
+//! let status = seads_study::sweep::status(&dir.path().join(runs[0].rel_dir()))?;
+//! assert_eq!(status.0, seads_study::sweep::Status::Pending);
+//! # Ok::<(), Box<dyn std::error::Error>>(())
+//! ```
+
+pub mod draw;
+mod error;
+pub mod evaluation;
+pub mod provenance;
+pub mod report;
+pub mod sweep;
+
+pub use error::{BoxError, Context, Result, StudyError};
+
+/// The number of skills K of a run: its `num_skills`, else the moves of its environment's game
+/// (for a robot run, whose environment is not in the registry, the tablet's LightsOut 5×5).
+pub fn run_skills(config: &seads_rl::TrainConfig) -> usize {
+    config.num_skills.unwrap_or_else(|| {
+        match seads_embodiment::make_env(&config.env, &config.env_config) {
+            Ok(env) => env.spec().num_skills,
+            Err(_) => seads_uarm::BOARD_SIZE * seads_uarm::BOARD_SIZE,
+        }
+    })
+}
+
+/// The board game of a run's environment (for a robot run, the tablet's LightsOut 5×5).
+pub fn run_game(config: &seads_rl::TrainConfig) -> Result<Box<dyn seads_games::BoardGame>> {
+    let game = match seads_embodiment::make_env(&config.env, &config.env_config) {
+        Ok(env) => env.spec().game.build(env.spec().board_size),
+        Err(_) => seads_games::GameKind::LightsOut.build(seads_uarm::BOARD_SIZE),
+    };
+    game.doing(|| format!("building the game of {}", config.env))
+}

@@ -1,0 +1,17 @@
+//! Sweeps: a [`Manifest`] (environments × variants × seeds, a variant being overrides of the
+//! environment's preset) expands into a [`Sweep`] planned on disk, `sweep.json` and one run
+//! directory per run with its validated `config.toml`. Where a run stands is read from its
+//! directory alone ([`status`]), so that every machine of a cluster tells the same; a Slurm job
+//! array runs it ([`slurm`]).
+
+pub mod index;
+pub mod manifest;
+pub mod slurm;
+pub mod state;
+
+pub use index::{INDEX, MANIFEST, Planned, Sweep, SweepRun};
+pub use manifest::{EvaluationPlan, Manifest, PlannedRun};
+pub use state::{
+    Claim, LOG, Missing, Outcome, PATIENCE, RECORD, Record, Status, TAKEN_EXIT, Taken,
+    check_outputs, damage, is_claimed, status,
+};
