@@ -85,7 +85,7 @@ pub fn write_figures(
         let k = agent.policy_skills();
         both("coverage", &|p| coverage_figure(p, &metrics, k, &title))?;
         let file = EvaluationKind::Replan.results_file(&STANDARD_DEPTHS, None);
-        match read_evaluation(&run.join(&file))? {
+        match read_evaluation(&run.join(&file)).map_err(crate::study_error)? {
             Some(record) if record.checkpoint.is_some_and(|c| c.epoch == agent.epoch) => {
                 let replan = [(true, record.results)];
                 both("success", &|p| success_figure(p, &replan, &title))?;
@@ -170,7 +170,8 @@ fn evaluations(
 ) -> Result<[(bool, Vec<DepthResult>); 2]> {
     let mut load = |replan: bool| -> Result<Vec<DepthResult>> {
         let kind = EvaluationKind::planning(replan);
-        let saved = read_evaluation(&run.join(kind.results_file(&STANDARD_DEPTHS, None)))?;
+        let saved = read_evaluation(&run.join(kind.results_file(&STANDARD_DEPTHS, None)))
+            .map_err(crate::study_error)?;
         if let Some(record) = saved
             && record.checkpoint.is_some_and(|c| c.epoch == agent.epoch)
         {

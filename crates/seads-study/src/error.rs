@@ -14,6 +14,9 @@ pub enum StudyError {
     /// sweep changed since planning), said in a sentence.
     #[error("{0}")]
     Failed(String),
+    /// Another error that, here, is the user's input to fix (exit code 2 on the command line).
+    #[error(transparent)]
+    Input(Box<StudyError>),
     /// Reading, writing or parsing a file or folder failed; `what` says which and what for.
     #[error("{what}")]
     File {
@@ -70,7 +73,17 @@ impl StudyError {
 
     /// Whether the error is the user's input (exit code 2 on the command line).
     pub fn is_invalid(&self) -> bool {
-        matches!(self, Self::Invalid(_))
+        matches!(self, Self::Invalid(_) | Self::Input(_))
+    }
+
+    /// This error as the user's input to fix: how a report treats inputs that are not sweeps or
+    /// runs, or runs it cannot group.
+    pub fn into_invalid(self) -> Self {
+        if self.is_invalid() {
+            self
+        } else {
+            Self::Input(Box::new(self))
+        }
     }
 }
 

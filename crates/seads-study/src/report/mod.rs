@@ -61,9 +61,9 @@ pub struct ReportSummary {
 /// figures (and the runs' data with [`ReportOptions::copy_runs`]). An input that is not a sweep
 /// or run, or a reference that is no variant, is [`StudyError::Invalid`].
 pub fn write_report(options: &ReportOptions, out: &Path) -> Result<ReportSummary> {
-    let collection = runs::collect(&options.inputs)?;
+    let collection = runs::collect(&options.inputs).map_err(StudyError::into_invalid)?;
     let reference = options.reference.clone().or(collection.reference.clone());
-    let (groups, unfinished) = runs::group(&collection.runs)?;
+    let (groups, unfinished) = runs::group(&collection.runs).map_err(StudyError::into_invalid)?;
     if let Some(r) = &reference
         && options.reference.is_some()
         && !collection.runs.iter().any(|run| run.variant == *r)
