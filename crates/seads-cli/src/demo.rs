@@ -80,6 +80,7 @@ pub fn run(args: RunArgs) -> Result<()> {
             timeout_s: args.timeout,
             max_expanded: None,
         }),
+        action_noise: None,
     };
     let replan = run_evaluation(&mut agent, &args.out, &protocol(true), false)?.results;
     let once = run_evaluation(&mut agent, &args.out, &protocol(false), false)?.results;

@@ -17,7 +17,7 @@ mod envs;
 mod episodes;
 mod games;
 mod kernels;
-mod overtraining;
+
 mod plan;
 mod plot;
 mod report;

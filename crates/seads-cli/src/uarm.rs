@@ -456,6 +456,7 @@ fn evaluate(
             timeout_s: timeout,
             max_expanded: None,
         }),
+        action_noise: None,
     };
     let solve_config = SolveConfig {
         replan: true,

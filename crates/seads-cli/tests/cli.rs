@@ -1382,3 +1382,73 @@ proptest::proptest! {
         }
     }
 }
+
+/// `seads evaluate --action-noise STD` plays the same tasks with noisy actions, into files of
+/// their own that record the noise; the same seed gives the same outcome; a negative or
+/// non-finite deviation is bad input.
+#[test]
+fn an_evaluation_under_action_noise_has_files_of_its_own_and_repeats() {
+    let dir = tempfile::tempdir().unwrap();
+    let run = dir.path().join("run");
+    let status = std::process::Command::new("cp")
+        .arg("-r")
+        .arg(tiny_run().join("run"))
+        .arg(&run)
+        .status()
+        .unwrap();
+    assert!(status.success());
+    let args = |noise: &str| -> Vec<String> {
+        let mut a: Vec<String> = [
+            "evaluate",
+            "--run",
+            s(&run),
+            "--boards",
+            "2",
+            "--depths",
+            "1-2",
+            "--replan",
+            "--max-expanded",
+            "500",
+            "--json",
+        ]
+        .iter()
+        .map(|x| (*x).to_owned())
+        .collect();
+        if !noise.is_empty() {
+            a.extend(["--action-noise".to_owned(), noise.to_owned()]);
+        }
+        a
+    };
+    let call = |noise: &str| {
+        let a = args(noise);
+        let refs: Vec<&str> = a.iter().map(String::as_str).collect();
+        seads_ok(&refs)
+    };
+    call("");
+    call("0.05");
+    let plain = run.join("evaluation-replan-depths-1-2.json");
+    let noisy = run.join("evaluation-replan-depths-1-2-noise-0.05.json");
+    let record: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(&noisy).unwrap()).unwrap();
+    assert_eq!(record["protocol"]["action_noise"], 0.05, "{record}");
+    let plain_record: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(&plain).unwrap()).unwrap();
+    assert!(plain_record["protocol"].get("action_noise").is_none());
+    let tasks = |path: &std::path::Path| -> Vec<serde_json::Value> {
+        std::fs::read_to_string(path)
+            .unwrap()
+            .lines()
+            .map(|l| serde_json::from_str(l).unwrap())
+            .collect()
+    };
+    let noisy_tasks = run.join("evaluation-replan-depths-1-2-noise-0.05-tasks.jsonl");
+    let first = tasks(&noisy_tasks);
+    call("0.05");
+    assert_eq!(tasks(&noisy_tasks), first, "the same seeds, the same noise");
+    for bad in ["-0.1", "nan", "inf"] {
+        let a = args(bad);
+        let refs: Vec<&str> = a.iter().map(String::as_str).collect();
+        let out = seads(&refs);
+        assert_eq!(out.status.code(), Some(2), "{bad}");
+    }
+}

@@ -52,6 +52,7 @@ mod error;
 #[cfg(feature = "jaco")]
 mod jaco;
 mod layout;
+mod noise;
 mod policy;
 mod reacher;
 mod record;
@@ -69,6 +70,7 @@ pub use error::EnvError;
 #[cfg(feature = "jaco")]
 pub use jaco::{DEFAULT_SUBSTEPS as JACO_DEFAULT_SUBSTEPS, Jaco, JacoBoard};
 pub use layout::Layout;
+pub use noise::{ACTION_NOISE_STREAM, ActionNoise};
 pub use policy::{SkillPolicy, SkillRun, execute_skill};
 pub use reacher::Reacher;
 pub use record::{

@@ -95,6 +95,9 @@ pub struct Evaluation {
     pub tasks: TaskSet,
     /// With or without re-planning, search limits.
     pub solve: SolveConfig,
+    /// Standard deviation of Gaussian noise on every low-level action, drawn from each task's
+    /// seed ([`seads_embodiment::ActionNoise`]); `None`: none.
+    pub action_noise: Option<f64>,
 }
 
 /// Evaluates `policy` and `successor`: for each depth, boards of exactly that depth from the
@@ -115,6 +118,9 @@ pub fn evaluate(
             ..evaluation.env_config.clone()
         };
         let mut env = make_env(&evaluation.env, &env_config)?;
+        if let Some(std) = evaluation.action_noise {
+            env = Box::new(seads_embodiment::ActionNoise::new(env, std)?);
+        }
         let game = env.spec().game.build(env.spec().board_size)?;
         let goal = game.goal();
         let mut result = DepthResult::new(depth);

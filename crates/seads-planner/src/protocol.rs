@@ -209,6 +209,36 @@ pub struct Protocol {
     /// The search limits (`None` for a policy acting alone).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub limits: Option<SearchLimits>,
+    /// Standard deviation of Gaussian noise on every low-level action
+    /// ([`seads_embodiment::ActionNoise`]); `None`: none.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub action_noise: Option<f64>,
+}
+
+impl Protocol {
+    /// The stem of this evaluation's files: the kind's ([`EvaluationKind::stem`]), with
+    /// `-noise-0.05` for an evaluation under action noise, so that it never takes the name of
+    /// the one without.
+    pub fn stem(&self, epoch: Option<u64>) -> String {
+        let mut stem = self.kind.stem(&self.tasks.depths, None);
+        if let Some(std) = self.action_noise {
+            stem += &format!("-noise-{std}");
+        }
+        if let Some(epoch) = epoch {
+            stem += &format!("-epoch-{epoch:06}");
+        }
+        stem
+    }
+
+    /// The per-depth results ([`EvaluationRecord`], JSON).
+    pub fn results_file(&self, epoch: Option<u64>) -> String {
+        format!("{}.json", self.stem(epoch))
+    }
+
+    /// Every task, one JSON line each.
+    pub fn tasks_file(&self, epoch: Option<u64>) -> String {
+        format!("{}-tasks.jsonl", self.stem(epoch))
+    }
 }
 
 /// The checkpoint an evaluation evaluated.
@@ -358,9 +388,27 @@ mod tests {
                     timeout_s: 10.0,
                     max_expanded: None,
                 }),
+                action_noise: None,
             }),
             results: vec![DepthResult::new(1)],
         };
+        let noisy = Protocol {
+            action_noise: Some(0.05),
+            ..record.protocol.clone().unwrap()
+        };
+        assert_eq!(
+            record.protocol.as_ref().unwrap().results_file(Some(7)),
+            "evaluation-replan-epoch-000007.json"
+        );
+        assert_eq!(
+            noisy.results_file(Some(7)),
+            "evaluation-replan-noise-0.05-epoch-000007.json"
+        );
+        assert_eq!(
+            noisy.tasks_file(None),
+            "evaluation-replan-noise-0.05-tasks.jsonl"
+        );
+        assert!(!record.made_with(&noisy));
         let back = EvaluationRecord::from_json(&record.to_json()).unwrap();
         assert_eq!(back.checkpoint, record.checkpoint);
         assert!(back.made_with(record.protocol.as_ref().unwrap()));

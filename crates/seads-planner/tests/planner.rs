@@ -310,6 +310,7 @@ fn evaluation_protocol_reports_per_depth() {
             seed: Some(1),
         },
         solve: SolveConfig::default(),
+        action_noise: None,
     };
     let mut calls = 0;
     let results = evaluate(

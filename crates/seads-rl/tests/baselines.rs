@@ -489,6 +489,7 @@ fn policy_and_planning_evaluations_play_the_same_boards() {
         env_config: config.env_config.clone(),
         tasks: tasks.clone(),
         solve: seads_planner::SolveConfig::default(),
+        action_noise: None,
     };
     let mut planning_boards = Vec::new();
     seads_planner::evaluate(

@@ -26,6 +26,9 @@ pub enum StudyError {
         #[source]
         source: BoxError,
     },
+    /// The evaluation cannot be played in the agent's environment (input the user must fix).
+    #[error(transparent)]
+    Environment(seads_embodiment::EnvError),
     /// A file system call failed.
     #[error(transparent)]
     Io(#[from] std::io::Error),
@@ -73,7 +76,10 @@ impl StudyError {
 
     /// Whether the error is the user's input (exit code 2 on the command line).
     pub fn is_invalid(&self) -> bool {
-        matches!(self, Self::Invalid(_) | Self::Input(_))
+        matches!(
+            self,
+            Self::Invalid(_) | Self::Input(_) | Self::Environment(_)
+        )
     }
 
     /// This error as the user's input to fix: how a report treats inputs that are not sweeps or

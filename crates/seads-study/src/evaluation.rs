@@ -1,13 +1,16 @@
 //! The files an evaluation writes into a run directory: the end-of-training records, named by
 //! their protocol and checkpoint ([`seads_planner::EvaluationKind`] names them), and the
 //! evaluations over training (the paper's Fig. 3), one line per checkpoint and mode in
-//! [`OVER_TRAINING`].
+//! [`OVER_TRAINING`]; and running an evaluation of a trained agent or a baseline's policy.
 
 use std::path::Path;
 
+use seads_games::BoardGame;
 use seads_planner::{
-    CheckpointId, DepthResult, EvaluationKind, EvaluationRecord, Protocol, SearchLimits, TaskSet,
+    CheckpointId, DepthResult, Evaluation, EvaluationKind, EvaluationRecord, PlannerConfig,
+    Protocol, SearchLimits, SolveConfig, TaskRecord, TaskSet, evaluate,
 };
+use seads_rl::{Agent, TrainConfig};
 use serde::{Deserialize, Serialize};
 
 use crate::{Context as _, Result, StudyError};
@@ -33,14 +36,13 @@ pub fn save_evaluation(
         .protocol
         .as_ref()
         .ok_or_else(|| StudyError::failed("an evaluation is saved with its protocol"))?;
-    let (kind, depths) = (protocol.kind, &protocol.tasks.depths);
     seads_rl::write_atomic(
-        &run.join(kind.results_file(depths, named_epoch)),
+        &run.join(protocol.results_file(named_epoch)),
         record.to_json().as_bytes(),
     )?;
     if let Some(lines) = task_lines {
         seads_rl::write_atomic(
-            &run.join(kind.tasks_file(depths, named_epoch)),
+            &run.join(protocol.tasks_file(named_epoch)),
             lines.as_bytes(),
         )?;
     }
@@ -96,6 +98,7 @@ impl CheckpointEvaluation {
                 timeout_s: self.timeout_s,
                 max_expanded: self.max_expanded,
             }),
+            action_noise: None,
         }
     }
 }
@@ -116,5 +119,138 @@ pub fn over_training_protocol(tasks: &TaskSet, limits: SearchLimits, replan: boo
         kind: EvaluationKind::planning(replan),
         tasks: tasks.clone(),
         limits: Some(limits),
+        action_noise: None,
     }
+}
+
+/// Evaluates the agent with `protocol` (a planning kind), calling `each` with every task as it
+/// ends (for progress). An evaluation the agent's environment cannot play is
+/// [`StudyError::Invalid`].
+pub fn evaluate_agent(
+    agent: &mut Agent,
+    protocol: &Protocol,
+    mut each: impl FnMut(&TaskRecord<'_>),
+) -> Result<Vec<DepthResult>> {
+    let limits = protocol
+        .limits
+        .ok_or_else(|| StudyError::failed("a planning evaluation needs search limits"))?;
+    let evaluation = Evaluation {
+        env: agent.config.env.clone(),
+        env_config: agent.config.env_config.clone(),
+        tasks: protocol.tasks.clone(),
+        solve: SolveConfig {
+            replan: protocol.kind == EvaluationKind::Replan,
+            planner: PlannerConfig {
+                timeout_s: Some(limits.timeout_s),
+                max_expanded: limits.max_expanded,
+                ..PlannerConfig::default()
+            },
+            ..SolveConfig::default()
+        },
+        action_noise: protocol.action_noise,
+    };
+    let (policy, model) = agent.parts()?;
+    evaluate(&evaluation, policy, model, |task| each(task)).map_err(StudyError::Environment)
+}
+
+/// Evaluates the agent with `protocol` and saves the record and one line per task into the run
+/// directory (`evaluation-replan.json` and `evaluation-replan-tasks.jsonl` for the standard
+/// depths of the latest checkpoint), calling `each` with every task as it ends.
+pub fn run_evaluation(
+    agent: &mut Agent,
+    run: &Path,
+    protocol: &Protocol,
+    mut each: impl FnMut(&TaskRecord<'_>),
+) -> Result<EvaluationRecord> {
+    let game = crate::run_game(&agent.config)?;
+    let mut lines = String::new();
+    let results = evaluate_agent(agent, protocol, |task| {
+        lines += &task_line(game.as_ref(), task).to_string();
+        lines.push('\n');
+        each(task);
+    })?;
+    let (checkpoint, named) = checkpoint_of(run, &agent.checkpoint)?;
+    let record = EvaluationRecord {
+        checkpoint: Some(checkpoint),
+        protocol: Some(protocol.clone()),
+        results,
+    };
+    save_evaluation(run, &record, named, Some(&lines))?;
+    Ok(record)
+}
+
+/// Evaluates a baseline's policy saved in `checkpoint` alone on `tasks` and saves the record
+/// and one line per task (depth, seed, board, solved) into the run directory
+/// (`evaluation-policy.json` for the standard depths of the latest checkpoint).
+pub fn run_policy_evaluation(
+    config: &TrainConfig,
+    run: &Path,
+    checkpoint: &Path,
+    tasks: TaskSet,
+) -> Result<EvaluationRecord> {
+    let mut policy = seads_rl::load_policy(config, checkpoint)
+        .doing(|| format!("loading the policy of run {}", run.display()))?;
+    let game = crate::run_game(config)?;
+    let mut lines = String::new();
+    let results = seads_rl::task_success(
+        config,
+        policy.as_mut(),
+        &tasks,
+        |depth, seed, board, solved| {
+            let line = serde_json::json!({
+                "depth": depth,
+                "seed": seed,
+                "board": game.format(board),
+                "solved": solved,
+            });
+            lines += &line.to_string();
+            lines.push('\n');
+        },
+    )?;
+    let (id, named) = checkpoint_of(run, checkpoint)?;
+    let record = EvaluationRecord {
+        checkpoint: Some(id),
+        protocol: Some(Protocol {
+            kind: EvaluationKind::Policy,
+            tasks,
+            limits: None,
+            action_noise: None,
+        }),
+        results,
+    };
+    save_evaluation(run, &record, named, Some(&lines))?;
+    Ok(record)
+}
+
+/// One line of `evaluation-*-tasks.jsonl`: a task, how it ended, and every skill that left
+/// another board than the forward model predicted (boards as `seads solve --board` takes them).
+fn task_line(game: &dyn BoardGame, task: &TaskRecord<'_>) -> serde_json::Value {
+    let o = task.outcome;
+    let deviations: Vec<serde_json::Value> = o
+        .deviations
+        .iter()
+        .map(|d| {
+            serde_json::json!({
+                "step": d.step,
+                "skill": d.skill,
+                "before": game.format(d.before),
+                "predicted": game.format(d.predicted),
+                "reached": game.format(d.reached),
+            })
+        })
+        .collect();
+    serde_json::json!({
+        "depth": task.depth,
+        "seed": task.seed,
+        "board": game.format(task.board),
+        "solved": o.solved,
+        "plan_found": o.plan_found,
+        "plans": o.plans,
+        "first_plan": o.first_plan,
+        "executed": o.executed,
+        "skill_steps": o.skill_steps,
+        "timed_out": o.timed_out,
+        "failure": o.failure,
+        "deviations": deviations,
+    })
 }

@@ -8,6 +8,7 @@
 //!   checkpoint, and the evaluations over training.
 //! - [`report`]: Table 1 with the one-sided Mann–Whitney test (exact p too), task success,
 //!   solution lengths, failure analysis, wall time and figures, from sweeps and runs.
+//! - [`figures`]: the figures of one run: coverage, success, skill trajectories and pushes.
 //! - [`provenance`]: which code on which processor trained which part of a run.
 //!
 //! The `seads` command (`seads sweep`, `seads report`) is the front end; this crate never prints.
@@ -40,6 +41,8 @@
 pub mod draw;
 mod error;
 pub mod evaluation;
+pub mod figures;
+pub mod over_training;
 pub mod provenance;
 pub mod report;
 pub mod sweep;

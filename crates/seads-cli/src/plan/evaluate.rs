@@ -8,8 +8,9 @@ use clap::Args;
 use seads_games::Split;
 use seads_planner::{EvaluationKind, Protocol, SearchLimits, TaskSet, summarise};
 
-use super::{load_agent, run_evaluation, run_policy_evaluation};
+use super::{load_agent, run_evaluation};
 use crate::BadInput;
+use seads_study::evaluation::run_policy_evaluation;
 
 /// Parses "1-5", "6,8,10" or "3": sorted, each once, none zero.
 fn parse_depths(text: &str) -> Result<Vec<usize>> {
@@ -26,6 +27,18 @@ fn parse_depths(text: &str) -> Result<Vec<usize>> {
         .into_iter()
         .map(|d| usize::try_from(d).map_err(|_| bad().into()))
         .collect()
+}
+
+/// A command-line number that must be finite and not negative (a standard deviation).
+fn non_negative_finite(text: &str) -> Result<f64, String> {
+    let value: f64 = text
+        .parse()
+        .map_err(|_| format!("{text:?} is not a number"))?;
+    if value.is_finite() && value >= 0.0 {
+        Ok(value)
+    } else {
+        Err(format!("{text} must be a finite number of at least 0"))
+    }
 }
 
 /// Arguments of `seads evaluate`.
@@ -57,7 +70,7 @@ pub struct EvaluateArgs {
     /// appending to evaluation-over-training.jsonl in the run directory. Checkpoints already
     /// there are skipped.
     #[arg(long, conflicts_with_all = ["checkpoint", "replan", "seed"])]
-    checkpoints: Option<crate::overtraining::Selection>,
+    checkpoints: Option<seads_study::over_training::Selection>,
     /// Time limit per search, seconds (the authors' evaluation used 60).
     #[arg(long, default_value_t = 60.0, value_parser = crate::positive_finite)]
     timeout: f64,
@@ -65,6 +78,11 @@ pub struct EvaluateArgs {
     /// gives the same results on every machine.
     #[arg(long, value_parser = clap::value_parser!(u64).range(1..))]
     max_expanded: Option<u64>,
+    /// Execute skills with Gaussian noise of this standard deviation on every low-level action
+    /// (the authors' evaluation under noise used 0.05 for the cursor), drawn from each task's
+    /// seed; the files are named `evaluation-replan-noise-STD…`.
+    #[arg(long, value_parser = non_negative_finite, conflicts_with = "checkpoints")]
+    action_noise: Option<f64>,
     /// No progress bar.
     #[arg(long)]
     quiet: bool,
@@ -96,6 +114,12 @@ pub fn evaluate_run(args: EvaluateArgs) -> Result<()> {
         .with_context(|| format!("loading run {}", args.run.display()))?;
     let _lock = crate::lock_run(&args.run)?;
     if config.algorithm.is_baseline() {
+        if args.action_noise.is_some() {
+            bail!(BadInput(anyhow::anyhow!(
+                "--action-noise is for planning evaluations of SEADS runs; {} is a baseline",
+                args.run.display()
+            )));
+        }
         if args.checkpoints.is_some() {
             bail!(BadInput(anyhow::anyhow!(
                 "{}: a baseline's task success over training is in its metrics.jsonl; \
@@ -116,7 +140,7 @@ pub fn evaluate_run(args: EvaluateArgs) -> Result<()> {
             depths,
             ..TaskSet::standard(args.boards)
         };
-        let added = crate::overtraining::evaluate_checkpoints(
+        let added = super::evaluate_checkpoints(
             &args.run,
             selection,
             &tasks,
@@ -170,6 +194,7 @@ pub fn evaluate_run(args: EvaluateArgs) -> Result<()> {
             seed: args.seed,
         },
         limits: Some(limits),
+        action_noise: args.action_noise,
     };
     let record = run_evaluation(&mut agent, &args.run, &protocol, args.quiet || args.json)?;
     let results = record.results;
@@ -178,7 +203,7 @@ pub fn evaluate_run(args: EvaluateArgs) -> Result<()> {
         outln!("{}", serde_json::to_string(&summary)?);
     } else {
         outln!(
-            "{} (epoch {}), {}, {} boards per depth",
+            "{} (epoch {}), {}, {} boards per depth{}",
             agent.config.env,
             agent.epoch,
             if args.replan {
@@ -186,7 +211,9 @@ pub fn evaluate_run(args: EvaluateArgs) -> Result<()> {
             } else {
                 "plan once"
             },
-            args.boards
+            args.boards,
+            args.action_noise
+                .map_or(String::new(), |s| format!(", action noise σ = {s}"))
         );
         outln!(" depth  success  plan found  search s  median steps  median skill steps");
         for r in &results {

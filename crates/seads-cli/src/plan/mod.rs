@@ -13,7 +13,7 @@ use seads_rl::Agent;
 
 pub use bench::{PlanBenchArgs, plan_bench};
 pub use evaluate::{EvaluateArgs, evaluate_run};
-pub use evaluation::{evaluate_agent, run_evaluation, run_policy_evaluation};
+pub use evaluation::{evaluate_checkpoints, run_evaluation};
 pub use solve::{SolveArgs, solve_board};
 
 use crate::BadInput;

@@ -13,9 +13,11 @@ use seads_skillmodel::SkillModelKind;
 
 use super::index::Sweep;
 use super::state::{Claim, Missing, Outcome, Record, check_outputs};
-use crate::overtraining::{Selection, evaluate_checkpoints};
-use crate::plan::{load_agent, run_evaluation, run_policy_evaluation};
+use crate::plan::evaluate_checkpoints;
+use crate::plan::{load_agent, run_evaluation};
 use seads_planner::{EvaluationKind, Protocol, TaskSet};
+use seads_study::evaluation::run_policy_evaluation;
+use seads_study::over_training::Selection;
 
 /// libtorch threads for a task with `cores` cores: two training threads of `cores / 2` each,
 /// and all cores for SAC when the other thread waits (0 = keep: a task alone on one core).
@@ -127,6 +129,7 @@ fn train_and_evaluate(sweep: &Sweep, run: &Path, cores: usize) -> Result<()> {
                 kind: EvaluationKind::planning(replan),
                 tasks: TaskSet::standard(plan.boards),
                 limits: Some(plan.limits()),
+                action_noise: None,
             };
             let results = run_evaluation(&mut agent, run, &protocol, true)?.results;
             let solved: usize = results.iter().map(|r| r.solved).sum();

@@ -1,20 +1,37 @@
-//! Task success over training (the paper's Fig. 3): `seads evaluate --checkpoints all|N`
-//! evaluates kept checkpoints with and without re-planning and appends one line per checkpoint
+//! Task success over training (the paper's Fig. 3): [`evaluate_checkpoints`] (`seads evaluate
+//! --checkpoints all|N`) evaluates kept checkpoints with and without re-planning and appends one line per checkpoint
 //! and mode to `evaluation-over-training.jsonl`, keyed by environment steps. Checkpoints already
 //! in the file are skipped, so the command resumes where it stopped.
 
 use std::path::Path;
 
-use anyhow::{Context, Result, anyhow};
-use indicatif::{ProgressBar, ProgressStyle};
 use seads_planner::{Protocol, SearchLimits, TaskSet};
 use seads_rl::Agent;
 
-use crate::BadInput;
-use crate::plan::evaluate_agent;
-use seads_study::evaluation::{
-    CheckpointEvaluation, OVER_TRAINING, over_training_protocol, read_over_training,
+use crate::evaluation::{
+    CheckpointEvaluation, OVER_TRAINING, evaluate_agent, over_training_protocol, read_over_training,
 };
+use crate::{Context as _, Result, StudyError};
+
+/// What [`evaluate_checkpoints`] is doing, for a progress display.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Progress {
+    /// This many tasks are to be evaluated in all.
+    Planned {
+        /// Tasks.
+        tasks: usize,
+    },
+    /// The evaluations of this checkpoint begin.
+    Checkpoint {
+        /// Its epoch.
+        epoch: u64,
+    },
+    /// A task of this depth ended.
+    Task {
+        /// Its depth.
+        depth: usize,
+    },
+}
 
 /// Which checkpoints: `all`, every N-th kept one (the last always), or the listed epochs.
 #[derive(Debug, Clone, PartialEq, Eq)]
@@ -30,7 +47,7 @@ pub enum Selection {
 impl Selection {
     /// The chosen checkpoints among the `kept` ones (epoch, folder), in their order; for listed
     /// epochs, the error names those that were not kept.
-    fn choose<T: Clone>(&self, kept: &[(u64, T)]) -> Result<Vec<(u64, T)>, String> {
+    pub fn choose<T: Clone>(&self, kept: &[(u64, T)]) -> Result<Vec<(u64, T)>, String> {
         Ok(match self {
             Selection::All => kept.to_vec(),
             Selection::Every(n) => kept
@@ -76,9 +93,14 @@ impl std::str::FromStr for Selection {
             if listed.contains('-') {
                 return Err(bad());
             }
-            return crate::NumberList::parse(listed)
-                .map(|epochs| Self::Epochs(epochs.0))
-                .map_err(|_| bad());
+            let mut epochs = listed
+                .split(',')
+                .map(|e| e.trim().parse::<u64>())
+                .collect::<Result<Vec<u64>, _>>()
+                .map_err(|_| bad())?;
+            epochs.sort_unstable();
+            epochs.dedup();
+            return Ok(Self::Epochs(epochs));
         }
         match text.parse::<usize>() {
             Ok(n) if n > 0 => Ok(Self::Every(n)),
@@ -89,23 +111,25 @@ impl std::str::FromStr for Selection {
 
 /// Evaluates the selected checkpoints of `run` in both modes on `tasks` (test boards, the
 /// protocol's seeds), unless the file holds them evaluated with the same protocol already.
-/// Returns the number of lines appended.
+/// Returns the number of lines appended. `progress` hears of the work as it goes. A run
+/// without the chosen checkpoints is [`StudyError::Invalid`].
 pub fn evaluate_checkpoints(
     run: &Path,
     selection: Selection,
     tasks: &TaskSet,
     limits: SearchLimits,
-    quiet: bool,
+    mut progress: impl FnMut(Progress),
 ) -> Result<usize> {
-    let config =
-        seads_rl::load_config(run).with_context(|| format!("reading {}", run.display()))?;
-    crate::kernels::use_kernels(config.portable_numerics)?;
-    let kept = seads_rl::checkpoints(run).with_context(|| format!("reading {}", run.display()))?;
+    let config = seads_rl::load_config(run).doing(|| format!("reading {}", run.display()))?;
+    let kept = seads_rl::checkpoints(run).doing(|| format!("reading {}", run.display()))?;
     if kept.is_empty() {
-        return Err(BadInput(anyhow!("{} has no checkpoint to evaluate", run.display())).into());
+        return Err(StudyError::invalid(format!(
+            "{} has no checkpoint to evaluate",
+            run.display()
+        )));
     }
     let chosen = selection.choose(&kept).map_err(|e| {
-        BadInput(anyhow!(
+        StudyError::invalid(format!(
             "{} keeps no checkpoint of epoch(s) {e}",
             run.display()
         ))
@@ -121,19 +145,9 @@ pub fn evaluate_checkpoints(
             !done.contains(&(*epoch, over_training_protocol(tasks, limits, *replan)))
         })
         .collect();
-    let per = tasks.len() as u64;
-    let bar = if quiet {
-        ProgressBar::hidden()
-    } else {
-        ProgressBar::new(per * todo.len() as u64)
-    };
-    bar.set_style(
-        ProgressStyle::with_template(
-            "{elapsed_precise} [{bar:30}] {pos}/{len} tasks {prefix} {msg}",
-        )
-        .expect("valid template")
-        .progress_chars("=> "),
-    );
+    progress(Progress::Planned {
+        tasks: tasks.len() * todo.len(),
+    });
     let path = run.join(OVER_TRAINING);
     let mut loaded: Option<(u64, Agent)> = None;
     for (epoch, dir, replan) in &todo {
@@ -141,16 +155,22 @@ pub fn evaluate_checkpoints(
             loaded = Some((*epoch, Agent::load_checkpoint(config.clone(), dir)?));
         }
         let agent = &mut loaded.as_mut().expect("just loaded").1;
-        bar.set_prefix(format!("epoch {epoch}"));
-        let results = evaluate_agent(agent, &over_training_protocol(tasks, limits, *replan), &bar)?;
+        progress(Progress::Checkpoint { epoch: *epoch });
+        let results = evaluate_agent(
+            agent,
+            &over_training_protocol(tasks, limits, *replan),
+            |t| {
+                progress(Progress::Task { depth: t.depth });
+            },
+        )?;
         let env_steps = seads_rl::checkpoint_id(run, dir)?
             .env_steps
             .ok_or_else(|| {
-                anyhow!(
+                StudyError::failed(format!(
                     "{}: no metrics line at epoch {epoch} and no progress file to tell its \
                  environment steps",
                     run.display()
-                )
+                ))
             })?;
         let line = CheckpointEvaluation {
             epoch: *epoch,
@@ -163,7 +183,6 @@ pub fn evaluate_checkpoints(
         };
         seads_rl::append_json_line(&path, &line)?;
     }
-    bar.finish_and_clear();
     Ok(todo.len())
 }
 
