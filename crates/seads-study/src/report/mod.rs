@@ -85,6 +85,10 @@ pub fn write_report(options: &ReportOptions, out: &Path) -> Result<ReportSummary
     }
     let (success_md, success_csv) = tables::success_tables(&groups);
     write("success.csv", &success_csv)?;
+    let noise = tables::noise_tables(&groups);
+    if let Some((_, csv)) = &noise {
+        write("noise.csv", csv)?;
+    }
     let (length_md, length_csv) = tables::length_tables(&groups);
     write("lengths.csv", &length_csv)?;
     let (walltime_md, walltime_csv) = walltime::walltime_tables(&groups);
@@ -175,6 +179,11 @@ pub fn write_report(options: &ReportOptions, out: &Path) -> Result<ReportSummary
         let _ = writeln!(md, "## SEADS against the baselines: task success\n");
         md += &comparison;
         md.push('\n');
+    }
+    if let Some((noise_md, _)) = &noise {
+        let _ = writeln!(md, "## Task success under action noise\n");
+        md += noise_md;
+        let _ = writeln!(md, "\nAs CSV: `noise.csv`.\n");
     }
     let _ = writeln!(md, "## Skill and solution length\n");
     md += &length_md;

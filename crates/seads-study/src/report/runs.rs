@@ -33,6 +33,9 @@ pub struct RunData {
     pub replan: Option<Vec<DepthResult>>,
     /// Final task evaluation without re-planning, if any.
     pub plan_once: Option<Vec<DepthResult>>,
+    /// Final task evaluations under action noise: (σ, with re-planning, per depth), in the
+    /// order of their files' names.
+    pub noisy: Vec<(f64, bool, Vec<DepthResult>)>,
     /// Task success over training, if evaluated.
     pub over_training: Vec<CheckpointEvaluation>,
     /// The processors that trained it (`provenance.jsonl`; empty for older runs).
@@ -115,6 +118,7 @@ impl RunData {
             evaluation(EvaluationKind::PlanOnce)?,
             evaluation(EvaluationKind::Policy)?,
         );
+        let noisy = noisy_evaluations(dir, last_epoch, &mut damage);
         Ok(Self {
             dir: dir.to_path_buf(),
             copy_to,
@@ -122,6 +126,7 @@ impl RunData {
             replan,
             plan_once,
             policy,
+            noisy,
             evaluation_notes,
             unrecorded_evaluations,
             damage,
@@ -133,6 +138,55 @@ impl RunData {
             task_metrics,
         })
     }
+}
+
+/// The run's planning evaluations of the standard depths under action noise that evaluated its
+/// last checkpoint (`evaluation-replan-noise-0.05.json`, …); an unreadable one is damage.
+fn noisy_evaluations(
+    dir: &Path,
+    last_epoch: Option<u64>,
+    damage: &mut Vec<String>,
+) -> Vec<(f64, bool, Vec<DepthResult>)> {
+    let mut names: Vec<String> = std::fs::read_dir(dir)
+        .into_iter()
+        .flatten()
+        .filter_map(|e| e.ok()?.file_name().into_string().ok())
+        .filter(|n| n.contains("-noise-") && n.ends_with(".json") && !n.contains("-epoch-"))
+        .collect();
+    names.sort();
+    let mut found = Vec::new();
+    for name in names {
+        let record = match crate::evaluation::read_evaluation(&dir.join(&name)) {
+            Ok(Some(record)) => record,
+            Ok(None) => continue,
+            Err(e) => {
+                damage.push(format!("{e:#}"));
+                continue;
+            }
+        };
+        let Some(protocol) = record.protocol else {
+            continue;
+        };
+        let standard = protocol.tasks.depths == STANDARD_DEPTHS
+            && protocol.tasks.split == seads_games::Split::Test
+            && protocol.tasks.seed.is_none();
+        let at_end = record
+            .checkpoint
+            .is_some_and(|c| Some(c.epoch) == last_epoch);
+        if let (Some(std), true, true, Some(replan)) = (
+            protocol.action_noise,
+            standard,
+            at_end,
+            match protocol.kind {
+                EvaluationKind::Replan => Some(true),
+                EvaluationKind::PlanOnce => Some(false),
+                EvaluationKind::Policy => None,
+            },
+        ) {
+            found.push((std, replan, record.results));
+        }
+    }
+    found
 }
 
 /// The metrics lines of the run in `dir`; none without a metrics file (not started), and none
@@ -300,4 +354,26 @@ pub fn data_files(run: &Path) -> Result<Vec<PathBuf>> {
     }
     files.sort();
     Ok(files)
+}
+
+/// A run with nothing in it but its name and the default config, for tests to fill in.
+#[cfg(test)]
+pub(crate) fn bare_run(seed: u32) -> RunData {
+    RunData {
+        dir: format!("seed-{seed}").into(),
+        copy_to: format!("seed-{seed}").into(),
+        variant: "seads".into(),
+        config: TrainConfig::default(),
+        metrics: Vec::new(),
+        task_metrics: Vec::new(),
+        policy: None,
+        replan: None,
+        plan_once: None,
+        noisy: Vec::new(),
+        over_training: Vec::new(),
+        processors: Vec::new(),
+        evaluation_notes: Vec::new(),
+        unrecorded_evaluations: 0,
+        damage: Vec::new(),
+    }
 }

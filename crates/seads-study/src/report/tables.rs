@@ -169,6 +169,95 @@ fn depths(groups: &[Group<'_>]) -> Vec<usize> {
     depths
 }
 
+/// Task success under action noise beside the same runs' success without it, per group, noise
+/// and mode (Markdown and CSV); `None` if no run was evaluated under noise.
+pub fn noise_tables(groups: &[Group<'_>]) -> Option<(String, String)> {
+    let depths = depths(groups);
+    let mut md = String::from("| environment | variant | mode | σ | runs |");
+    for d in &depths {
+        let _ = write!(md, " depth {d} |");
+    }
+    md += " all |\n|---|---|---|---|---|";
+    md += &"---|".repeat(depths.len() + 1);
+    md.push('\n');
+    let mut csv = String::from("env,variant,mode,noise,runs,depth,mean_success,std_success\n");
+    let mut any = false;
+    for g in groups {
+        let mut keys: Vec<(f64, bool)> = g
+            .runs
+            .iter()
+            .flat_map(|r| r.noisy.iter().map(|(s, replan, _)| (*s, *replan)))
+            .collect();
+        keys.sort_by(|a, b| a.0.total_cmp(&b.0).then(b.1.cmp(&a.1)));
+        keys.dedup();
+        for (std, replan) in keys {
+            // The runs evaluated under this noise, each with its noiseless evaluation.
+            let pairs: Vec<(&Vec<DepthResult>, &Vec<DepthResult>)> = g
+                .runs
+                .iter()
+                .filter_map(|r| {
+                    let noisy = r
+                        .noisy
+                        .iter()
+                        .find(|(s, p, _)| *s == std && *p == replan)
+                        .map(|(_, _, e)| e)?;
+                    let plain = if replan {
+                        r.replan.as_ref()
+                    } else {
+                        r.plan_once.as_ref()
+                    }?;
+                    Some((plain, noisy))
+                })
+                .collect();
+            if pairs.is_empty() {
+                continue;
+            }
+            any = true;
+            let mode = label(if replan { Mode::Replan } else { Mode::PlanOnce });
+            for (sigma, pick) in [(0.0, 0usize), (std, 1)] {
+                let _ = write!(
+                    md,
+                    "| {} | {} | {mode} | {sigma} | {} |",
+                    g.env,
+                    g.variant,
+                    pairs.len()
+                );
+                let mut all = Vec::new();
+                for d in &depths {
+                    let rates: Vec<f64> = pairs
+                        .iter()
+                        .map(|p| if pick == 0 { p.0 } else { p.1 })
+                        .filter_map(|e| e.iter().find(|r| r.depth == *d))
+                        .map(|r| r.solved as f64 / r.tasks.max(1) as f64)
+                        .collect();
+                    all.extend(rates.iter().copied());
+                    match summary(&rates) {
+                        Some(s) => {
+                            let _ = write!(md, " {:.1} % |", 100.0 * s.mean);
+                            let _ = writeln!(
+                                csv,
+                                "{},{},{mode},{sigma},{},{d},{:.4},{:.4}",
+                                g.env, g.variant, s.n, s.mean, s.std
+                            );
+                        }
+                        None => md += " – |",
+                    }
+                }
+                match summary(&all) {
+                    Some(s) => {
+                        let _ = writeln!(md, " {:.1} % |", 100.0 * s.mean);
+                    }
+                    None => md += " – |\n",
+                }
+            }
+        }
+    }
+    md += "\nShare of the same test boards solved at the end of training without (σ = 0) and with \
+           Gaussian noise of standard deviation σ on every low-level action (`seads evaluate \
+           --action-noise`), mean over the runs evaluated both ways.\n";
+    any.then_some((md, csv))
+}
+
 /// Final task success per depth (mean over runs of each run's success rate), Markdown and CSV.
 pub fn success_tables(groups: &[Group<'_>]) -> (String, String) {
     let depths = depths(groups);
@@ -369,4 +458,62 @@ pub fn length_tables(groups: &[Group<'_>]) -> (String, String) {
     md += "\nMedians in manipulator steps over the solved tasks of all runs, with re-planning (the seed's \
            Figs. S.5, S.6 show their distributions; see the box plots).\n";
     (md, csv)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::report::runs::bare_run;
+
+    /// Results of one depth: `solved` of 20.
+    fn depth(d: usize, solved: usize) -> DepthResult {
+        DepthResult {
+            tasks: 20,
+            solved,
+            ..DepthResult::new(d)
+        }
+    }
+
+    /// By hand: without noise both runs solve 20/20 at depth 1 and 18/20, 20/20 at depth 2 (95 %);
+    /// under σ = 0.05 they solve 10/20 and 20/20 (75 %), 9/20 and 11/20 (50 %); over both depths
+    /// 97.5 % and 62.5 %. A run without a noisy evaluation is left out of its row.
+    #[test]
+    fn noise_rows_compare_the_same_runs_with_and_without_noise() {
+        let mut a = bare_run(1);
+        a.replan = Some(vec![depth(1, 20), depth(2, 18)]);
+        a.noisy = vec![(0.05, true, vec![depth(1, 10), depth(2, 9)])];
+        let mut b = bare_run(2);
+        b.replan = Some(vec![depth(1, 20), depth(2, 20)]);
+        b.noisy = vec![(0.05, true, vec![depth(1, 20), depth(2, 11)])];
+        let mut c = bare_run(3);
+        c.replan = Some(vec![depth(1, 0), depth(2, 0)]);
+        let runs = [a, b, c];
+        let group = Group {
+            env: "lightsout-cursor".into(),
+            variant: "seads".into(),
+            runs: runs.iter().collect(),
+        };
+        let (md, csv) = noise_tables(&[group]).expect("noisy runs");
+        assert!(
+            md.contains(
+                "| lightsout-cursor | seads | re-planning | 0 | 2 | 100.0 % | 95.0 % | 97.5 % |"
+            ),
+            "{md}"
+        );
+        assert!(
+            md.contains(
+                "| lightsout-cursor | seads | re-planning | 0.05 | 2 | 75.0 % | 50.0 % | 62.5 % |"
+            ),
+            "{md}"
+        );
+        assert_eq!(csv.lines().count(), 5, "{csv}");
+        assert!(
+            noise_tables(&[Group {
+                env: "x".into(),
+                variant: "y".into(),
+                runs: vec![&runs[2]],
+            }])
+            .is_none()
+        );
+    }
 }

@@ -155,24 +155,13 @@ mod tests {
                         "sac": wall - 90.0, "evaluate": 6.0},
         });
         RunData {
-            dir: format!("seed-{seed}").into(),
-            copy_to: format!("seed-{seed}").into(),
-            variant: "seads".into(),
-            config: seads_rl::TrainConfig::default(),
             metrics: vec![serde_json::from_value(line).unwrap()],
-            task_metrics: Vec::new(),
-            policy: None,
-            replan: None,
-            plan_once: None,
-            over_training: Vec::new(),
             processors: if seed == 1 {
                 vec!["AMD EPYC, 9554".into(), "Intel(R) Xeon(R)".into()]
             } else {
                 Vec::new()
             },
-            evaluation_notes: Vec::new(),
-            unrecorded_evaluations: 0,
-            damage: Vec::new(),
+            ..super::super::runs::bare_run(seed)
         }
     }
 
