@@ -245,10 +245,7 @@ impl<M: Manipulator> Environment for Embodied<M> {
         let (m, d) = (self.spec.manipulator_dim, self.spec.symbolic_len);
         self.manipulator.observe(&mut out[..m]);
         self.board.board().write_f32(&mut out[m..m + d]);
-        out[m + d] = match self.spec.step_limit {
-            Some(limit) => limit.saturating_sub(self.steps) as f32 / limit as f32,
-            None => 1.0,
-        };
+        out[m + d] = self.spec.remaining_time(self.steps);
     }
 
     fn board(&self) -> SymbolicState {

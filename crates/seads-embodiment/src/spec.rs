@@ -36,6 +36,15 @@ pub struct EnvSpec {
 }
 
 impl EnvSpec {
+    /// The observation's remaining time ρ = (T_max − t)/T_max after `steps` steps of the current
+    /// skill; 1 without a step limit. Every environment observes it through this one rule.
+    pub fn remaining_time(&self, steps: usize) -> f32 {
+        match self.step_limit {
+            Some(limit) => limit.saturating_sub(steps) as f32 / limit.max(1) as f32,
+            None => 1.0,
+        }
+    }
+
     /// Checks an action's length and that every entry is finite.
     pub fn check_action(&self, action: &[f32]) -> Result<(), crate::EnvError> {
         if action.len() != self.action_dim {

@@ -303,8 +303,7 @@ impl Environment for UarmEnv {
         out[0] = hw.cursor[0] as f32;
         out[1] = hw.cursor[1] as f32;
         hw.board.write_f32(&mut out[2..27]);
-        let limit = self.spec.step_limit.unwrap_or(1);
-        out[27] = limit.saturating_sub(self.steps) as f32 / limit as f32;
+        out[27] = self.spec.remaining_time(self.steps);
     }
 
     fn board(&self) -> SymbolicState {

@@ -347,3 +347,30 @@ fn episodes_on_one_robot_run_one_after_another() {
         board = e.zt;
     }
 }
+
+/// The robot observes its remaining time by the rule every environment shares: after each step,
+/// with a step limit of 10, of 1, and with none (as when recording), the twin's last entry is the
+/// LightsOutCursor's.
+#[test]
+fn the_twin_observes_remaining_time_as_the_cursor_does() {
+    let twin = Twin::new(8);
+    let mut robot = env(&twin, ActionSpace::Displacement);
+    let mut cursor = seads_embodiment::make_env(
+        "lightsout-cursor",
+        &seads_embodiment::EnvConfig::default(),
+    )
+    .unwrap();
+    for limit in [Some(10), Some(1), None] {
+        robot.set_step_limit(limit);
+        cursor.set_step_limit(limit);
+        robot.reset_step_counter();
+        cursor.reset_step_counter();
+        for step in 0..limit.unwrap_or(3) {
+            let (r, c) = (robot.observation(), cursor.observation());
+            assert_eq!(r[27], c[27], "limit {limit:?}, step {step}");
+            robot.step(&[0.0, 0.0, -1.0]).unwrap();
+            cursor.step(&[0.0, 0.0, -1.0]).unwrap();
+        }
+        assert_eq!(robot.observation()[27], cursor.observation()[27], "limit {limit:?}");
+    }
+}
