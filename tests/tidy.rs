@@ -419,3 +419,163 @@ fn the_documents_cite_only_files_and_tests_that_exist() {
         missing.join("\n")
     );
 }
+
+/// Every `.rs` file under `dir`, recursively.
+fn rust_files(dir: &std::path::Path) -> Vec<std::path::PathBuf> {
+    let mut files = Vec::new();
+    let mut stack = vec![dir.to_path_buf()];
+    while let Some(d) = stack.pop() {
+        for entry in std::fs::read_dir(&d).unwrap() {
+            let path = entry.unwrap().path();
+            if path.is_dir() {
+                stack.push(path);
+            } else if path.extension().is_some_and(|e| e == "rs") {
+                files.push(path);
+            }
+        }
+    }
+    files
+}
+
+/// The words of `text` that can be Rust identifiers.
+fn words(text: &str) -> impl Iterator<Item = &str> {
+    text.split(|c: char| !(c.is_ascii_alphanumeric() || c == '_'))
+        .filter(|w| !w.is_empty())
+}
+
+/// The top-level modules of each crate that another module of the same crate uses (through
+/// `crate::module::…`, `crate::{…}` or a name the crate root re-exports from a module), and the
+/// cycles among them: `[crate, a, b, …, a]`.
+fn module_cycles() -> Vec<Vec<String>> {
+    let mut cycles = Vec::new();
+    let mut crates: Vec<_> = std::fs::read_dir(root().join("crates"))
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .collect();
+    crates.sort();
+    for krate in crates {
+        let src = krate.join("src");
+        let name = krate.file_name().unwrap().to_string_lossy().into_owned();
+        // Module name → its files.
+        let mut modules: std::collections::BTreeMap<String, Vec<std::path::PathBuf>> =
+            Default::default();
+        for entry in std::fs::read_dir(&src).unwrap() {
+            let path = entry.unwrap().path();
+            let stem = path.file_stem().unwrap().to_string_lossy().into_owned();
+            if path.is_dir() {
+                modules.entry(stem).or_default().extend(rust_files(&path));
+            } else if path.extension().is_some_and(|e| e == "rs") && stem != "lib" && stem != "main"
+            {
+                modules.entry(stem).or_default().push(path);
+            }
+        }
+        let root_file = ["lib.rs", "main.rs"]
+            .iter()
+            .map(|f| src.join(f))
+            .find(|p| p.exists())
+            .unwrap();
+        // Names the crate root re-exports: `pub use module::{A, B};`.
+        let mut exported: std::collections::BTreeMap<String, String> = Default::default();
+        let root_text = std::fs::read_to_string(root_file).unwrap();
+        for part in root_text.split("pub use ").skip(1) {
+            let statement = part.split(';').next().unwrap();
+            if let Some((module, names)) = statement.split_once("::") {
+                for word in words(names) {
+                    exported.insert(word.to_owned(), module.trim().to_owned());
+                }
+            }
+        }
+        let mut edges: std::collections::BTreeMap<String, std::collections::BTreeSet<String>> =
+            Default::default();
+        for (module, files) in &modules {
+            let text: String = files
+                .iter()
+                .map(|f| std::fs::read_to_string(f).unwrap())
+                .flat_map(|t| {
+                    t.lines()
+                        .map(|l| l.split("//").next().unwrap_or("").to_owned() + "\n")
+                        .collect::<Vec<_>>()
+                })
+                .collect();
+            let mut used = std::collections::BTreeSet::new();
+            for part in text.split("crate::").skip(1) {
+                let names: &str = if let Some(list) = part.strip_prefix('{') {
+                    list.split('}').next().unwrap()
+                } else {
+                    part.split(|c: char| !(c.is_ascii_alphanumeric() || c == '_'))
+                        .next()
+                        .unwrap()
+                };
+                for word in words(names) {
+                    if modules.contains_key(word) {
+                        used.insert(word.to_owned());
+                    } else if let Some(m) = exported.get(word) {
+                        used.insert(m.clone());
+                    }
+                }
+            }
+            used.remove(module);
+            edges.insert(module.clone(), used);
+        }
+        // Every simple cycle, found once from its smallest module.
+        fn walk(
+            edges: &std::collections::BTreeMap<String, std::collections::BTreeSet<String>>,
+            start: &str,
+            path: &mut Vec<String>,
+            found: &mut Vec<Vec<String>>,
+        ) {
+            let last = path.last().unwrap().clone();
+            for next in edges.get(&last).into_iter().flatten() {
+                if next == start {
+                    found.push(path.iter().cloned().chain([next.clone()]).collect());
+                } else if next.as_str() > start && !path.contains(next) {
+                    path.push(next.clone());
+                    walk(edges, start, path, found);
+                    path.pop();
+                }
+            }
+        }
+        for start in edges.keys() {
+            let mut found = Vec::new();
+            walk(&edges, start, &mut vec![start.clone()], &mut found);
+            for cycle in found {
+                cycles.push([name.clone()].into_iter().chain(cycle).collect());
+            }
+        }
+    }
+    cycles
+}
+
+/// The modules of a crate use one another one way. The cycles listed here are known debt, each to
+/// be broken (and removed from the list: the test also fails when a listed cycle is gone); any
+/// other cycle fails.
+#[test]
+fn modules_within_a_crate_use_one_another_one_way() {
+    let known: [&[&str]; 5] = [
+        &["seads-planner", "evaluate", "protocol", "evaluate"],
+        &["seads-rl", "run", "store", "run"],
+        &["seads-rl", "run", "trainer", "run"],
+        &["seads-skillmodel", "groundtruth", "model", "groundtruth"],
+        &["seads-study", "error", "sweep", "error"],
+    ];
+    let found = module_cycles();
+    let text = |c: &[String]| c.join(" → ");
+    for cycle in &found {
+        assert!(
+            known
+                .iter()
+                .any(|k| k.iter().copied().eq(cycle.iter().map(String::as_str))),
+            "a new import cycle: {}",
+            text(cycle)
+        );
+    }
+    for k in known {
+        assert!(
+            found
+                .iter()
+                .any(|c| k.iter().copied().eq(c.iter().map(String::as_str))),
+            "{} is gone: remove it from the known cycles",
+            k.join(" → ")
+        );
+    }
+}

@@ -1,5 +1,5 @@
 //! A trained agent loaded from a run directory: the skill policy (for executing skills) and the
-//! forward model (for planning).
+//! forward model (for planning); and a baseline's task policy loaded from its checkpoint.
 
 use std::path::{Path, PathBuf};
 
@@ -7,7 +7,11 @@ use seads_embodiment::{EnvSpec, SkillPolicy, make_env};
 use seads_skillmodel::{ForwardModel, SkillModel, SkillModelKind};
 use tch::Device;
 
-use crate::{RlError, Sac, TrainConfig, checkpoints, latest_checkpoint, load_config, policy_input};
+use crate::hac::HacPolicy;
+use crate::task_policy::TaskPolicy;
+use crate::{
+    Algorithm, RlError, Sac, TrainConfig, checkpoints, latest_checkpoint, load_config, policy_input,
+};
 
 /// The skill policy π(a | s, k) of a trained agent, executed deterministically.
 pub struct AgentPolicy {
@@ -137,5 +141,33 @@ impl Agent {
                 "this agent learned a VIC skill discriminator, which cannot plan".into(),
             )),
         }
+    }
+}
+
+/// The policy saved in a checkpoint folder of a baseline run with `config` (only the actors are
+/// read: older checkpoints keep nothing else).
+pub fn load_policy(
+    config: &TrainConfig,
+    checkpoint: &Path,
+) -> Result<Box<dyn TaskPolicy>, RlError> {
+    crate::store::check_origin(checkpoint, config)?;
+    let spec = make_env(&config.env, &config.env_config)?.spec().clone();
+    match config.algorithm {
+        Algorithm::Sac => {
+            let mut sac = Sac::new(
+                spec.obs_dim,
+                &spec.action_low,
+                &spec.action_high,
+                &config.sac,
+                Device::Cpu,
+                0,
+            );
+            sac.load(checkpoint, true)?;
+            Ok(Box::new(sac))
+        }
+        Algorithm::Hac => Ok(Box::new(HacPolicy::load(config, &spec, checkpoint)?)),
+        Algorithm::Seads => Err(RlError::Config(
+            "a SEADS run has skills and a forward model, not a task policy; plan with it".into(),
+        )),
     }
 }

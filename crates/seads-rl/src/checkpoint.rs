@@ -8,7 +8,6 @@ use std::path::Path;
 use seads_games::SymbolicState;
 use tch::{Kind, Tensor};
 
-use crate::trainer::Prepared;
 use crate::{Episode, RlError, TransitionBatch};
 
 /// The episode buffer (long-term buffer; the recent episodes are its tail).
@@ -170,6 +169,15 @@ impl<'a> TensorFile<'a> {
         Vec::<i64>::try_from(self.get(name)?.to_kind(Kind::Int64).view([-1]))
             .map_err(|e| self.corrupt(e.to_string()))
     }
+}
+
+/// An epoch's skill-model update done and its SAC minibatches relabelled, ready for SAC: part
+/// of a checkpoint when the run stopped between preparing and using them.
+#[derive(Debug)]
+pub(crate) struct Prepared {
+    pub(crate) minibatches: Vec<TransitionBatch>,
+    pub(crate) mean_reward: f32,
+    pub(crate) skill_model_loss: f32,
 }
 
 impl Prepared {

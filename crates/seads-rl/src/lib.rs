@@ -53,7 +53,7 @@ mod trainer;
 
 use std::path::Path;
 
-pub use agent::{Agent, AgentPolicy, find_checkpoint};
+pub use agent::{Agent, AgentPolicy, find_checkpoint, load_policy};
 pub use buffers::{RelabelBatch, RelabelObserver, Relabelling};
 pub use config::{
     Algorithm, BaselineConfig, HacConfig, RelabelConfig, TrainConfig, config_difference,
@@ -71,7 +71,7 @@ pub use store::{
     checkpoint_name, checkpoints, is_copy_without_checkpoints, last_env_steps, latest_checkpoint,
     read_json_lines, read_metrics, read_metrics_as, run_is_locked, write_atomic,
 };
-pub use task_policy::{TaskPolicy, load_policy, task_success};
+pub use task_policy::{TaskPolicy, task_success};
 pub use task_sac::{TaskEpochStats, TaskMetrics, TaskSac, TaskTimings, updates_due};
 pub use trainer::{COVERAGE_SEED, EpochStats, Timings, Trainer};
 

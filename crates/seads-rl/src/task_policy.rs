@@ -1,15 +1,11 @@
 //! What the task-reward baselines share at evaluation: a policy acting in task mode, its task
-//! success on the SEADS protocol's boards, and loading it from a checkpoint.
-
-use std::path::Path;
+//! success on the SEADS protocol's boards (`agent.rs` loads one from a checkpoint).
 
 use seads_embodiment::{EnvConfig, TaskEnv, make_env};
 use seads_games::SymbolicState;
 use seads_planner::{DepthResult, TaskSet};
-use tch::Device;
 
-use crate::hac::HacPolicy;
-use crate::{Algorithm, RlError, Sac, TrainConfig};
+use crate::{RlError, Sac, TrainConfig};
 
 /// A deterministic policy acting in task mode: one action per observation of an episode.
 pub trait TaskPolicy {
@@ -29,34 +25,6 @@ impl TaskPolicy for &Sac {
 impl TaskPolicy for Sac {
     fn act(&mut self, obs: &[f32]) -> Vec<f32> {
         Sac::act(self, obs, None)
-    }
-}
-
-/// The policy saved in a checkpoint folder of a baseline run with `config` (only the actors are
-/// read: older checkpoints keep nothing else).
-pub fn load_policy(
-    config: &TrainConfig,
-    checkpoint: &Path,
-) -> Result<Box<dyn TaskPolicy>, RlError> {
-    crate::store::check_origin(checkpoint, config)?;
-    let spec = make_env(&config.env, &config.env_config)?.spec().clone();
-    match config.algorithm {
-        Algorithm::Sac => {
-            let mut sac = Sac::new(
-                spec.obs_dim,
-                &spec.action_low,
-                &spec.action_high,
-                &config.sac,
-                Device::Cpu,
-                0,
-            );
-            sac.load(checkpoint, true)?;
-            Ok(Box::new(sac))
-        }
-        Algorithm::Hac => Ok(Box::new(HacPolicy::load(config, &spec, checkpoint)?)),
-        Algorithm::Seads => Err(RlError::Config(
-            "a SEADS run has skills and a forward model, not a task policy; plan with it".into(),
-        )),
     }
 }
 

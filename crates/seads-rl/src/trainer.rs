@@ -15,7 +15,7 @@ use serde::{Deserialize, Serialize};
 use tch::Device;
 
 use crate::buffers::{Buffers, RelabelObserver};
-use crate::checkpoint;
+use crate::checkpoint::{self, Prepared};
 use crate::episode::{run_episodes, skill_coverage};
 use crate::seeds::{Purpose, derived_seed, stream, train_env_seed};
 use crate::{Episode, Moment, RlError, Sac, SacLosses, TrainConfig, TransitionBatch};
@@ -97,14 +97,6 @@ pub struct Trainer {
     prepared: Option<Prepared>,
     /// Sees each joint relabelling (diagnostics only; not part of a checkpoint).
     relabel_observer: Option<Box<RelabelObserver>>,
-}
-
-/// An epoch's skill-model update done and its SAC minibatches relabelled, ready for SAC.
-#[derive(Debug)]
-pub(crate) struct Prepared {
-    pub(crate) minibatches: Vec<TransitionBatch>,
-    pub(crate) mean_reward: f32,
-    pub(crate) skill_model_loss: f32,
 }
 
 impl Trainer {

@@ -355,11 +355,9 @@ fn episodes_on_one_robot_run_one_after_another() {
 fn the_twin_observes_remaining_time_as_the_cursor_does() {
     let twin = Twin::new(8);
     let mut robot = env(&twin, ActionSpace::Displacement);
-    let mut cursor = seads_embodiment::make_env(
-        "lightsout-cursor",
-        &seads_embodiment::EnvConfig::default(),
-    )
-    .unwrap();
+    let mut cursor =
+        seads_embodiment::make_env("lightsout-cursor", &seads_embodiment::EnvConfig::default())
+            .unwrap();
     for limit in [Some(10), Some(1), None] {
         robot.set_step_limit(limit);
         cursor.set_step_limit(limit);
@@ -371,6 +369,10 @@ fn the_twin_observes_remaining_time_as_the_cursor_does() {
             robot.step(&[0.0, 0.0, -1.0]).unwrap();
             cursor.step(&[0.0, 0.0, -1.0]).unwrap();
         }
-        assert_eq!(robot.observation()[27], cursor.observation()[27], "limit {limit:?}");
+        assert_eq!(
+            robot.observation()[27],
+            cursor.observation()[27],
+            "limit {limit:?}"
+        );
     }
 }
