@@ -313,12 +313,22 @@ fn status(args: StatusArgs) -> Result<()> {
         outln!("{}", serde_json::to_string(&report)?);
         return Ok(());
     }
+    // Columns as wide as their longest entry.
+    let env_w = rows.iter().map(|r| r.env.len()).max().unwrap_or(0).max(3);
+    let variant_w = rows
+        .iter()
+        .map(|r| r.variant.len())
+        .max()
+        .unwrap_or(0)
+        .max(7);
     outln!(
-        " index  status   env                variant                   seed      steps / budget  tries"
+        " index  status   {:<env_w$}  {:<variant_w$}  seed      steps / budget  tries",
+        "env",
+        "variant"
     );
     for r in &rows {
         outln!(
-            "{:>6}  {:<7}  {:<17}  {:<24}  {:>4}  {:>9} / {:<9} {:>3}{}",
+            "{:>6}  {:<7}  {:<env_w$}  {:<variant_w$}  {:>4}  {:>9} / {:<9} {:>3}{}",
             r.index,
             r.status.name(),
             r.env,
