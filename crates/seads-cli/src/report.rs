@@ -20,9 +20,10 @@ pub struct ReportArgs {
     /// The variant the others are tested against (default: the first sweep's reference).
     #[arg(long)]
     reference: Option<String>,
-    /// Also copy what the report rests on into REPORT_DIR/runs/: each run's config.toml,
-    /// metrics.jsonl and evaluation files (never checkpoints), so that the folder can be
-    /// committed as data and reported again from itself.
+    /// Also copy what the report rests on into REPORT_DIR/runs/: each finished, undamaged run's
+    /// config.toml, metrics.jsonl and evaluation files (never checkpoints; unfinished runs stay
+    /// where they resume), so that the folder can be committed as data and reported again from
+    /// itself.
     #[arg(long)]
     copy_runs: bool,
 }

@@ -809,3 +809,32 @@ fn a_deleted_run_is_planned_again_and_done_needs_readable_outputs() {
     seads_ok(&["sweep", "run", s(&sweep), "--quiet"]);
     assert_eq!(std::fs::read(&evaluation).unwrap(), b"{ torn");
 }
+
+/// `report --copy-runs` of a sweep in progress copies its finished runs only (an unfinished one
+/// resumes where it is), and the copy is reported again, naming the runs it lacks, none damaged.
+#[test]
+fn a_copy_of_a_sweep_in_progress_holds_its_finished_runs_and_reports_again() {
+    let tmp = tempfile::tempdir().unwrap();
+    let manifest = write_manifest(tmp.path(), &seads_only_without_evaluation_over_training());
+    let sweep = tmp.path().join("sweep");
+    seads_ok(&["sweep", "plan", s(&manifest), "--out", s(&sweep)]);
+    seads_ok(&["sweep", "run", s(&sweep), "--seeds", "1", "--quiet"]);
+    let out = tmp.path().join("report");
+    seads_ok(&["report", s(&sweep), "--out", s(&out), "--copy-runs"]);
+    let copied = out.join("runs/tiny/runs/lightsout-cursor/seads");
+    assert!(copied.join("seed-1/metrics.jsonl").is_file());
+    assert!(
+        !copied.join("seed-2").exists(),
+        "an unstarted run is not copied"
+    );
+    let again = tmp.path().join("again");
+    let output = seads_ok(&["report", s(&out.join("runs/tiny")), "--out", s(&again)]);
+    let stderr = String::from_utf8_lossy(&output.stderr);
+    assert!(!stderr.contains("damaged"), "{stderr}");
+    let md = std::fs::read_to_string(again.join("report.md")).unwrap();
+    assert!(
+        md.contains("1 finished, 0 unfinished and 0 damaged"),
+        "{md}"
+    );
+    assert!(md.contains("- not here: 1 run(s)"), "{md}");
+}

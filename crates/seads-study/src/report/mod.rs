@@ -37,8 +37,9 @@ pub struct ReportOptions {
     pub inputs: Vec<PathBuf>,
     /// The variant the others are tested against (`None`: the first sweep's reference).
     pub reference: Option<String>,
-    /// Also copy what the report rests on into `OUT/runs/`: each run's config, metrics and
-    /// evaluation files (never checkpoints), with each sweep's index and manifest.
+    /// Also copy what the report rests on into `OUT/runs/`: each finished, undamaged run's
+    /// config, metrics and evaluation files (never checkpoints), with each sweep's index and
+    /// manifest; a report of the copy names the runs it lacks.
     pub copy_runs: bool,
 }
 
@@ -145,6 +146,13 @@ pub fn write_report(options: &ReportOptions, out: &Path) -> Result<ReportSummary
     if not_started > 0 {
         let _ = writeln!(md, "- not started: {not_started} run(s)");
     }
+    if collection.absent > 0 {
+        let _ = writeln!(
+            md,
+            "- not here: {} run(s) of the sweep have no directory (a copy holds finished runs only)",
+            collection.absent
+        );
+    }
     for run in collection.runs.iter().filter(|r| !r.damage.is_empty()) {
         let _ = writeln!(
             md,
@@ -160,7 +168,7 @@ pub fn write_report(options: &ReportOptions, out: &Path) -> Result<ReportSummary
             dir.display()
         );
     }
-    if !unfinished.is_empty() || damaged > 0 {
+    if !unfinished.is_empty() || damaged > 0 || collection.absent > 0 {
         md.push('\n');
     }
     let _ = writeln!(md, "## Skill coverage at the end of training (Table 1)\n");
@@ -228,7 +236,12 @@ pub fn write_report(options: &ReportOptions, out: &Path) -> Result<ReportSummary
                 seads_rl::write_atomic(&dest.join(file), &bytes)?;
             }
         }
-        for run in &collection.runs {
+        // What the tables rest on: finished, undamaged runs (the others resume where they are).
+        for run in collection
+            .runs
+            .iter()
+            .filter(|r| r.finished() && r.damage.is_empty())
+        {
             let dest = out.join("runs").join(&run.copy_to);
             std::fs::create_dir_all(&dest).doing(|| format!("creating {}", dest.display()))?;
             for file in runs::data_files(&run.dir)? {

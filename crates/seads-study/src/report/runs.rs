@@ -215,6 +215,8 @@ pub struct Collection {
     pub sweep_dirs: Vec<PathBuf>,
     /// Run directories whose configuration cannot be read, with why (left out, listed).
     pub unreadable: Vec<(PathBuf, String)>,
+    /// Runs of a sweep's index without a directory here: a copy holds finished runs only.
+    pub absent: usize,
 }
 
 /// Reads the sweeps and runs in `inputs`.
@@ -225,12 +227,17 @@ pub fn collect(inputs: &[PathBuf]) -> Result<Collection> {
         sweeps: Vec::new(),
         sweep_dirs: Vec::new(),
         unreadable: Vec::new(),
+        absent: 0,
     };
     for input in inputs {
         if input.join(crate::sweep::INDEX).is_file() {
             let sweep = Sweep::load(input)?;
             for run in &sweep.runs {
                 let dir = input.join(&run.dir);
+                if !dir.exists() {
+                    collection.absent += 1;
+                    continue;
+                }
                 match RunData::load(
                     &dir,
                     run.variant.clone(),
