@@ -397,6 +397,17 @@ fn train_rejects_bad_input() {
     assert!(String::from_utf8_lossy(&missing.stderr).contains("config.toml"));
 }
 
+/// A copy of the shared tiny run at `to`, for a test that writes into it.
+fn copy_tiny_run(to: &std::path::Path) {
+    let status = std::process::Command::new("cp")
+        .arg("-r")
+        .arg(tiny_run().join("run"))
+        .arg(to)
+        .status()
+        .unwrap();
+    assert!(status.success());
+}
+
 /// One tiny trained run shared by the planning tests.
 fn tiny_run() -> &'static std::path::Path {
     static RUN: std::sync::OnceLock<tempfile::TempDir> = std::sync::OnceLock::new();
@@ -1211,13 +1222,7 @@ fn a_report_lists_damaged_runs_with_why() {
     let dir = tempfile::tempdir().unwrap();
     let copy = |name: &str| {
         let to = dir.path().join(name);
-        let status = std::process::Command::new("cp")
-            .arg("-r")
-            .arg(tiny_run().join("run"))
-            .arg(&to)
-            .status()
-            .unwrap();
-        assert!(status.success());
+        copy_tiny_run(&to);
         to
     };
     let (good, metrics, evaluation, config) = (
@@ -1271,13 +1276,7 @@ fn a_report_lists_damaged_runs_with_why() {
 fn a_checkpoint_of_other_shapes_is_one_line_of_bad_input() {
     let dir = tempfile::tempdir().unwrap();
     let run = dir.path().join("run");
-    let status = std::process::Command::new("cp")
-        .arg("-r")
-        .arg(tiny_run().join("run"))
-        .arg(&run)
-        .status()
-        .unwrap();
-    assert!(status.success());
+    copy_tiny_run(&run);
     let latest = std::fs::read_to_string(run.join("checkpoints/latest")).unwrap();
     let weights = run
         .join("checkpoints")
@@ -1390,13 +1389,7 @@ proptest::proptest! {
 fn an_evaluation_under_action_noise_has_files_of_its_own_and_repeats() {
     let dir = tempfile::tempdir().unwrap();
     let run = dir.path().join("run");
-    let status = std::process::Command::new("cp")
-        .arg("-r")
-        .arg(tiny_run().join("run"))
-        .arg(&run)
-        .status()
-        .unwrap();
-    assert!(status.success());
+    copy_tiny_run(&run);
     let args = |noise: &str| -> Vec<String> {
         let mut a: Vec<String> = [
             "evaluate",

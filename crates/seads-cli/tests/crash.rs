@@ -124,6 +124,18 @@ fn start_and_kill(config: &Path, out: &Path, point: usize) {
     kill_at_moment(train(config, out), point);
 }
 
+/// The moment right after the fourth `latest` update: older complete checkpoints exist.
+fn after_a_later_checkpoint(base: &Baseline) -> usize {
+    1 + base
+        .moments
+        .iter()
+        .enumerate()
+        .filter(|(_, m)| *m == "latest-written")
+        .nth(3)
+        .unwrap()
+        .0
+}
+
 /// Starts a fresh run, kills it at moment `point`, then resumes it to the end; returns the
 /// resumed run's stderr.
 fn kill_and_resume(point: usize, tear: bool) -> String {
@@ -210,14 +222,7 @@ fn killed_runs_resume_to_the_same_metrics_b() {
 fn a_torn_line_and_a_corrupt_latest_checkpoint_are_repaired() {
     let base = baseline();
     // The second checkpoint's pointer update: an older complete checkpoint exists.
-    let point = 1 + base
-        .moments
-        .iter()
-        .enumerate()
-        .filter(|(_, m)| *m == "latest-written")
-        .nth(3)
-        .unwrap()
-        .0;
+    let point = after_a_later_checkpoint(base);
     let dir = tempfile::tempdir().unwrap();
     let out = dir.path().join("run");
     start_and_kill(&base.config, &out, point);
@@ -312,14 +317,7 @@ fn a_second_writer_is_refused_while_the_run_trains() {
 #[test]
 fn damaged_runs_are_repaired_with_a_word_or_refused_never_retrained() {
     let base = baseline();
-    let point = 1 + base
-        .moments
-        .iter()
-        .enumerate()
-        .filter(|(_, m)| *m == "latest-written")
-        .nth(3)
-        .unwrap()
-        .0;
+    let point = after_a_later_checkpoint(base);
     let dir = tempfile::tempdir().unwrap();
     let killed = dir.path().join("killed");
     start_and_kill(&base.config, &killed, point);
