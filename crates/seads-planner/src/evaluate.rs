@@ -7,7 +7,7 @@ use seads_embodiment::{EnvConfig, EnvError, SkillPolicy, make_env};
 use seads_games::{Successor, SymbolicState};
 use serde::{Deserialize, Serialize};
 
-use crate::{SolveConfig, SolveOutcome, TaskSet, solve};
+use crate::{Protocol, SolveConfig, SolveOutcome, TaskSet, solve};
 
 /// One task of an evaluation, as it ended.
 #[derive(Debug, Clone, Copy)]
@@ -23,15 +23,6 @@ pub struct TaskRecord<'a> {
     /// What solving it did.
     pub outcome: &'a SolveOutcome,
 }
-
-/// The 20 environment seeds of the authors' evaluation jobs (the first 20 draws of
-/// `randint(0, 10^8)` from NumPy's `RandomState(4343)`). They select other boards here than in
-/// the reference (different RNG), but they fix the task list of this implementation.
-pub const EVALUATION_SEEDS: [u64; 20] = [
-    71503910, 12648915, 30568854, 4573881, 45446760, 94593131, 49877556, 8409767, 80251918,
-    3111044, 91239881, 76542445, 17493797, 60709534, 18799053, 83516419, 64932163, 31287836,
-    49353701, 42153732,
-];
 
 /// The results of one solution depth.
 #[derive(Debug, Clone, Serialize, Deserialize)]
@@ -217,5 +208,116 @@ pub fn summarise(results: &[DepthResult]) -> EvaluationSummary {
             .iter()
             .map(|r| (key(r), median(&to_f64(&r.skill_steps))))
             .collect(),
+    }
+}
+
+/// The checkpoint an evaluation evaluated.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct CheckpointId {
+    /// Its epoch.
+    pub epoch: u64,
+    /// Environment steps of training when it was written (`None` where the run does not say).
+    pub env_steps: Option<u64>,
+}
+
+/// An evaluation file: what was evaluated, how, and the results per depth.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct EvaluationRecord {
+    /// The checkpoint (`None` in files written before evaluations recorded it).
+    pub checkpoint: Option<CheckpointId>,
+    /// The protocol (`None` in files written before evaluations recorded it).
+    pub protocol: Option<Protocol>,
+    /// Per depth.
+    pub results: Vec<DepthResult>,
+}
+
+/// The two shapes of an evaluation file: today's record, and the bare list of per-depth
+/// results that files had before they recorded their checkpoint and protocol.
+#[derive(Deserialize)]
+#[serde(untagged)]
+enum Stored {
+    Record(EvaluationRecord),
+    Bare(Vec<DepthResult>),
+}
+
+impl EvaluationRecord {
+    /// Parses an evaluation file of either shape.
+    pub fn from_json(text: &str) -> Result<Self, serde_json::Error> {
+        Ok(match serde_json::from_str(text)? {
+            Stored::Record(record) => record,
+            Stored::Bare(results) => Self {
+                checkpoint: None,
+                protocol: None,
+                results,
+            },
+        })
+    }
+
+    /// The file's text (pretty JSON).
+    pub fn to_json(&self) -> String {
+        serde_json::to_string_pretty(self).expect("an evaluation record serialises")
+    }
+
+    /// The record says it was made with `protocol` (older files say nothing, so never).
+    pub fn made_with(&self, protocol: &Protocol) -> bool {
+        self.protocol.as_ref() == Some(protocol)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::{EvaluationKind, SearchLimits};
+
+    #[test]
+    fn a_record_round_trips_and_old_bare_lists_still_read() {
+        let record = EvaluationRecord {
+            checkpoint: Some(CheckpointId {
+                epoch: 100,
+                env_steps: Some(4_496),
+            }),
+            protocol: Some(Protocol {
+                kind: EvaluationKind::Replan,
+                tasks: TaskSet::standard(20),
+                limits: Some(SearchLimits {
+                    timeout_s: 10.0,
+                    max_expanded: None,
+                }),
+                action_noise: None,
+            }),
+            results: vec![DepthResult::new(1)],
+        };
+        let noisy = Protocol {
+            action_noise: Some(0.05),
+            ..record.protocol.clone().unwrap()
+        };
+        assert_eq!(
+            record.protocol.as_ref().unwrap().results_file(Some(7)),
+            "evaluation-replan-epoch-000007.json"
+        );
+        assert_eq!(
+            noisy.results_file(Some(7)),
+            "evaluation-replan-noise-0.05-epoch-000007.json"
+        );
+        assert_eq!(
+            noisy.tasks_file(None),
+            "evaluation-replan-noise-0.05-tasks.jsonl"
+        );
+        assert!(!record.made_with(&noisy));
+        let back = EvaluationRecord::from_json(&record.to_json()).unwrap();
+        assert_eq!(back.checkpoint, record.checkpoint);
+        assert!(back.made_with(record.protocol.as_ref().unwrap()));
+        let other = Protocol {
+            tasks: TaskSet::standard(10),
+            ..record.protocol.clone().unwrap()
+        };
+        assert!(!back.made_with(&other));
+        let old = serde_json::to_string(&vec![DepthResult::new(2)]).unwrap();
+        let old = EvaluationRecord::from_json(&old).unwrap();
+        assert_eq!((old.checkpoint, old.protocol), (None, None));
+        assert_eq!(old.results[0].depth, 2);
+        assert!(EvaluationRecord::from_json("{\"results\": 3}").is_err());
     }
 }

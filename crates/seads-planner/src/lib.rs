@@ -34,10 +34,11 @@ mod protocol;
 
 pub use bfs::{Plan, PlanError, PlannerConfig, bfs_plan};
 pub use evaluate::{
-    DepthResult, EVALUATION_SEEDS, Evaluation, EvaluationSummary, TaskRecord, evaluate, summarise,
+    CheckpointId, DepthResult, Evaluation, EvaluationRecord, EvaluationSummary, TaskRecord,
+    evaluate, summarise,
 };
 pub use execute::{Deviation, SolveConfig, SolveOutcome, solve};
 pub use protocol::{
-    CheckpointId, EvaluationKind, EvaluationRecord, Protocol, STANDARD_DEPTHS, SearchLimits,
-    TASK_STREAM_SEED, TaskSet,
+    EVALUATION_SEEDS, EvaluationKind, Protocol, STANDARD_DEPTHS, SearchLimits, TASK_STREAM_SEED,
+    TaskSet,
 };

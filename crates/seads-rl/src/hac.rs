@@ -71,8 +71,8 @@ use seads_planner::{DepthResult, TaskSet};
 use serde::{Deserialize, Serialize};
 use tch::Device;
 
+use crate::learner::Learner;
 use crate::replay::Replay;
-use crate::run::Learner;
 use crate::task_policy::TaskPolicy;
 use crate::task_sac::{OpenEpisode, Streams, training_envs};
 use crate::{

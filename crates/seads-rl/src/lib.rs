@@ -40,6 +40,8 @@ mod checkpoint;
 mod config;
 mod episode;
 mod hac;
+mod learner;
+mod metrics;
 mod numerics;
 mod relaxed;
 mod replay;
@@ -61,15 +63,17 @@ pub use config::{
 };
 pub use episode::{Episode, policy_input, run_episodes, skill_coverage};
 pub use hac::{Hac, HacPolicy};
+pub use learner::{Hook, Learner, Moment};
+pub use metrics::{Metrics, read_metrics};
 pub use numerics::{FAST_KERNELS, PORTABLE_KERNELS, kernel_environment, portable_kernels_active};
 pub use relaxed::RelaxedBernoulli;
-pub use run::{Hook, Learner, Metrics, Moment, Run, RunEvent, load_config, raise_budget};
+pub use run::{Run, RunEvent, load_config, raise_budget};
 pub use sac::{Sac, SacConfig, SacLosses, TransitionBatch, checkpoint_files};
 pub use seeds::{Purpose, derived_seed, stream, train_env_seed};
 pub use store::{
     METRICS, MetricsLine, RUN_LOCK, RunLock, append_json_line, check_origin, checkpoint_id,
     checkpoint_name, checkpoints, is_copy_without_checkpoints, last_env_steps, latest_checkpoint,
-    read_json_lines, read_metrics, read_metrics_as, run_is_locked, write_atomic,
+    read_json_lines, read_metrics_as, run_is_locked, write_atomic,
 };
 pub use task_policy::{TaskPolicy, task_success};
 pub use task_sac::{TaskEpochStats, TaskMetrics, TaskSac, TaskTimings, updates_due};

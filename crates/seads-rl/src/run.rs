@@ -13,115 +13,13 @@ use std::fs;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
-use serde::{Deserialize, Serialize};
-
+use crate::learner::{Hook, Learner, Moment};
 use crate::store::{
     CHECKPOINTS, CONFIG, LATEST, Latest, METRICS, MetricsLine, append_metrics, check_origin,
     checkpoint_name, checkpoints, clean_leftovers, commit_dir, hidden_sibling, read_metrics_text,
     write_atomic, write_metrics, write_origin,
 };
-use crate::{EpochStats, RlError, Timings, TrainConfig, Trainer};
-
-/// What a [`Run`] drives: an agent in training whose whole state a checkpoint folder holds.
-/// [`Trainer`] (SEADS) and [`TaskSac`](crate::TaskSac) (the task-reward baseline) are learners.
-pub trait Learner: Sized {
-    /// What one epoch reports.
-    type Stats: Clone;
-    /// One line of `metrics.jsonl`.
-    type Metrics: MetricsLine + Clone;
-    /// A fresh learner for `config` (validated).
-    fn build(config: TrainConfig) -> Result<Self, RlError>;
-    /// The configuration.
-    fn config(&self) -> &TrainConfig;
-    /// Epochs completed.
-    fn epoch(&self) -> u64;
-    /// Whether the step budget is spent.
-    fn finished(&self) -> bool;
-    /// One epoch, calling `hook` at the [`Moment`]s inside it.
-    fn run_epoch_observed(&mut self, hook: &mut dyn FnMut(Moment)) -> Result<Self::Stats, RlError>;
-    /// The evaluation after an epoch, as a metrics line (`wall_s`: the run's seconds so far).
-    fn metrics(&mut self, stats: &Self::Stats, wall_s: f64) -> Result<Self::Metrics, RlError>;
-    /// Writes the complete state into the folder `dir`.
-    fn save(&self, dir: &Path) -> Result<(), RlError>;
-    /// Restores what [`Learner::save`] wrote.
-    fn load(&mut self, dir: &Path) -> Result<(), RlError>;
-    /// The checkpoint files only resuming needs, dropped from all but the two newest.
-    fn resume_only_files() -> Vec<&'static str>;
-}
-
-/// Moments of a run at which a crash leaves a different state on disk. A hook set with
-/// [`Run::set_hook`] is called at each (the crash-point tests stop the process there).
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum Moment {
-    /// An epoch's episodes are collected; its updates have not started.
-    Collected,
-    /// The next epoch's updates are prepared while this epoch's SAC steps may still run.
-    Prepared,
-    /// An epoch is complete in memory; nothing of it is on disk yet.
-    EpochDone,
-    /// An evaluation line was appended to `metrics.jsonl`.
-    MetricsAppended,
-    /// A checkpoint's files are written in its temporary folder, not yet renamed.
-    CheckpointWritten,
-    /// A checkpoint folder is in place; `latest` still names the previous one.
-    CheckpointRenamed,
-    /// `latest` names the new checkpoint; older ones still hold their resume files.
-    LatestWritten,
-}
-
-impl MetricsLine for Metrics {
-    fn epoch(&self) -> u64 {
-        self.epoch
-    }
-    fn wall_s(&self) -> f64 {
-        self.wall_s
-    }
-}
-
-impl Moment {
-    /// A short name (`collected`, `metrics-appended`, …).
-    pub fn name(self) -> &'static str {
-        match self {
-            Moment::Collected => "collected",
-            Moment::Prepared => "prepared",
-            Moment::EpochDone => "epoch-done",
-            Moment::MetricsAppended => "metrics-appended",
-            Moment::CheckpointWritten => "checkpoint-written",
-            Moment::CheckpointRenamed => "checkpoint-renamed",
-            Moment::LatestWritten => "latest-written",
-        }
-    }
-}
-
-/// A hook called at every [`Moment`].
-pub type Hook = Box<dyn FnMut(Moment) + Send>;
-
-/// One line of `metrics.jsonl`.
-#[derive(Debug, Clone, Serialize, Deserialize)]
-pub struct Metrics {
-    /// Epochs completed.
-    pub epoch: u64,
-    /// Environment steps so far.
-    pub env_steps: u64,
-    /// Mean number of distinct game moves made by the skills (SPEC §4.5).
-    pub skill_coverage: f64,
-    /// Wall-clock seconds since the run started (across resumes).
-    pub wall_s: f64,
-    /// Mean final reward of the last SAC batch.
-    pub mean_reward: f32,
-    /// Fraction of the last epoch's new episodes that changed the board.
-    pub changed: f32,
-    /// Last skill-model loss.
-    pub skill_model_loss: f32,
-    /// Last critic loss.
-    pub critic_loss: f32,
-    /// Last actor loss.
-    pub actor_loss: f32,
-    /// Environment steps per wall-clock second since the start of the run.
-    pub steps_per_s: f64,
-    /// Seconds per phase since the start of the run.
-    pub timings: Timings,
-}
+use crate::{RlError, TrainConfig, Trainer};
 
 /// What a call to [`Run::step`] did.
 #[derive(Debug, Clone)]
@@ -453,50 +351,4 @@ pub fn load_config(dir: &Path) -> Result<TrainConfig, RlError> {
     let text = fs::read_to_string(&path).map_err(|e| RlError::io(&path, e))?;
     TrainConfig::from_user_toml(&text, None, None)
         .map_err(|e| RlError::Config(format!("{}: {e}", path.display())))
-}
-
-impl Learner for Trainer {
-    type Stats = EpochStats;
-    type Metrics = Metrics;
-
-    fn build(config: TrainConfig) -> Result<Self, RlError> {
-        Trainer::new(config)
-    }
-    fn config(&self) -> &TrainConfig {
-        Trainer::config(self)
-    }
-    fn epoch(&self) -> u64 {
-        Trainer::epoch(self)
-    }
-    fn finished(&self) -> bool {
-        Trainer::finished(self)
-    }
-    fn run_epoch_observed(&mut self, hook: &mut dyn FnMut(Moment)) -> Result<EpochStats, RlError> {
-        Trainer::run_epoch_observed(self, hook)
-    }
-    fn metrics(&mut self, stats: &EpochStats, wall_s: f64) -> Result<Metrics, RlError> {
-        let skill_coverage = self.skill_coverage()?;
-        Ok(Metrics {
-            epoch: self.epoch(),
-            env_steps: self.env_steps(),
-            skill_coverage,
-            wall_s,
-            mean_reward: stats.mean_reward,
-            changed: stats.changed,
-            skill_model_loss: stats.skill_model_loss,
-            critic_loss: stats.sac.critic,
-            actor_loss: stats.sac.actor,
-            steps_per_s: self.env_steps() as f64 / wall_s.max(1e-9),
-            timings: self.timings(),
-        })
-    }
-    fn save(&self, dir: &Path) -> Result<(), RlError> {
-        Trainer::save(self, dir)
-    }
-    fn load(&mut self, dir: &Path) -> Result<(), RlError> {
-        Trainer::load(self, dir)
-    }
-    fn resume_only_files() -> Vec<&'static str> {
-        crate::checkpoint::resume_only_files()
-    }
 }

@@ -5,7 +5,7 @@
 //! - every file is written to a temporary name, fsynced, renamed into place and its folder
 //!   fsynced ([`write_atomic`]); a checkpoint is a folder written the same way ([`commit_dir`]);
 //! - `metrics.jsonl` only grows by whole lines, each fsynced before the checkpoint that follows
-//!   it; a line cut by a crash has no newline and is dropped when read ([`read_metrics`]);
+//!   it; a line cut by a crash has no newline and is dropped when read ([`read_metrics_as`]);
 //! - the two newest checkpoints keep what resuming needs, so one that cannot be read has a
 //!   complete predecessor to fall back to.
 //!
@@ -28,7 +28,7 @@ use serde::de::DeserializeOwned;
 
 use seads_planner::CheckpointId;
 
-use crate::{Metrics, RlError};
+use crate::RlError;
 
 /// A line of `metrics.jsonl`: what resuming needs to know of it.
 pub trait MetricsLine: Serialize + DeserializeOwned {
@@ -346,13 +346,9 @@ pub fn latest_checkpoint(dir: &Path) -> Result<Option<PathBuf>, RlError> {
     Ok(checkpoints(dir)?.pop().map(|(_, path)| path))
 }
 
-/// The lines of `dir/metrics.jsonl`. A last line without its newline is the trace of a crash
-/// during the append and is left out; any other line that does not parse is an error.
-pub fn read_metrics(dir: &Path) -> Result<Vec<Metrics>, RlError> {
-    read_metrics_as(dir)
-}
-
-/// [`read_metrics`] for any kind of line (a baseline's [`TaskMetrics`](crate::TaskMetrics)).
+/// The lines of `dir/metrics.jsonl`, of any kind (SEADS's [`Metrics`](crate::Metrics), a
+/// baseline's [`TaskMetrics`](crate::TaskMetrics)). A last line without its newline is the trace
+/// of a crash during the append and is left out; any other line that does not parse is an error.
 pub fn read_metrics_as<M: MetricsLine>(dir: &Path) -> Result<Vec<M>, RlError> {
     Ok(read_metrics_text(dir)?.0)
 }

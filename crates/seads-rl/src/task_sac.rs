@@ -31,8 +31,8 @@ use seads_planner::{DepthResult, TaskSet};
 use serde::{Deserialize, Serialize};
 use tch::Device;
 
+use crate::learner::Learner;
 use crate::replay::Replay;
-use crate::run::Learner;
 use crate::store::MetricsLine;
 use crate::{Moment, Purpose, RlError, Sac, SacLosses, TrainConfig};
 use crate::{derived_seed, stream, task_success};

@@ -516,6 +516,42 @@ impl Trainable {
     }
 }
 
+impl seads_games::Successor for ForwardModel {
+    fn num_skills(&self) -> usize {
+        self.k
+    }
+
+    fn symbolic_len(&self) -> usize {
+        self.d
+    }
+
+    /// The mode of q(· | z, k) for every state and skill (SPEC §4.1): bit d is 1 afterwards iff
+    /// α_d > 0.5, i.e. a 0 flips iff its flip logit is > 0 and a 1 flips iff it is ≥ 0.
+    fn successors(&mut self, states: &[SymbolicState], out: &mut Vec<SymbolicState>) {
+        if states.is_empty() {
+            return;
+        }
+        let flips = tch::no_grad(|| {
+            let z0 = states_tensor(states.iter().copied(), self.d, self.device);
+            self.screened_flips(&z0)
+                .unwrap_or_else(|| self.exact_flips(&z0))
+        });
+        out.reserve(states.len() * self.k);
+        for (i, &z) in states.iter().enumerate() {
+            for k in 0..self.k {
+                let row = &flips[(i * self.k + k) * self.d..(i * self.k + k + 1) * self.d];
+                let mut next = z;
+                for (d, &f) in row.iter().enumerate() {
+                    if f != 0 {
+                        next.flip(d);
+                    }
+                }
+                out.push(next);
+            }
+        }
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -580,145 +616,5 @@ mod tests {
         );
         assert!(ll[1].abs() < 1e-6);
         assert!((ll[2] - 0.5f32.ln()).abs() < 1e-6);
-    }
-}
-
-impl seads_games::Successor for ForwardModel {
-    fn num_skills(&self) -> usize {
-        self.k
-    }
-
-    fn symbolic_len(&self) -> usize {
-        self.d
-    }
-
-    /// The mode of q(· | z, k) for every state and skill (SPEC §4.1): bit d is 1 afterwards iff
-    /// α_d > 0.5, i.e. a 0 flips iff its flip logit is > 0 and a 1 flips iff it is ≥ 0.
-    fn successors(&mut self, states: &[SymbolicState], out: &mut Vec<SymbolicState>) {
-        if states.is_empty() {
-            return;
-        }
-        let flips = tch::no_grad(|| {
-            let z0 = states_tensor(states.iter().copied(), self.d, self.device);
-            self.screened_flips(&z0)
-                .unwrap_or_else(|| self.exact_flips(&z0))
-        });
-        out.reserve(states.len() * self.k);
-        for (i, &z) in states.iter().enumerate() {
-            for k in 0..self.k {
-                let row = &flips[(i * self.k + k) * self.d..(i * self.k + k + 1) * self.d];
-                let mut next = z;
-                for (d, &f) in row.iter().enumerate() {
-                    if f != 0 {
-                        next.flip(d);
-                    }
-                }
-                out.push(next);
-            }
-        }
-    }
-}
-
-#[cfg(test)]
-mod successor_tests {
-    use super::*;
-    use seads_games::Successor;
-
-    /// Successors of `states` with the 8-bit screen and in float32 alone.
-    fn both_ways(
-        model: &mut ForwardModel,
-        states: &[SymbolicState],
-    ) -> (Vec<SymbolicState>, Vec<SymbolicState>) {
-        let (mut screened, mut exact) = (Vec::new(), Vec::new());
-        model.set_int8_screen(true);
-        model.successors(states, &mut screened);
-        model.set_int8_screen(false);
-        model.successors(states, &mut exact);
-        model.set_int8_screen(true);
-        (screened, exact)
-    }
-
-    fn random_states(n: usize, seed: u64) -> Vec<SymbolicState> {
-        use rand::RngExt;
-        let mut rng = ChaCha8Rng::seed_from_u64(seed);
-        (0..n)
-            .map(|_| SymbolicState::from_u64(rng.random_range(0..1u64 << 25)))
-            .collect()
-    }
-
-    /// An untrained model has many logits near 0: the screen must send those states to float32.
-    #[test]
-    fn the_int8_screen_gives_the_float_successors_of_an_untrained_model() {
-        let mut model = ForwardModel::new(25, 25, &SkillModelConfig::default(), Device::Cpu, 11);
-        let states = random_states(300, 1);
-        let (screened, exact) = both_ways(&mut model, &states);
-        assert_eq!(screened, exact);
-        let (seen, redone) = model.screen_counts();
-        assert_eq!(seen, 300 * 25);
-        assert!(redone > 0, "an untrained model has logits within the bound");
-        // A small batch goes straight to float32.
-        let _ = both_ways(&mut model, &states[..100]);
-        assert_eq!(model.screen_counts(), (seen, redone));
-    }
-
-    /// A model fitted to the LightsOut moves: the screen decides most states itself, and every
-    /// successor equals float32's, also after further training (the screen follows the weights).
-    #[test]
-    fn the_int8_screen_gives_the_float_successors_of_a_fitted_model() {
-        let game = seads_games::LightsOut::new(5).unwrap();
-        let config = SkillModelConfig {
-            hidden: vec![128, 128],
-            batch_size: 256,
-            ..SkillModelConfig::default()
-        };
-        let mut model = crate::fit_to_game(&game, &config, 400, 3);
-        let states = random_states(2000, 2);
-        let (screened, exact) = both_ways(&mut model, &states);
-        assert_eq!(screened, exact);
-        let (seen, redone) = model.screen_counts();
-        assert_eq!(seen, 2000 * 25);
-        assert!(
-            redone < seen / 20,
-            "{redone} of {seen} states computed again"
-        );
-        let batch: Vec<SkillTransition> = states
-            .iter()
-            .take(256)
-            .map(|&z0| SkillTransition {
-                z0,
-                skill: 3,
-                zt: z0,
-            })
-            .collect();
-        for _ in 0..20 {
-            model.train_step(&batch);
-        }
-        let (screened, exact) = both_ways(&mut model, &states);
-        assert_eq!(screened, exact);
-    }
-
-    /// The batched successor agrees with the per-pair mode computed from `flip_logits`.
-    #[test]
-    fn successors_are_the_mode_of_the_model() {
-        let mut model = ForwardModel::new(25, 25, &SkillModelConfig::default(), Device::Cpu, 4);
-        let states: Vec<SymbolicState> = (0..7u64)
-            .map(|i| SymbolicState::from_u64(i * 0x15_4321 % (1 << 25)))
-            .collect();
-        let mut out = Vec::new();
-        model.successors(&states, &mut out);
-        assert_eq!(out.len(), 7 * 25);
-        for (i, &z) in states.iter().enumerate() {
-            for k in 0..25 {
-                let logits =
-                    Vec::<f32>::try_from(model.flip_logits(&[z], &[k]).view([-1])).unwrap();
-                let mut expected = z;
-                for (d, &x) in logits.iter().enumerate() {
-                    let p = 1.0 / (1.0 + (-x).exp());
-                    let alpha = if z.get(d) { 1.0 - p } else { p };
-                    expected.set(d, alpha > 0.5);
-                }
-                assert_eq!(out[i * 25 + k], expected, "state {i}, skill {k}");
-            }
-        }
     }
 }

@@ -43,7 +43,7 @@ pub enum StudyError {
     TomlWrite(#[from] toml::ser::Error),
     /// Another task holds the run: the caller may wait or leave it to that task.
     #[error(transparent)]
-    Taken(#[from] crate::sweep::Taken),
+    Taken(#[from] Taken),
     /// A run directory could not be read or written.
     #[error(transparent)]
     Run(#[from] seads_rl::RlError),
@@ -120,3 +120,19 @@ macro_rules! failure {
 }
 
 pub(crate) use {fail, failure};
+
+/// The error of a claim on a run that another task holds.
+#[derive(Debug)]
+pub struct Taken(pub std::path::PathBuf);
+
+impl std::fmt::Display for Taken {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(
+            f,
+            "{} is already being trained by another task",
+            self.0.display()
+        )
+    }
+}
+
+impl std::error::Error for Taken {}

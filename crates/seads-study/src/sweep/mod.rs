@@ -9,9 +9,10 @@ pub mod manifest;
 pub mod slurm;
 pub mod state;
 
+pub use crate::error::Taken;
 pub use index::{INDEX, MANIFEST, Planned, Sweep, SweepRun};
 pub use manifest::{EvaluationPlan, Manifest, PlannedRun};
 pub use state::{
-    Claim, LOG, Missing, Outcome, PATIENCE, RECORD, Record, Status, TAKEN_EXIT, Taken,
-    check_outputs, damage, is_claimed, status,
+    Claim, LOG, Missing, Outcome, PATIENCE, RECORD, Record, Status, TAKEN_EXIT, check_outputs,
+    damage, is_claimed, status,
 };

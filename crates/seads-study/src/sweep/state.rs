@@ -4,9 +4,10 @@
 //!   other writer works on the run: a killed one releases it, so "running" can never be stale;
 //! - `task.json` records the last task's outcome: running, done or failed (with the error).
 
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use std::time::Duration;
 
+use crate::error::Taken;
 use crate::{Context as _, Result};
 use serde::{Deserialize, Serialize};
 
@@ -173,22 +174,6 @@ pub const PATIENCE: Duration = Duration::from_secs(60);
 /// The exit status of a `seads sweep task` that found its run held by another task, so that
 /// `seads sweep run` can tell "taken elsewhere" from "failed".
 pub const TAKEN_EXIT: u8 = 3;
-
-/// The error of a claim on a run that another task holds.
-#[derive(Debug)]
-pub struct Taken(pub PathBuf);
-
-impl std::fmt::Display for Taken {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        write!(
-            f,
-            "{} is already being trained by another task",
-            self.0.display()
-        )
-    }
-}
-
-impl std::error::Error for Taken {}
 
 impl Claim {
     /// Claims `run`, waiting up to `patience` for another task to release it; [`Taken`] if it
