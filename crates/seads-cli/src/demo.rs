@@ -10,7 +10,7 @@ use seads_rl::{Run, TrainConfig, Trainer};
 
 use crate::BadInput;
 use crate::plan::run_evaluation;
-use seads_planner::{EvaluationKind, Protocol, SearchLimits, TaskSet};
+use seads_planner::Protocol;
 
 /// Arguments of `seads run`.
 #[derive(Debug, Args)]
@@ -73,15 +73,7 @@ pub fn run(args: RunArgs) -> Result<()> {
         args.boards
     );
     outln!(" depth   with re-planning   plan once   median steps (re-planning)");
-    let protocol = |replan| Protocol {
-        kind: EvaluationKind::planning(replan),
-        tasks: TaskSet::standard(args.boards),
-        limits: Some(SearchLimits {
-            timeout_s: args.timeout,
-            max_expanded: None,
-        }),
-        action_noise: None,
-    };
+    let protocol = |replan| Protocol::planning(replan, args.boards, args.timeout);
     let replan = run_evaluation(&mut agent, &args.out, &protocol(true), false)?.results;
     let once = run_evaluation(&mut agent, &args.out, &protocol(false), false)?.results;
     let (a, b) = (summarise(&replan), summarise(&once));

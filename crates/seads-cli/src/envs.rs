@@ -1,12 +1,10 @@
 //! `seads envs`, `seads render`, `seads env-bench`: the embodied environments.
 
 use std::path::PathBuf;
-use std::time::Instant;
 
 use anyhow::{Context, Result};
 use clap::Args;
-use seads_embodiment::{EnvConfig, Environment, list_envs, make_env, random_rollout};
-use serde::Serialize;
+use seads_embodiment::{EnvConfig, Environment, Throughput, list_envs, make_env};
 
 use crate::BadInput;
 
@@ -101,15 +99,6 @@ pub struct BenchArgs {
     json: bool,
 }
 
-#[derive(Serialize)]
-struct BenchReport {
-    env: String,
-    steps: usize,
-    threads: usize,
-    seconds: f64,
-    steps_per_sec: f64,
-}
-
 /// `seads env-bench`: environment steps per second with random actions.
 pub fn env_bench(args: BenchArgs) -> Result<()> {
     if args.threads == 0 || args.steps == 0 {
@@ -119,48 +108,18 @@ pub fn env_bench(args: BenchArgs) -> Result<()> {
         physics_substeps: args.physics_substeps,
         ..EnvConfig::default()
     };
-    let template = build_env(&args.env, &config)?;
-    let per_thread = args.steps.div_ceil(args.threads);
-    let envs: Vec<Box<dyn Environment>> = (0..args.threads)
-        .map(|i| {
-            let mut env = template.clone();
-            env.seed(i as u64 + 1);
-            env.reset()?;
-            Ok(env)
-        })
-        .collect::<Result<_>>()?;
-    let start = Instant::now();
-    std::thread::scope(|scope| {
-        let handles: Vec<_> = envs
-            .into_iter()
-            .enumerate()
-            .map(|(i, mut env)| {
-                scope.spawn(move || random_rollout(env.as_mut(), per_thread, i as u64))
-            })
-            .collect();
-        handles
-            .into_iter()
-            .try_for_each(|h| h.join().expect("bench thread").map(|_| ()))
-    })
-    .context("stepping the environment")?;
-    let seconds = start.elapsed().as_secs_f64();
-    let steps = per_thread * args.threads;
-    let report = BenchReport {
-        env: args.env,
-        steps,
-        threads: args.threads,
-        seconds,
-        steps_per_sec: steps as f64 / seconds,
-    };
+    let env = build_env(&args.env, &config)?;
+    let report = Throughput::measure(env.as_ref(), args.steps, args.threads)
+        .context("stepping the environment")?;
     if args.json {
         outln!("{}", serde_json::to_string(&report)?);
     } else {
         outln!(
             "{}: {} steps on {} thread(s) in {:.3} s = {:.0} steps/s",
             report.env,
-            steps,
+            report.steps,
             report.threads,
-            seconds,
+            report.seconds,
             report.steps_per_sec
         );
     }

@@ -13,7 +13,7 @@ use seads_rl::{Agent, find_checkpoint, read_metrics};
 
 use crate::envs::build_env;
 use crate::plan::{load_agent, run_evaluation};
-use seads_planner::{EvaluationKind, Protocol, STANDARD_DEPTHS, SearchLimits, TaskSet};
+use seads_planner::{EvaluationKind, Protocol, STANDARD_DEPTHS};
 use seads_study::evaluation::read_evaluation;
 use seads_study::figures::{coverage_figure, skill_figures, success_figure};
 
@@ -80,7 +80,7 @@ pub fn write_figures(
         // train` measured (with re-planning only).
         let spec = twin.spec().clone();
         let agent = Agent::load_for(config, spec, &find_checkpoint(run, checkpoint)?)?;
-        let k = agent.policy_skills();
+        let k = seads_embodiment::SkillPolicy::num_skills(&agent.policy);
         both("coverage", &|p| coverage_figure(p, &metrics, k, &title))?;
         let file = EvaluationKind::Replan.results_file(&STANDARD_DEPTHS, None);
         match read_evaluation(&run.join(&file)).map_err(crate::study_error)? {
@@ -106,7 +106,7 @@ pub fn write_figures(
         return Ok(written);
     }
     let mut agent = load_agent(run, checkpoint)?;
-    let k = agent.policy_skills();
+    let k = seads_embodiment::SkillPolicy::num_skills(&agent.policy);
     both("coverage", &|p| coverage_figure(p, &metrics, k, &title))?;
     if agent.model.is_some() {
         let evaluations = evaluations(&mut agent, run, boards, timeout, quiet)?;
@@ -126,16 +126,6 @@ pub fn write_figures(
     )?;
     skill_figures(env.as_mut(), &agent.policy, &title, both)?;
     Ok(written)
-}
-
-trait PolicySkills {
-    fn policy_skills(&self) -> usize;
-}
-
-impl PolicySkills for Agent {
-    fn policy_skills(&self) -> usize {
-        seads_embodiment::SkillPolicy::num_skills(&self.policy)
-    }
 }
 
 /// The run's evaluations of the agent's checkpoint with and without re-planning: the saved ones
@@ -158,15 +148,7 @@ fn evaluations(
         {
             return Ok(record.results);
         }
-        let protocol = Protocol {
-            kind,
-            tasks: TaskSet::standard(boards),
-            limits: Some(SearchLimits {
-                timeout_s: timeout,
-                max_expanded: None,
-            }),
-            action_noise: None,
-        };
+        let protocol = Protocol::planning(replan, boards, timeout);
         Ok(run_evaluation(agent, run, &protocol, quiet)?.results)
     };
     Ok([(true, load(true)?), (false, load(false)?)])

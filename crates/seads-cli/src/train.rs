@@ -7,8 +7,7 @@ use anyhow::{Context, Result};
 use clap::Args;
 use indicatif::{ProgressBar, ProgressStyle};
 use seads_rl::{
-    Algorithm, Hac, Hook, Learner, Moment, Run, TaskEpochStats, TaskMetrics, TaskSac, TrainConfig,
-    Trainer,
+    Algorithm, Hac, Hook, InWords, Learner, Moment, Run, TaskSac, TrainConfig, Trainer,
 };
 
 use crate::BadInput;
@@ -183,129 +182,8 @@ fn crash_hook() -> Result<Option<Hook>> {
     })))
 }
 
-/// How `seads train` shows a learner's progress.
-pub trait Shown: Learner {
-    /// Environment steps so far.
-    fn steps(&self) -> u64;
-    /// (epoch, environment steps) after an epoch.
-    fn stats_steps(stats: &Self::Stats) -> (u64, u64);
-    /// (epoch, environment steps, steps per second) of an evaluation.
-    fn metrics_steps(m: &Self::Metrics) -> (u64, u64, f64);
-    /// What an evaluation found, in a few words ("coverage 24.10/25").
-    fn headline(&self, m: &Self::Metrics) -> String;
-    /// The time per phase, one line.
-    fn phases(&self) -> String;
-}
-
-impl Shown for Trainer {
-    fn steps(&self) -> u64 {
-        self.env_steps()
-    }
-    fn stats_steps(stats: &Self::Stats) -> (u64, u64) {
-        (stats.epoch, stats.env_steps)
-    }
-    fn metrics_steps(m: &Self::Metrics) -> (u64, u64, f64) {
-        (m.epoch, m.env_steps, m.steps_per_s)
-    }
-    fn headline(&self, m: &Self::Metrics) -> String {
-        format!(
-            "coverage {:>5.2}/{}  reward {:>6.2}",
-            m.skill_coverage,
-            self.num_skills(),
-            m.mean_reward
-        )
-    }
-    fn phases(&self) -> String {
-        let t = self.timings();
-        format!(
-            "collect {:.1} s, relabel {:.1} s, skill model {:.1} s, SAC {:.1} s, evaluation {:.1} s",
-            t.collect, t.relabel, t.skill_model, t.sac, t.evaluate
-        )
-    }
-}
-
-/// A task-reward baseline as `seads train` shows it: all report [`TaskEpochStats`] and
-/// [`TaskMetrics`], and differ only in what they add to the headline and in their phases.
-pub trait ShownBaseline: Learner<Stats = TaskEpochStats, Metrics = TaskMetrics> {
-    /// Environment steps so far.
-    fn env_steps(&self) -> u64;
-    /// What the baseline adds to an evaluation's headline ("" for none).
-    fn extra(&self, m: &TaskMetrics) -> String;
-    /// The time per phase, one line.
-    fn phases(&self) -> String;
-}
-
-impl<B: ShownBaseline> Shown for B {
-    fn steps(&self) -> u64 {
-        self.env_steps()
-    }
-    fn stats_steps(stats: &Self::Stats) -> (u64, u64) {
-        (stats.epoch, stats.env_steps)
-    }
-    fn metrics_steps(m: &Self::Metrics) -> (u64, u64, f64) {
-        (m.epoch, m.env_steps, m.steps_per_s)
-    }
-    fn headline(&self, m: &Self::Metrics) -> String {
-        format!("{}{}", task_headline(m), self.extra(m))
-    }
-    fn phases(&self) -> String {
-        ShownBaseline::phases(self)
-    }
-}
-
-impl ShownBaseline for TaskSac {
-    fn env_steps(&self) -> u64 {
-        TaskSac::env_steps(self)
-    }
-    fn extra(&self, _: &TaskMetrics) -> String {
-        String::new()
-    }
-    fn phases(&self) -> String {
-        let t = self.timings();
-        format!(
-            "collect {:.1} s, SAC {:.1} s, evaluation {:.1} s",
-            t.collect, t.sac, t.evaluate
-        )
-    }
-}
-
-impl ShownBaseline for Hac {
-    fn env_steps(&self) -> u64 {
-        Hac::env_steps(self)
-    }
-    fn extra(&self, m: &TaskMetrics) -> String {
-        let recent = m.subgoals_reached.unwrap_or_default();
-        format!(
-            "  subgoals reached {:.1} % (since the last line)",
-            100.0 * recent
-        )
-    }
-    fn phases(&self) -> String {
-        let t = self.timings();
-        format!(
-            "collect {:.1} s, SAC updates of both levels {:.1} s, evaluation {:.1} s",
-            t.collect, t.sac, t.evaluate
-        )
-    }
-}
-
-/// A baseline's evaluation in a few words.
-fn task_headline(m: &TaskMetrics) -> String {
-    let per_depth: Vec<String> = m
-        .success
-        .iter()
-        .map(|s| format!("{:.0}", 100.0 * s))
-        .collect();
-    format!(
-        "task success {:>5.1} % (depths 1-5: {} %)  training episodes solved {:.1} %",
-        100.0 * m.mean_success,
-        per_depth.join("/"),
-        100.0 * m.train_solved
-    )
-}
-
 /// Trains `run` to its budget, showing progress, and prints a summary.
-pub fn drive<L: Shown>(run: &mut Run<L>, quiet: bool) -> Result<()> {
+pub fn drive<L: InWords>(run: &mut Run<L>, quiet: bool) -> Result<()> {
     if let Some(hook) = crash_hook()? {
         run.set_hook(hook);
     }

@@ -1,6 +1,5 @@
 //! `seads uarm …`: the real robot (uArm Swift Pro + LightsOut tablet) or its simulated twin.
 
-use std::collections::BTreeMap;
 use std::io::BufRead;
 use std::path::{Path, PathBuf};
 
@@ -8,18 +7,11 @@ use anyhow::{Context, Result, bail};
 use clap::{Args, Subcommand};
 use indicatif::ProgressBar;
 use seads_embodiment::Environment;
-use seads_games::{BoardGame, GameKind, Gf2Solver, LightsOut};
-use seads_planner::{
-    DepthResult, EvaluationKind, EvaluationRecord, PlannerConfig, Protocol, SearchLimits,
-    SolveConfig, TaskSet, solve,
-};
-use seads_rl::{Agent, Run, TrainConfig, Trainer, find_checkpoint, load_config};
+use seads_rl::{Run, TrainConfig, Trainer, find_checkpoint, load_config};
 use seads_uarm::{
-    ActionSpace, AdbTablet, Calibration, CalibrationFile, DriverConfig, SerialTransport, Swift,
-    Tablet, Twin, UarmConfig, UarmEnv, twin_screen_corners,
+    ActionSpace, AdbTablet, Calibration, CalibrationFile, DriverConfig, RobotSettings,
+    SerialTransport, Swift, Tablet, Twin, UarmConfig, UarmEnv, UarmError, twin_screen_corners,
 };
-
-use serde::{Deserialize, Serialize};
 
 use crate::BadInput;
 
@@ -155,7 +147,7 @@ pub struct UarmTrainArgs {
     #[arg(long)]
     calibration: Option<PathBuf>,
     /// Action space: absolute (press at (x, y)) or displacement (the Cursor in hardware).
-    #[arg(long, default_value = "absolute", value_parser = parse_space)]
+    #[arg(long, default_value = "absolute")]
     action_space: ActionSpace,
     /// Interactions (environment steps) to train for (the paper: 5000 with absolute pushes).
     #[arg(long, default_value_t = 5000)]
@@ -188,16 +180,6 @@ pub struct UarmTrainArgs {
     reset_board: bool,
 }
 
-fn parse_space(text: &str) -> Result<ActionSpace, String> {
-    match text {
-        "absolute" => Ok(ActionSpace::Absolute),
-        "displacement" => Ok(ActionSpace::Displacement),
-        other => Err(format!(
-            "unknown action space {other:?} (valid: absolute, displacement)"
-        )),
-    }
-}
-
 fn build_env(
     connection: &Connection,
     calibration: Option<&Path>,
@@ -219,7 +201,7 @@ fn build_env(
     };
     let config = UarmConfig {
         action_space,
-        step_limit: step_limit(action_space),
+        step_limit: action_space.step_limit(),
         reset_board,
         tap_timeout_s: if twin.is_some() { 0.0 } else { 2.0 },
     };
@@ -236,14 +218,6 @@ fn calibrate_twin(connection: &Connection, twin: &Twin) -> Result<Calibration> {
         corners: record_corners(&mut arm, Some(twin), true)?,
         d_max_mm: 100.0,
     })?)
-}
-
-/// Steps per skill: one press, or as many displacements as the Cursor's skills take.
-fn step_limit(space: ActionSpace) -> usize {
-    match space {
-        ActionSpace::Absolute => 1,
-        ActionSpace::Displacement => 10,
-    }
 }
 
 /// The twin acting as the robot run `config` did, to show its skills: every reset draws a new
@@ -301,7 +275,7 @@ pub fn train(mut args: UarmTrainArgs) -> Result<()> {
     }
     let trainer = |mut config: TrainConfig| {
         if let Some(cores) = cores {
-            (config.threads, config.sac_threads_alone) = crate::sweep::task::thread_split(cores);
+            config.use_cores(cores);
         }
         Trainer::with_environments(config, env.box_clone(), env.box_clone())
     };
@@ -313,14 +287,11 @@ pub fn train(mut args: UarmTrainArgs) -> Result<()> {
         let run = Run::with_trainer(&args.out, trainer(robot_config(&env, &args)?)?)
             .map_err(|e| BadInput(e.into()))?;
         let lock = crate::lock_run(&args.out)?;
-        let settings = RobotSettings {
+        RobotSettings {
             action_space: args.action_space,
             reset_board: args.reset_board,
-        };
-        seads_rl::write_atomic(
-            &args.out.join(ROBOT_SETTINGS),
-            toml::to_string(&settings)?.as_bytes(),
-        )?;
+        }
+        .write(&args.out)?;
         (run, lock)
     };
     crate::train::drive(&mut run, args.quiet)?;
@@ -336,34 +307,13 @@ pub fn train(mut args: UarmTrainArgs) -> Result<()> {
     )
 }
 
-/// What a robot run's `config.toml` does not hold: how the arm acts and whether the twin resets
-/// the board. A resumed run keeps them.
-#[derive(Debug, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
-struct RobotSettings {
-    action_space: ActionSpace,
-    reset_board: bool,
-}
-
-const ROBOT_SETTINGS: &str = "robot.toml";
-
-/// The settings `robot.toml` of the run in `run` records; `None` for a run from before it.
-fn run_settings(run: &Path) -> Result<Option<RobotSettings>> {
-    let path = run.join(ROBOT_SETTINGS);
-    let text = match std::fs::read_to_string(&path) {
-        Ok(text) => text,
-        Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok(None),
-        Err(e) => return Err(e).with_context(|| format!("reading {}", path.display())),
-    };
-    toml::from_str(&text)
-        .map(Some)
-        .map_err(|e| BadInput(anyhow::anyhow!("{}: {}", path.display(), e.message())).into())
-}
-
 /// A resumed run acts as it was trained, whatever `--action-space` and `--reset-board` say. A run
 /// from before `robot.toml` keeps the flags given.
 fn adopt_run_settings(args: &mut UarmTrainArgs) -> Result<()> {
-    if let Some(settings) = run_settings(&args.out)? {
+    if let Some(settings) = RobotSettings::read(&args.out).map_err(|e| match e {
+        UarmError::Config(_) => BadInput(e.into()).into(),
+        other => anyhow::Error::from(other),
+    })? {
         args.action_space = settings.action_space;
         args.reset_board = settings.reset_board;
     }
@@ -437,66 +387,29 @@ pub fn evaluate_run(args: UarmEvaluateArgs) -> Result<()> {
 fn evaluate(
     run: &Path,
     epoch: Option<u64>,
-    mut env: UarmEnv,
+    env: UarmEnv,
     settable: bool,
     boards: usize,
     timeout: f64,
     quiet: bool,
 ) -> Result<()> {
     let checkpoint = find_checkpoint(run, epoch).map_err(|e| BadInput(e.into()))?;
-    let config = load_config(run)?;
-    let mut agent = Agent::load_for(config, env.spec().clone(), &checkpoint)?;
-    let (policy, model) = agent.parts()?;
-    let game = LightsOut::new(5)?;
-    let solver = Gf2Solver::new(&game);
-    let protocol = Protocol {
-        kind: EvaluationKind::Replan,
-        tasks: TaskSet::standard(boards),
-        limits: Some(SearchLimits {
-            timeout_s: timeout,
-            max_expanded: None,
-        }),
-        action_noise: None,
-    };
-    let solve_config = SolveConfig {
-        replan: true,
-        planner: PlannerConfig {
-            timeout_s: Some(timeout),
-            ..PlannerConfig::default()
-        },
-        ..SolveConfig::default()
-    };
     let bar = if quiet {
         ProgressBar::hidden()
     } else {
-        ProgressBar::new(protocol.tasks.len() as u64)
+        ProgressBar::new(5 * boards as u64)
     };
-    // Keyed by the board's solution depth: the twin's are the tasks' by construction, the
-    // tablet's are whatever the app shows.
-    let mut results: BTreeMap<usize, DepthResult> = BTreeMap::new();
-    let seeds = protocol.tasks.seeds();
-    for &depth in &protocol.tasks.depths {
-        for &seed in &seeds {
-            if settable {
-                env.set_board(protocol.tasks.board(GameKind::LightsOut, 5, depth, seed)?)?;
-            }
-            let d = solver.depth(env.board()).unwrap_or(0);
-            let outcome = solve(&mut env, policy, model, game.goal(), &solve_config)?;
-            results
-                .entry(d)
-                .or_insert_with(|| DepthResult::new(d))
-                .record(&outcome);
-            bar.inc(1);
-        }
-    }
+    let record = seads_study::robot::evaluate_robot(
+        run,
+        &checkpoint,
+        env,
+        settable,
+        boards,
+        timeout,
+        || bar.inc(1),
+    )
+    .map_err(crate::study_error)?;
     bar.finish_and_clear();
-    let (id, named) = seads_study::evaluation::checkpoint_of(run, &checkpoint)?;
-    let record = EvaluationRecord {
-        checkpoint: Some(id),
-        protocol: Some(protocol),
-        results: results.into_values().collect(),
-    };
-    seads_study::evaluation::save_evaluation(run, &record, named, None)?;
     let results = record.results;
     let (solved, tasks) = results
         .iter()

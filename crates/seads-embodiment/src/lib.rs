@@ -77,7 +77,7 @@ pub use record::{
     Comparison, EpisodeRecord, ReplayError, StepRecord, compare, record_episode, replay_episode,
 };
 pub use registry::{EnvInfo, env_names, list_envs, make_env};
-pub use runner::random_rollout;
+pub use runner::{Throughput, random_rollout};
 pub use scene::{FieldView, Scene, Shape};
 pub use spec::{EnvSpec, Push, StepOutcome};
 pub use task::{TaskEnv, TaskStep};

@@ -151,6 +151,27 @@ pub struct EvaluationSummary {
     pub skill_steps: BTreeMap<usize, Option<f64>>,
 }
 
+impl EvaluationSummary {
+    /// One line per depth under a header: success, plan found, search seconds and the median
+    /// steps, as `seads evaluate` prints them.
+    pub fn table(&self) -> String {
+        let fmt = |v: Option<f64>| v.map_or("-".to_owned(), |x| format!("{x:.1}"));
+        let mut out =
+            String::from(" depth  success  plan found  search s  median steps  median skill steps");
+        for (depth, success) in &self.success_rate {
+            out += &format!(
+                "\n{depth:>6}  {:>6.0}%  {:>9.0}%  {:>8.3}  {:>12}  {:>18}",
+                success * 100.0,
+                self.plan_found[depth] * 100.0,
+                self.planning_s[depth],
+                fmt(self.solution_steps[depth]),
+                fmt(self.skill_steps[depth])
+            );
+        }
+        out
+    }
+}
+
 fn median<T: Copy + Into<f64>>(values: &[T]) -> Option<f64> {
     let mut v: Vec<f64> = values.iter().map(|&x| x.into()).collect();
     if v.is_empty() {

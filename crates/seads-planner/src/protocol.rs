@@ -194,7 +194,7 @@ impl EvaluationKind {
         stem
     }
 
-    /// The per-depth results ([`EvaluationRecord`], JSON).
+    /// The per-depth results ([`EvaluationRecord`](crate::EvaluationRecord), JSON).
     pub fn results_file(self, depths: &[usize], epoch: Option<u64>) -> String {
         format!("{}.json", self.stem(depths, epoch))
     }
@@ -223,6 +223,20 @@ pub struct Protocol {
 }
 
 impl Protocol {
+    /// A planning evaluation, with or without re-planning, on the standard tasks of depths 1–5
+    /// with `boards` boards per depth, `timeout_s` per search and no action noise.
+    pub fn planning(replan: bool, boards: usize, timeout_s: f64) -> Self {
+        Self {
+            kind: EvaluationKind::planning(replan),
+            tasks: TaskSet::standard(boards),
+            limits: Some(SearchLimits {
+                timeout_s,
+                max_expanded: None,
+            }),
+            action_noise: None,
+        }
+    }
+
     /// The stem of this evaluation's files: the kind's ([`EvaluationKind::stem`]), with
     /// `-noise-0.05` for an evaluation under action noise, so that it never takes the name of
     /// the one without.
@@ -237,7 +251,7 @@ impl Protocol {
         stem
     }
 
-    /// The per-depth results ([`EvaluationRecord`], JSON).
+    /// The per-depth results ([`EvaluationRecord`](crate::EvaluationRecord), JSON).
     pub fn results_file(&self, epoch: Option<u64>) -> String {
         format!("{}.json", self.stem(epoch))
     }

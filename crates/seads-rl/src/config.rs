@@ -306,6 +306,23 @@ const SAC_PRESETS: &[(&str, &str)] = &[
 ];
 
 impl TrainConfig {
+    /// Sets the libtorch threads for a run with `cores` cores to itself: two training threads
+    /// of `cores / 2` each, and all cores for SAC while the other thread waits (a run alone on
+    /// one core keeps one thread throughout).
+    ///
+    /// ```
+    /// let mut config = seads_rl::TrainConfig::default();
+    /// config.use_cores(4);
+    /// assert_eq!((config.threads, config.sac_threads_alone), (2, 4));
+    /// config.use_cores(1);
+    /// assert_eq!((config.threads, config.sac_threads_alone), (1, 0));
+    /// ```
+    pub fn use_cores(&mut self, cores: usize) {
+        let cores = cores.max(1);
+        self.threads = (cores / 2).max(1);
+        self.sac_threads_alone = if cores >= 2 { cores } else { 0 };
+    }
+
     /// The preset of environment `env` (the paper's settings).
     pub fn preset(env: &str) -> Result<Self, RlError> {
         Self::preset_for(env, Algorithm::Seads)

@@ -40,6 +40,7 @@ mod checkpoint;
 mod config;
 mod episode;
 mod hac;
+mod in_words;
 mod learner;
 mod metrics;
 mod numerics;
@@ -63,6 +64,7 @@ pub use config::{
 };
 pub use episode::{Episode, policy_input, run_episodes, skill_coverage};
 pub use hac::{Hac, HacPolicy};
+pub use in_words::{BaselineInWords, InWords};
 pub use learner::{Hook, Learner, Moment};
 pub use metrics::{Metrics, read_metrics};
 pub use numerics::{FAST_KERNELS, PORTABLE_KERNELS, kernel_environment, portable_kernels_active};

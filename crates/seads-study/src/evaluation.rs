@@ -112,6 +112,39 @@ pub fn read_over_training(run: &Path) -> Result<Vec<CheckpointEvaluation>> {
     Ok(seads_rl::read_json_lines(&path)?.0)
 }
 
+/// The evaluations over training of the run in `run` made on `tasks` with `limits` (the file may
+/// hold evaluations with other depths, boards or limits).
+pub fn read_over_training_of(
+    run: &Path,
+    tasks: &TaskSet,
+    limits: SearchLimits,
+) -> Result<Vec<CheckpointEvaluation>> {
+    Ok(read_over_training(run)?
+        .into_iter()
+        .filter(|l| l.protocol() == over_training_protocol(tasks, limits, l.replan))
+        .collect())
+}
+
+/// One line per evaluation under a header: epoch, steps, mode and success per depth.
+pub fn over_training_table(lines: &[CheckpointEvaluation]) -> String {
+    let mut out = String::from("     epoch   env steps  mode            success per depth");
+    for l in lines {
+        let rates: Vec<String> = l
+            .results
+            .iter()
+            .map(|r| format!("{:.0}%", 100.0 * r.solved as f64 / r.tasks.max(1) as f64))
+            .collect();
+        out += &format!(
+            "\n{:>10}  {:>10}  {:<14}  {}",
+            l.epoch,
+            l.env_steps,
+            if l.replan { "re-planning" } else { "plan once" },
+            rates.join(" ")
+        );
+    }
+    out
+}
+
 /// The protocol of over-training evaluations of `tasks` with `limits`, with or without
 /// re-planning.
 pub fn over_training_protocol(tasks: &TaskSet, limits: SearchLimits, replan: bool) -> Protocol {

@@ -38,6 +38,7 @@
 //! # Ok::<(), Box<dyn std::error::Error>>(())
 //! ```
 
+pub mod bench;
 pub mod draw;
 mod error;
 pub mod evaluation;
@@ -45,6 +46,7 @@ pub mod figures;
 pub mod over_training;
 pub mod provenance;
 pub mod report;
+pub mod robot;
 pub mod sweep;
 
 pub use error::{BoxError, Context, Result, StudyError};

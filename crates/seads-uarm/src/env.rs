@@ -51,6 +51,76 @@ impl ActionSpace {
             .into_iter()
             .find(|space| space.env_name() == name)
     }
+
+    /// Steps per skill: one press, or as many displacements as the Cursor's skills take.
+    pub fn step_limit(self) -> usize {
+        match self {
+            Self::Absolute => 1,
+            Self::Displacement => 10,
+        }
+    }
+}
+
+impl std::str::FromStr for ActionSpace {
+    type Err = String;
+
+    /// `absolute` or `displacement`.
+    fn from_str(text: &str) -> Result<Self, String> {
+        match text {
+            "absolute" => Ok(Self::Absolute),
+            "displacement" => Ok(Self::Displacement),
+            other => Err(format!(
+                "unknown action space {other:?} (valid: absolute, displacement)"
+            )),
+        }
+    }
+}
+
+/// What a robot run's `config.toml` does not hold, kept beside it in [`RobotSettings::FILE`]: how
+/// the arm acts and whether the twin resets the board. A resumed run keeps them.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RobotSettings {
+    /// How actions move the pen.
+    pub action_space: ActionSpace,
+    /// Whether reset draws a new board (the twin only).
+    pub reset_board: bool,
+}
+
+impl RobotSettings {
+    /// The file in a run directory.
+    pub const FILE: &str = "robot.toml";
+
+    /// The settings the run in `run` records; `None` for a run from before the file.
+    pub fn read(run: &std::path::Path) -> Result<Option<Self>, UarmError> {
+        let path = run.join(Self::FILE);
+        let text = match std::fs::read_to_string(&path) {
+            Ok(text) => text,
+            Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok(None),
+            Err(e) => {
+                return Err(UarmError::Io {
+                    what: format!("reading {}", path.display()),
+                    source: Box::new(e),
+                });
+            }
+        };
+        toml::from_str(&text)
+            .map(Some)
+            .map_err(|e| UarmError::Config(format!("{}: {}", path.display(), e.message())))
+    }
+
+    /// Writes them into the run in `run`, atomically.
+    pub fn write(&self, run: &std::path::Path) -> Result<(), UarmError> {
+        let path = run.join(Self::FILE);
+        let io = |e: std::io::Error| UarmError::Io {
+            what: format!("writing {}", path.display()),
+            source: Box::new(e),
+        };
+        let text = toml::to_string(self).expect("two plain fields serialise");
+        let mut file = atomic_write_file::AtomicWriteFile::open(&path).map_err(io)?;
+        std::io::Write::write_all(&mut file, text.as_bytes()).map_err(io)?;
+        file.commit().map_err(io)
+    }
 }
 
 /// Settings of the uArm environment.

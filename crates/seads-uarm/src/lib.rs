@@ -65,7 +65,7 @@ pub use calibration::{Calibration, CalibrationFile};
 /// Side of the LightsOut board the robot plays (on the tablet); its K is the game's 25 moves.
 pub const BOARD_SIZE: usize = 5;
 pub use driver::{DriverConfig, SerialTransport, Swift, Transport};
-pub use env::{ActionSpace, UarmConfig, UarmEnv};
+pub use env::{ActionSpace, RobotSettings, UarmConfig, UarmEnv};
 pub use tablet::{AdbTablet, Tablet, TabletReport};
 pub use twin::{Faults, Twin, twin_screen_corners};
 

@@ -10,7 +10,7 @@ use seads_planner::{EvaluationKind, Protocol, SearchLimits, TaskSet, summarise};
 
 use super::{load_agent, run_evaluation};
 use crate::BadInput;
-use seads_study::evaluation::run_policy_evaluation;
+use seads_study::evaluation::{self, run_policy_evaluation};
 
 /// Parses "1-5", "6,8,10" or "3": sorted, each once, none zero.
 fn parse_depths(text: &str) -> Result<Vec<usize>> {
@@ -147,40 +147,16 @@ pub fn evaluate_run(args: EvaluateArgs) -> Result<()> {
             limits,
             args.quiet || args.json,
         )?;
-        // The lines of this protocol only: the file may hold evaluations with other depths,
-        // boards or limits.
-        let lines: Vec<_> = seads_study::evaluation::read_over_training(&args.run)?
-            .into_iter()
-            .filter(|l| {
-                l.protocol()
-                    == seads_study::evaluation::over_training_protocol(&tasks, limits, l.replan)
-            })
-            .collect();
+        let lines = evaluation::read_over_training_of(&args.run, &tasks, limits)?;
         if args.json {
             outln!("{}", serde_json::to_string(&lines)?);
         } else {
             outln!(
                 "{added} new evaluation(s); {} in {}",
                 lines.len(),
-                args.run
-                    .join(seads_study::evaluation::OVER_TRAINING)
-                    .display()
+                args.run.join(evaluation::OVER_TRAINING).display()
             );
-            outln!("     epoch   env steps  mode            success per depth");
-            for l in &lines {
-                let rates: Vec<String> = l
-                    .results
-                    .iter()
-                    .map(|r| format!("{:.0}%", 100.0 * r.solved as f64 / r.tasks.max(1) as f64))
-                    .collect();
-                outln!(
-                    "{:>10}  {:>10}  {:<14}  {}",
-                    l.epoch,
-                    l.env_steps,
-                    if l.replan { "re-planning" } else { "plan once" },
-                    rates.join(" ")
-                );
-            }
+            outln!("{}", evaluation::over_training_table(&lines));
         }
         return Ok(());
     }
@@ -215,20 +191,7 @@ pub fn evaluate_run(args: EvaluateArgs) -> Result<()> {
             args.action_noise
                 .map_or(String::new(), |s| format!(", action noise σ = {s}"))
         );
-        outln!(" depth  success  plan found  search s  median steps  median skill steps");
-        for r in &results {
-            let key = r.depth;
-            let fmt = |v: Option<f64>| v.map_or("-".to_owned(), |x| format!("{x:.1}"));
-            outln!(
-                "{:>6}  {:>6.0}%  {:>9.0}%  {:>8.3}  {:>12}  {:>18}",
-                r.depth,
-                summary.success_rate[&key] * 100.0,
-                summary.plan_found[&key] * 100.0,
-                summary.planning_s[&key],
-                fmt(summary.solution_steps[&key]),
-                fmt(summary.skill_steps[&key])
-            );
-        }
+        outln!("{}", summary.table());
     }
     Ok(())
 }

@@ -9,14 +9,13 @@ use std::time::Duration;
 
 use anyhow::{Context, Result, anyhow};
 use clap::{Args, Subcommand};
-use serde::Serialize;
 
 pub use index::Sweep;
 pub use manifest::Manifest;
-pub use state::{Status, TAKEN_EXIT};
+pub use state::TAKEN_EXIT;
 
 use crate::BadInput;
-use seads_study::sweep::{index, manifest, slurm, state};
+use seads_study::sweep::{Overview, index, manifest, slurm, state};
 
 /// `seads sweep …`.
 #[derive(Debug, Subcommand)]
@@ -244,126 +243,14 @@ fn slurm(args: SlurmArgs) -> Result<()> {
     Ok(())
 }
 
-#[derive(Serialize)]
-struct RunStatus {
-    index: usize,
-    env: String,
-    variant: String,
-    seed: u64,
-    dir: String,
-    status: Status,
-    env_steps: u64,
-    budget: u64,
-    attempts: u32,
-    #[serde(skip_serializing_if = "Option::is_none")]
-    error: Option<String>,
-}
-
 fn status(args: StatusArgs) -> Result<()> {
     let sweep = Sweep::load(&args.dir).map_err(crate::bad_input)?;
-    let mut rows = Vec::new();
-    for (index, run) in sweep.runs.iter().enumerate() {
-        let dir = args.dir.join(&run.dir);
-        let (status, record) = state::status(&dir)?;
-        let budget = seads_rl::load_config(&dir).map_or(0, |c| c.env_steps);
-        let env_steps = seads_rl::last_env_steps(&dir).unwrap_or(0);
-        rows.push(RunStatus {
-            index,
-            env: run.env.clone(),
-            variant: run.variant.clone(),
-            seed: run.seed,
-            dir: dir.display().to_string(),
-            status,
-            env_steps,
-            budget,
-            attempts: record.as_ref().map_or(0, |r| r.attempts),
-            error: match status {
-                Status::Damaged | Status::Pending => {
-                    state::damage(&dir).or_else(|| record.and_then(|r| r.error))
-                }
-                _ => record.and_then(|r| r.error),
-            },
-        });
-    }
-    let count = |s: Status| rows.iter().filter(|r| r.status == s).count();
+    let overview = Overview::read(&args.dir, &sweep)?;
     if args.json {
-        #[derive(Serialize)]
-        struct Report<'a> {
-            sweep: &'a str,
-            total: usize,
-            done: usize,
-            running: usize,
-            failed: usize,
-            pending: usize,
-            copied: usize,
-            damaged: usize,
-            runs: &'a [RunStatus],
-        }
-        let report = Report {
-            sweep: &sweep.name,
-            total: rows.len(),
-            done: count(Status::Done),
-            running: count(Status::Running),
-            failed: count(Status::Failed),
-            pending: count(Status::Pending),
-            copied: count(Status::Copied),
-            damaged: count(Status::Damaged),
-            runs: &rows,
-        };
-        outln!("{}", serde_json::to_string(&report)?);
-        return Ok(());
+        outln!("{}", serde_json::to_string(&overview)?);
+    } else {
+        outln!("{}", overview.table());
     }
-    // Columns as wide as their longest entry.
-    let env_w = rows.iter().map(|r| r.env.len()).max().unwrap_or(0).max(3);
-    let variant_w = rows
-        .iter()
-        .map(|r| r.variant.len())
-        .max()
-        .unwrap_or(0)
-        .max(7);
-    outln!(
-        " index  status   {:<env_w$}  {:<variant_w$}  seed      steps / budget  tries",
-        "env",
-        "variant"
-    );
-    for r in &rows {
-        outln!(
-            "{:>6}  {:<7}  {:<env_w$}  {:<variant_w$}  {:>4}  {:>9} / {:<9} {:>3}{}",
-            r.index,
-            r.status.name(),
-            r.env,
-            r.variant,
-            r.seed,
-            r.env_steps,
-            r.budget,
-            r.attempts,
-            r.error.as_ref().map_or(String::new(), |e| format!(
-                "  error: {}",
-                e.lines().next().unwrap_or("")
-            )),
-        );
-    }
-    let copied = count(Status::Copied);
-    let damaged = count(Status::Damaged);
-    outln!(
-        "sweep {:?}: {} runs: {} done, {} running, {} failed, {} pending{}{}",
-        sweep.name,
-        rows.len(),
-        count(Status::Done),
-        count(Status::Running),
-        count(Status::Failed),
-        count(Status::Pending),
-        if copied > 0 {
-            format!(", {copied} copied in without checkpoints")
-        } else {
-            String::new()
-        },
-        if damaged > 0 {
-            format!(", {damaged} damaged (left alone; see their errors)")
-        } else {
-            String::new()
-        }
-    );
     Ok(())
 }
 

@@ -13,46 +13,13 @@ use indicatif::{ProgressBar, ProgressStyle};
 
 use super::index::Sweep;
 use super::state::{LOG, Status, TAKEN_EXIT, status};
+use seads_study::sweep::overview::progress;
 
 /// What a worker reports for a run: whether its task succeeded, or `None` when another task
 /// had taken or finished the run by the time a worker came to it.
 struct Finished {
     index: usize,
     ok: Option<bool>,
-}
-
-/// The environment steps a run has trained so far (from its metrics; its budget when done).
-fn progress(run: &Path, done: bool) -> u64 {
-    let budget = seads_rl::load_config(run).map_or(0, |c| c.env_steps);
-    if done {
-        return budget;
-    }
-    seads_rl::last_env_steps(run).unwrap_or(0).min(budget)
-}
-
-/// The runs of `sweep` with one of `seeds` (all runs for `None`), in index order; a seed the
-/// sweep does not have is a usage error.
-fn selected(sweep: &Sweep, seeds: Option<&[u64]>) -> Result<Vec<usize>> {
-    let Some(seeds) = seeds else {
-        return Ok((0..sweep.runs.len()).collect());
-    };
-    if let Some(missing) = seeds
-        .iter()
-        .find(|s| !sweep.runs.iter().any(|r| r.seed == **s))
-    {
-        let mut have: Vec<u64> = sweep.runs.iter().map(|r| r.seed).collect();
-        have.sort_unstable();
-        have.dedup();
-        let have: Vec<String> = have.iter().map(u64::to_string).collect();
-        bail!(crate::BadInput(anyhow::anyhow!(
-            "sweep {:?} has no seed {missing} (its seeds: {})",
-            sweep.name,
-            have.join(", ")
-        )));
-    }
-    Ok((0..sweep.runs.len())
-        .filter(|&i| seeds.contains(&sweep.runs[i].seed))
-        .collect())
 }
 
 /// Runs the sweep in `dir` (only the runs of `seeds`, if given) with `workers` parallel tasks
@@ -65,7 +32,7 @@ pub fn run_sweep(
     quiet: bool,
 ) -> Result<()> {
     let sweep = Sweep::load(dir).map_err(crate::bad_input)?;
-    let chosen = selected(&sweep, seeds)?;
+    let chosen = sweep.runs_of_seeds(seeds).map_err(crate::study_error)?;
     let mut todo = Vec::new();
     let mut skipped_running = 0;
     let mut copied = 0;

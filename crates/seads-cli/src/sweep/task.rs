@@ -5,71 +5,40 @@
 use std::path::Path;
 use std::time::Duration;
 
-use anyhow::{Context, Result, bail};
+use anyhow::{Context, Result};
 use seads_rl::{Algorithm, Hac, Run, TaskSac, Trainer};
 
-use crate::train::Shown;
+use seads_rl::InWords;
 use seads_skillmodel::SkillModelKind;
 
 use super::index::Sweep;
-use super::state::{Claim, Missing, Outcome, Record, check_outputs};
 use crate::plan::evaluate_checkpoints;
 use crate::plan::{load_agent, run_evaluation};
 use seads_planner::{EvaluationKind, Protocol, TaskSet};
 use seads_study::evaluation::run_policy_evaluation;
 use seads_study::over_training::Selection;
-
-/// libtorch threads for a task with `cores` cores: two training threads of `cores / 2` each,
-/// and all cores for SAC when the other thread waits (0 = keep: a task alone on one core).
-pub fn thread_split(cores: usize) -> (usize, usize) {
-    let cores = cores.max(1);
-    ((cores / 2).max(1), if cores >= 2 { cores } else { 0 })
-}
+use seads_study::sweep::{Task, Work};
 
 /// Runs task `index` of the sweep in `dir` with `cores` cores, waiting up to `patience` for
 /// another task that holds the run. A run already done is left as it is. Errors are recorded in
 /// the run's `task.json` before they are returned.
 pub fn run_task(dir: &Path, index: usize, cores: usize, patience: Duration) -> Result<()> {
-    let sweep = Sweep::load(dir).map_err(crate::bad_input)?;
-    sweep.run_dir(dir, index).map_err(crate::bad_input)?;
-    let (run, replanned) = sweep.ensure_run_dir(dir, index)?;
-    if replanned {
-        outln!(
-            "{}: was deleted; planned again from the manifest",
-            run.display()
-        );
+    let task = Task::claim(dir, index, patience).map_err(crate::study_error)?;
+    let run = task.run.display();
+    if task.replanned {
+        outln!("{run}: was deleted; planned again from the manifest");
     }
-    let claim = Claim::take(&run, patience)?;
-    let previous = Record::read(&run)?;
-    if let Some(done) = previous.as_ref().filter(|r| r.outcome == Outcome::Done) {
-        match check_outputs(&run, done) {
-            Ok(()) => {
-                outln!("{}: already done", run.display());
-                return Ok(());
-            }
-            Err(Missing::Gone(name)) => {
-                outln!("{}: {name} is gone; finishing the run again", run.display());
-            }
-            Err(Missing::Unreadable(why)) => bail!(crate::BadInput(anyhow::anyhow!(why))),
+    match &task.work {
+        Work::Nothing => {
+            outln!("{run}: already done");
+            return Ok(());
         }
+        Work::Redo(name) => outln!("{run}: {name} is gone; finishing the run again"),
+        Work::Run => {}
     }
-    // Training it again from scratch would replace the data it holds; nothing is recorded, so
-    // the run stays "copied".
-    if seads_rl::is_copy_without_checkpoints(&run) {
-        bail!(crate::BadInput(anyhow::anyhow!(
-            "{} holds a run's data but no checkpoints folder (copied in by `seads report \
-             --copy-runs`?): it is reported as it is and cannot be trained further",
-            run.display()
-        )));
-    }
-    let attempts = previous.map_or(0, |r| r.attempts) + 1;
-    Record::write(&run, Outcome::Running, attempts, None)?;
-    let result = train_and_evaluate(&sweep, &run, cores);
-    match &result {
-        Ok(()) => Record::write(&run, Outcome::Done, attempts, None)?,
-        Err(e) => Record::write(&run, Outcome::Failed, attempts, Some(format!("{e:#}")))?,
-    }
-    drop(claim);
+    task.start()?;
+    let result = train_and_evaluate(&task.sweep, &task.run, cores);
+    task.finish(&result)?;
     result
 }
 
@@ -77,7 +46,6 @@ fn train_and_evaluate(sweep: &Sweep, run: &Path, cores: usize) -> Result<()> {
     let config =
         seads_rl::load_config(run).with_context(|| format!("loading {}", run.display()))?;
     crate::kernels::use_kernels(config.portable_numerics)?;
-    let (threads, alone) = thread_split(cores);
     match config.algorithm {
         Algorithm::Sac => return train_and_evaluate_baseline::<TaskSac>(sweep, run, cores),
         Algorithm::Hac => return train_and_evaluate_baseline::<Hac>(sweep, run, cores),
@@ -86,16 +54,16 @@ fn train_and_evaluate(sweep: &Sweep, run: &Path, cores: usize) -> Result<()> {
     let mut training = crate::train::resume(
         run,
         Run::resume_with(run, |mut c| {
-            c.threads = threads;
-            c.sac_threads_alone = alone;
+            c.use_cores(cores);
             Trainer::new(c)
         }),
     )?;
     if !training.finished() {
         outln!(
-            "{}: training from epoch {} with {threads} libtorch thread(s) per training thread",
+            "{}: training from epoch {} with {} libtorch thread(s) per training thread",
             run.display(),
-            training.trainer().epoch()
+            training.trainer().epoch(),
+            training.trainer().config().threads
         );
         crate::train::drive(&mut training, true)?;
     }
@@ -150,7 +118,7 @@ fn train_and_evaluate(sweep: &Sweep, run: &Path, cores: usize) -> Result<()> {
 
 /// A baseline run: training on all of the task's cores (one training thread), then task success
 /// of the final policy on the study's boards per depth (`evaluation-policy.json`).
-fn train_and_evaluate_baseline<L: Shown>(sweep: &Sweep, run: &Path, cores: usize) -> Result<()> {
+fn train_and_evaluate_baseline<L: InWords>(sweep: &Sweep, run: &Path, cores: usize) -> Result<()> {
     let mut training = crate::train::resume(
         run,
         Run::resume_with(run, |mut c| {

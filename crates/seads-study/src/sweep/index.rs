@@ -54,6 +54,31 @@ pub struct Planned {
 }
 
 impl Sweep {
+    /// The indices of the runs with one of `seeds` (all runs for `None`), in index order; a seed
+    /// the sweep does not have is [`StudyError::Invalid`](crate::StudyError::Invalid).
+    pub fn runs_of_seeds(&self, seeds: Option<&[u64]>) -> Result<Vec<usize>> {
+        let Some(seeds) = seeds else {
+            return Ok((0..self.runs.len()).collect());
+        };
+        if let Some(missing) = seeds
+            .iter()
+            .find(|s| !self.runs.iter().any(|r| r.seed == **s))
+        {
+            let mut have: Vec<u64> = self.runs.iter().map(|r| r.seed).collect();
+            have.sort_unstable();
+            have.dedup();
+            let have: Vec<String> = have.iter().map(u64::to_string).collect();
+            return Err(crate::StudyError::invalid(format!(
+                "sweep {:?} has no seed {missing} (its seeds: {})",
+                self.name,
+                have.join(", ")
+            )));
+        }
+        Ok((0..self.runs.len())
+            .filter(|&i| seeds.contains(&self.runs[i].seed))
+            .collect())
+    }
+
     /// Loads the sweep in `dir`; a missing folder or one that is not a sweep is a clear error.
     pub fn load(dir: &Path) -> Result<Self> {
         if !dir.is_dir() {

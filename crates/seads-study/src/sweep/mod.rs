@@ -6,13 +6,17 @@
 
 pub mod index;
 pub mod manifest;
+pub mod overview;
 pub mod slurm;
 pub mod state;
+pub mod task;
 
 pub use crate::error::Taken;
 pub use index::{INDEX, MANIFEST, Planned, Sweep, SweepRun};
 pub use manifest::{EvaluationPlan, Manifest, PlannedRun};
+pub use overview::{Overview, RunStatus};
 pub use state::{
     Claim, LOG, Missing, Outcome, PATIENCE, RECORD, Record, Status, TAKEN_EXIT, check_outputs,
     damage, is_claimed, status,
 };
+pub use task::{Task, Work};

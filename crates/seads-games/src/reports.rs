@@ -1,0 +1,166 @@
+//! What `seads games` shows of a game: boards per solution depth, the train/test split per
+//! depth, and the optimal solution of a board, each as JSON (serde) or as a small table.
+
+use std::fmt::Write as _;
+
+use serde::Serialize;
+
+use crate::{
+    BoardDataset, DepthTable, Enumerable, GameError, GameKind, Gf2Solver, LightsOut, MoveId, Split,
+    TileSwap, enumerate,
+};
+
+/// `kind` at `size` as a game that can be enumerated (both games are).
+fn enumerable(kind: GameKind, size: usize) -> Result<Box<dyn Enumerable>, GameError> {
+    Ok(match kind {
+        GameKind::LightsOut => Box::new(LightsOut::new(size)?),
+        GameKind::TileSwap => Box::new(TileSwap::with_size(size)?),
+    })
+}
+
+/// Boards per solution depth of a whole game.
+#[derive(Debug, Clone, Serialize)]
+pub struct DepthsReport {
+    /// The game.
+    pub game: GameKind,
+    /// Its size.
+    pub size: usize,
+    /// Boards per depth; index = depth, entry 0 is the goal.
+    pub counts: Vec<u64>,
+}
+
+impl DepthsReport {
+    /// Enumerates `game` at `size` from its goal.
+    ///
+    /// ```
+    /// use seads_games::{DepthsReport, GameKind};
+    /// let report = DepthsReport::of(GameKind::LightsOut, 3).unwrap();
+    /// assert_eq!(report.counts.iter().sum::<u64>(), 512);
+    /// assert!(report.table().ends_with(" total         512"));
+    /// ```
+    pub fn of(game: GameKind, size: usize) -> Result<Self, GameError> {
+        let g = enumerable(game, size)?;
+        Ok(Self {
+            game,
+            size,
+            counts: enumerate(g.as_ref(), None)?.depth_counts(),
+        })
+    }
+
+    /// A table: one line per depth and the total.
+    pub fn table(&self) -> String {
+        let total: u64 = self.counts.iter().sum();
+        let mut s = format!(
+            "{} {}×{}: boards per solution depth\n depth      boards\n",
+            self.game, self.size, self.size
+        );
+        for (d, c) in self.counts.iter().enumerate() {
+            let _ = writeln!(s, "{d:>6} {c:>11}");
+        }
+        s + &format!(" total {total:>11}")
+    }
+}
+
+/// Boards per depth in each split; index 0 is depth 1.
+#[derive(Debug, Clone, Serialize)]
+pub struct SplitReport {
+    /// Training boards per depth.
+    pub train: Vec<usize>,
+    /// Test boards per depth.
+    pub test: Vec<usize>,
+}
+
+impl SplitReport {
+    /// The split of `game` at `size` up to `max_depth` (at least 1).
+    pub fn of(game: GameKind, size: usize, max_depth: usize) -> Result<Self, GameError> {
+        let g = enumerable(game, size)?;
+        let data = BoardDataset::build(g.as_ref(), max_depth)?;
+        let count = |s| (1..=max_depth).map(|d| data.boards(d, s).len()).collect();
+        Ok(Self {
+            train: count(Split::Train),
+            test: count(Split::Test),
+        })
+    }
+
+    /// A table: one line per depth.
+    pub fn table(&self) -> String {
+        let mut s = String::from(" depth  train   test\n");
+        for (i, (a, b)) in self.train.iter().zip(&self.test).enumerate() {
+            let _ = writeln!(s, "{:>6} {a:>6} {b:>6}", i + 1);
+        }
+        s.trim_end().to_owned()
+    }
+}
+
+/// An optimal solution of a board.
+#[derive(Debug, Clone, Serialize)]
+pub struct SolveReport {
+    /// The game.
+    pub game: GameKind,
+    /// Its size.
+    pub size: usize,
+    /// The board, as the game writes it.
+    pub board: String,
+    /// Solution depth = length of `moves`.
+    pub depth: usize,
+    /// Move ids in order (LightsOut: row·N + col pressed; TileSwap: the swap ids of SPEC §1.2).
+    pub moves: Vec<MoveId>,
+}
+
+impl SolveReport {
+    /// Solves `board` (the game's text form) optimally: over GF(2) for LightsOut, from the depth
+    /// table for TileSwap.
+    ///
+    /// ```
+    /// use seads_games::{GameKind, SolveReport};
+    /// let report = SolveReport::of(GameKind::LightsOut, 3, "1,1,0,1,0,0,0,0,0").unwrap();
+    /// assert_eq!((report.depth, report.moves.clone()), (1, vec![0]));
+    /// assert!(report.table().ends_with("0 (press row 0 col 0)"));
+    /// ```
+    pub fn of(game: GameKind, size: usize, board: &str) -> Result<Self, GameError> {
+        let g = enumerable(game, size)?;
+        let z = g.parse(board)?;
+        let moves = match game {
+            GameKind::LightsOut => Gf2Solver::new(&LightsOut::new(size)?).solve(z)?,
+            GameKind::TileSwap => DepthTable::build(g.as_ref())?.solve(g.as_ref(), z)?,
+        };
+        debug_assert!(g.is_goal(g.apply_all(z, &moves)));
+        Ok(Self {
+            game,
+            size,
+            board: g.format(z),
+            depth: moves.len(),
+            moves,
+        })
+    }
+
+    /// Two lines: the board, and the moves in words.
+    pub fn table(&self) -> String {
+        let moves: Vec<String> = self.moves.iter().map(|m| self.describe(*m)).collect();
+        format!(
+            "{} {}×{} board {}\nsolution depth {}: {}",
+            self.game,
+            self.size,
+            self.size,
+            self.board,
+            self.depth,
+            if moves.is_empty() {
+                "already solved".to_owned()
+            } else {
+                moves.join(", ")
+            }
+        )
+    }
+
+    fn describe(&self, mv: MoveId) -> String {
+        match self.game {
+            GameKind::LightsOut => {
+                format!("{mv} (press row {} col {})", mv / self.size, mv % self.size)
+            }
+            GameKind::TileSwap => {
+                let (p, q) = TileSwap::swap_cells(mv);
+                format!("{mv} (swap ({},{})↔({},{}))", p / 3, p % 3, q / 3, q % 3)
+            }
+        }
+    }
+}

@@ -1,0 +1,138 @@
+//! The planning benchmark of `seads plan-bench`: breadth-first search with a forward model fitted
+//! to the LightsOut 5×5 move table, timed per depth on test boards.
+
+use std::time::Instant;
+
+use rand::SeedableRng;
+use rand_chacha::ChaCha8Rng;
+use seads_games::{BoardDataset, BoardGame, LightsOut, Split};
+use seads_planner::{PlannerConfig, bfs_plan};
+use seads_skillmodel::{SkillModelConfig, agreement_with_game, fit_to_game};
+use serde::Serialize;
+
+use crate::{Result, StudyError};
+
+/// What to time.
+#[derive(Debug, Clone)]
+pub struct PlanBench {
+    /// Hidden layer sizes of the forward model.
+    pub hidden: Vec<i64>,
+    /// Solution depths of the boards.
+    pub depths: Vec<usize>,
+    /// Boards per depth.
+    pub boards: usize,
+    /// Every logit in float32, without the 8-bit screen.
+    pub float32: bool,
+}
+
+/// The timings of one depth.
+#[derive(Debug, Clone, Serialize)]
+pub struct PlanBenchDepth {
+    /// Solution depth of the boards.
+    pub depth: usize,
+    /// Seconds per plan.
+    pub seconds: Vec<f64>,
+    /// Their mean.
+    pub mean_s: f64,
+    /// Skills per plan.
+    pub plan_lengths: Vec<usize>,
+    /// Nodes expanded per plan.
+    pub expanded: Vec<usize>,
+}
+
+/// The benchmark's result.
+#[derive(Debug, Clone, Serialize)]
+pub struct PlanBenchReport {
+    /// Hidden layer sizes of the model.
+    pub hidden: Vec<i64>,
+    /// Whether the screen was off.
+    pub float32: bool,
+    /// The fitted model's agreement with the move table.
+    pub model_agreement: f64,
+    /// (state, skill) pairs screened in 8-bit arithmetic.
+    pub screened: u64,
+    /// Those of them computed in float32 after all.
+    pub recomputed: u64,
+    /// Per depth.
+    pub depths: Vec<PlanBenchDepth>,
+    /// Peak resident memory of the process (Linux `VmHWM`), MiB; NaN elsewhere.
+    pub peak_rss_mib: f64,
+}
+
+/// Peak resident memory of this process (Linux `VmHWM`), MiB.
+fn peak_rss_mib() -> f64 {
+    std::fs::read_to_string("/proc/self/status")
+        .ok()
+        .and_then(|s| {
+            s.lines()
+                .find(|l| l.starts_with("VmHWM:"))
+                .and_then(|l| l.split_whitespace().nth(1)?.parse::<f64>().ok())
+        })
+        .map_or(f64::NAN, |kib| kib / 1024.0)
+}
+
+impl PlanBench {
+    /// Fits the model, then plans `boards` test boards of each depth, calling `on_depth` after
+    /// each depth. Empty or non-positive settings are [`StudyError::Invalid`].
+    pub fn run(&self, mut on_depth: impl FnMut(&PlanBenchDepth)) -> Result<PlanBenchReport> {
+        let Some(&max_depth) = self.depths.iter().max() else {
+            return Err(StudyError::invalid("--depths must name a depth"));
+        };
+        if self.hidden.is_empty()
+            || self.hidden.iter().any(|&h| h <= 0)
+            || self.depths.contains(&0)
+            || self.boards == 0
+        {
+            return Err(StudyError::invalid(
+                "--hidden, --depths and --boards must be positive",
+            ));
+        }
+        let game = LightsOut::new(5).expect("LightsOut 5×5 exists");
+        let config = SkillModelConfig {
+            hidden: self.hidden.clone(),
+            batch_size: 256,
+            ..SkillModelConfig::default()
+        };
+        let mut model = fit_to_game(&game, &config, 1500, 1);
+        let model_agreement = agreement_with_game(&mut model, &game, 2000, 2);
+        model.set_int8_screen(!self.float32);
+        let before = model.screen_counts();
+        let boards = BoardDataset::build(&game, max_depth)
+            .map_err(|e| StudyError::invalid(format!("boards up to depth {max_depth}: {e}")))?;
+        let mut rng = ChaCha8Rng::seed_from_u64(7);
+        let mut depths = Vec::new();
+        for &depth in &self.depths {
+            let mut row = PlanBenchDepth {
+                depth,
+                seconds: Vec::new(),
+                mean_s: 0.0,
+                plan_lengths: Vec::new(),
+                expanded: Vec::new(),
+            };
+            for _ in 0..self.boards {
+                let board = boards.sample(depth, Split::Test, &mut rng).ok_or_else(|| {
+                    StudyError::invalid(format!("LightsOut 5×5 has no test board of depth {depth}"))
+                })?;
+                let start = Instant::now();
+                let plan = bfs_plan(&mut model, board, game.goal(), &PlannerConfig::default());
+                row.seconds.push(start.elapsed().as_secs_f64());
+                let plan = plan.map_err(|e| StudyError::Failed(format!("depth {depth}: {e}")))?;
+                row.plan_lengths.push(plan.skills.len());
+                row.expanded.push(plan.expanded);
+            }
+            row.mean_s = row.seconds.iter().sum::<f64>() / row.seconds.len() as f64;
+            on_depth(&row);
+            depths.push(row);
+        }
+        let after = model.screen_counts();
+        Ok(PlanBenchReport {
+            hidden: self.hidden.clone(),
+            float32: self.float32,
+            model_agreement,
+            screened: after.0 - before.0,
+            recomputed: after.1 - before.1,
+            depths,
+            peak_rss_mib: peak_rss_mib(),
+        })
+    }
+}
