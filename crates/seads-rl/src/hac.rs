@@ -65,7 +65,7 @@ use std::path::Path;
 use std::time::Instant;
 
 use rand::RngExt;
-use seads_embodiment::{EnvSpec, TaskEnv};
+use seads_embodiment::EnvSpec;
 use seads_games::SymbolicState;
 use seads_planner::{DepthResult, TaskSet};
 use serde::{Deserialize, Serialize};
@@ -73,11 +73,13 @@ use tch::Device;
 
 use crate::learner::Learner;
 use crate::replay::Replay;
+use crate::task_episodes::{
+    self, LossMean, OpenEpisode, Streams, TaskEpisodes, TaskEpochStats, TaskTimings, read_progress,
+    updates_due, write_progress,
+};
 use crate::task_policy::TaskPolicy;
-use crate::task_sac::{OpenEpisode, Streams, training_envs};
 use crate::{
-    Moment, Purpose, RlError, Sac, SacConfig, SacLosses, TaskEpochStats, TaskMetrics, TaskTimings,
-    TrainConfig, derived_seed, task_success, updates_due,
+    Moment, Purpose, RlError, Sac, SacConfig, TaskMetrics, TrainConfig, derived_seed, task_success,
 };
 
 /// File prefix of the high level's networks in a checkpoint ([`crate::sac::checkpoint_files`]).
@@ -118,35 +120,89 @@ struct Attempt {
     reward: f32,
 }
 
-#[derive(Debug, Clone, Serialize, Deserialize)]
+/// HAC's progress: the baselines' shared progress and the state of its subgoals.
+#[derive(Debug, Clone)]
 struct Progress {
-    epoch: u64,
-    env_steps: u64,
-    /// Episodes started, over all environments (numbers their seeds).
-    episodes: u64,
-    /// Episodes ended, and how many of them solved their board.
-    ended: u64,
-    solved: u64,
+    shared: task_episodes::Progress,
     /// Subgoal attempts ended, and how many reached their subgoal.
     attempts: u64,
     reached: u64,
     /// `attempts` and `reached` at the last metrics line.
-    #[serde(default)]
     reported: (u64, u64),
-    timings: TaskTimings,
-    streams: Streams,
-    open: Vec<OpenEpisode>,
     /// The subgoal of each environment (`None` between attempts).
     subgoals: Vec<Option<Attempt>>,
     /// The ended attempts of each environment's open episode.
     ended_attempts: Vec<Vec<Ended>>,
 }
 
+/// [`HAC_PROGRESS_FILE`]: [`Progress`] as one flat object, the shared fields beside HAC's, as
+/// the file has always been (serde's `flatten` cannot carry the streams' 128-bit counters).
+#[derive(Serialize, Deserialize)]
+struct ProgressFile {
+    epoch: u64,
+    env_steps: u64,
+    episodes: u64,
+    ended: u64,
+    solved: u64,
+    attempts: u64,
+    reached: u64,
+    #[serde(default)]
+    reported: (u64, u64),
+    timings: TaskTimings,
+    streams: Streams,
+    open: Vec<OpenEpisode>,
+    subgoals: Vec<Option<Attempt>>,
+    ended_attempts: Vec<Vec<Ended>>,
+}
+
+impl From<ProgressFile> for Progress {
+    fn from(f: ProgressFile) -> Self {
+        Self {
+            shared: task_episodes::Progress {
+                epoch: f.epoch,
+                env_steps: f.env_steps,
+                episodes: f.episodes,
+                ended: f.ended,
+                solved: f.solved,
+                timings: f.timings,
+                streams: f.streams,
+                open: f.open,
+            },
+            attempts: f.attempts,
+            reached: f.reached,
+            reported: f.reported,
+            subgoals: f.subgoals,
+            ended_attempts: f.ended_attempts,
+        }
+    }
+}
+
+impl From<&Progress> for ProgressFile {
+    fn from(p: &Progress) -> Self {
+        let s = p.shared.clone();
+        Self {
+            epoch: s.epoch,
+            env_steps: s.env_steps,
+            episodes: s.episodes,
+            ended: s.ended,
+            solved: s.solved,
+            attempts: p.attempts,
+            reached: p.reached,
+            reported: p.reported,
+            timings: s.timings,
+            streams: s.streams,
+            open: s.open,
+            subgoals: p.subgoals.clone(),
+            ended_attempts: p.ended_attempts.clone(),
+        }
+    }
+}
+
 /// A two-level HAC agent in training on the task reward.
 pub struct Hac {
     config: TrainConfig,
     spec: EnvSpec,
-    envs: Vec<TaskEnv>,
+    episodes: TaskEpisodes,
     /// Every observation of each environment's open episode, row-major (steps + 1 rows).
     observations: Vec<Vec<f32>>,
     high: Sac,
@@ -212,46 +268,35 @@ fn levels(config: &TrainConfig, spec: &EnvSpec) -> (Sac, Sac) {
 impl Hac {
     /// A fresh agent for `config` (validated; `config.algorithm` is not checked here).
     pub fn new(config: TrainConfig) -> Result<Self, RlError> {
-        config.validate()?;
-        crate::numerics::check(config.portable_numerics)?;
-        if config.threads > 0 {
-            tch::set_num_threads(config.threads as i32);
-        }
-        let envs = training_envs(&config)?;
-        let spec = envs[0].spec().clone();
+        let (episodes, shared) = TaskEpisodes::new(&config)?;
+        let spec = episodes.spec().clone();
         let (high, low) = levels(&config, &spec);
         let d = spec.symbolic_len;
         let goal = game_goal(&spec)?;
         let capacity = config.baseline.replay_capacity;
+        let n = episodes.len();
         let progress = Progress {
-            epoch: 0,
-            env_steps: 0,
-            episodes: 0,
-            ended: 0,
-            solved: 0,
+            shared,
             attempts: 0,
             reached: 0,
             reported: (0, 0),
-            timings: TaskTimings::default(),
-            streams: Streams::new(config.seed),
-            open: Vec::new(),
-            subgoals: vec![None; envs.len()],
-            ended_attempts: vec![Vec::new(); envs.len()],
+            subgoals: vec![None; n],
+            ended_attempts: vec![Vec::new(); n],
         };
         let mut agent = Self {
-            observations: vec![Vec::new(); envs.len()],
+            observations: vec![Vec::new(); n],
             high_replay: Replay::new(capacity, spec.obs_dim + d, d),
             goal,
             scratch: [Vec::new(), Vec::new()],
             low_replay: Replay::new(capacity, spec.obs_dim + d, spec.action_dim),
             config,
             spec,
-            envs,
+            episodes,
             high,
             low,
             progress,
         };
-        for slot in 0..agent.envs.len() {
+        for slot in 0..n {
             agent.start_episode(slot)?;
         }
         Ok(agent)
@@ -259,23 +304,9 @@ impl Hac {
 
     /// Resets environment `slot` for the next episode, seeded by the episode's number.
     fn start_episode(&mut self, slot: usize) -> Result<(), RlError> {
-        let seed = derived_seed(self.config.seed, Purpose::TrainEnvs, self.progress.episodes);
-        self.progress.episodes += 1;
-        let env = &mut self.envs[slot];
-        env.seed(seed);
-        env.reset()?;
         let obs = &mut self.observations[slot];
         obs.clear();
-        obs.resize(self.spec.obs_dim, 0.0);
-        env.observe(obs);
-        let open = OpenEpisode {
-            seed,
-            actions: Vec::new(),
-        };
-        match self.progress.open.get_mut(slot) {
-            Some(o) => *o = open,
-            None => self.progress.open.push(open),
-        }
+        self.episodes.start(slot, &mut self.progress.shared, obs)?;
         self.progress.subgoals[slot] = None;
         self.progress.ended_attempts[slot].clear();
         Ok(())
@@ -300,22 +331,22 @@ impl Hac {
 
     /// Epochs run so far.
     pub fn epoch(&self) -> u64 {
-        self.progress.epoch
+        self.progress.shared.epoch
     }
 
     /// Environment steps so far.
     pub fn env_steps(&self) -> u64 {
-        self.progress.env_steps
+        self.progress.shared.env_steps
     }
 
     /// Whether the step budget is spent.
     pub fn finished(&self) -> bool {
-        self.progress.env_steps >= self.config.env_steps
+        self.progress.shared.env_steps >= self.config.env_steps
     }
 
     /// Time spent per phase.
     pub fn timings(&self) -> TaskTimings {
-        self.progress.timings
+        self.progress.shared.timings
     }
 
     /// The deterministic two-level policy.
@@ -341,7 +372,7 @@ impl Hac {
             self.spec.symbolic_len,
             &mut input,
         );
-        let streams = &mut self.progress.streams;
+        let streams = &mut self.progress.shared.streams;
         let action = self.high.act(&input, Some(&mut streams.collect));
         let testing = streams.collect.random::<f64>() < self.config.hac.subgoal_test_p;
         self.progress.subgoals[slot] = Some(Attempt {
@@ -357,39 +388,42 @@ impl Hac {
     pub fn run_epoch(&mut self) -> Result<TaskEpochStats, RlError> {
         let start = Instant::now();
         let (d, a) = (self.spec.symbolic_len, self.spec.action_dim);
-        for slot in 0..self.envs.len() {
+        for slot in 0..self.episodes.len() {
             if self.progress.subgoals[slot].is_none() {
                 self.propose(slot);
             }
         }
         let mut inputs = Vec::new();
-        for slot in 0..self.envs.len() {
+        for slot in 0..self.episodes.len() {
             let attempt = self.progress.subgoals[slot].as_ref().expect("proposed");
             with_board(self.current(slot), attempt.subgoal, d, &mut inputs);
         }
         let noisy = self
             .low
-            .act(&inputs, Some(&mut self.progress.streams.collect));
+            .act(&inputs, Some(&mut self.progress.shared.streams.collect));
         let tested = self.progress.subgoals.iter().flatten().any(|s| s.testing);
         let deterministic = tested.then(|| self.low.act(&inputs, None));
-        for slot in 0..self.envs.len() {
+        for slot in 0..self.episodes.len() {
             let attempt = self.progress.subgoals[slot].clone().expect("proposed");
             let action = match (&deterministic, attempt.testing) {
                 (Some(actions), true) => &actions[slot * a..(slot + 1) * a],
                 _ => &noisy[slot * a..(slot + 1) * a],
             };
-            let step = self.envs[slot].step(action)?;
             let o = self.spec.obs_dim;
             let rows = self.observations[slot].len();
             self.observations[slot].resize(rows + o, 0.0);
-            self.envs[slot].observe(&mut self.observations[slot][rows..]);
-            self.progress.open[slot].actions.extend_from_slice(action);
+            let step = self.episodes.step(
+                slot,
+                action,
+                &mut self.progress.shared,
+                &mut self.observations[slot][rows..],
+            )?;
             let reached = self.spec.phi(self.current(slot)) == attempt.subgoal;
             // The low level's transition toward its subgoal.
             let [mut from, mut to] = std::mem::take(&mut self.scratch);
             from.clear();
             to.clear();
-            let steps = self.progress.open[slot].actions.len() / a;
+            let steps = self.progress.shared.open[slot].actions.len() / a;
             with_board(
                 self.observation(slot, steps - 1),
                 attempt.subgoal,
@@ -412,55 +446,37 @@ impl Hac {
                 self.progress.subgoals[slot] = Some(attempt);
             }
             if step.done {
-                self.progress.ended += 1;
-                self.progress.solved += u64::from(step.solved);
                 self.relabel_episode(slot);
                 self.start_episode(slot)?;
             }
         }
-        self.progress.env_steps += self.envs.len() as u64;
-        self.progress.timings.collect += start.elapsed().as_secs_f64();
+        self.progress.shared.collected(self.episodes.len(), start);
 
         let start = Instant::now();
-        let due = updates_due(self.progress.epoch, self.config.baseline.updates_per_epoch);
+        let due = updates_due(
+            self.progress.shared.epoch,
+            self.config.baseline.updates_per_epoch,
+        );
         let batch_size = self.config.sac.batch_size;
-        let mut updates = 0;
-        let mut total = SacLosses::default();
+        let mut losses = LossMean::default();
         for _ in 0..due {
+            let streams = &mut self.progress.shared.streams;
             if self.low_replay.len() >= batch_size {
-                let streams = &mut self.progress.streams;
                 let batch = self.low_replay.sample(batch_size, &mut streams.sample);
-                let l = self.low.update(&batch, &mut streams.sac);
-                total.critic += l.critic;
-                total.actor += l.actor;
-                total.q += l.q;
-                updates += 1;
+                losses.add(self.low.update(&batch, &mut streams.sac));
             }
             if self.high_replay.len() >= batch_size {
-                let streams = &mut self.progress.streams;
                 let batch = self.high_replay.sample(batch_size, &mut streams.sample);
                 self.high.update(&batch, &mut streams.sac);
             }
         }
-        self.progress.timings.sac += start.elapsed().as_secs_f64();
-        self.progress.epoch += 1;
-        let n = updates.max(1) as f32;
-        Ok(TaskEpochStats {
-            epoch: self.progress.epoch,
-            env_steps: self.progress.env_steps,
-            updates,
-            sac: SacLosses {
-                critic: total.critic / n,
-                actor: total.actor / n,
-                q: total.q / n,
-            },
-        })
+        Ok(self.progress.shared.end_epoch(start, losses))
     }
 
     /// Stores what an ended subgoal attempt teaches both levels.
     fn end_attempt(&mut self, slot: usize, attempt: &Attempt, reached: bool, episode_done: bool) {
         let (d, a) = (self.spec.symbolic_len, self.spec.action_dim);
-        let actions = &self.progress.open[slot].actions;
+        let actions = &self.progress.shared.open[slot].actions;
         let end = actions.len() / a;
         let achieved = self.spec.phi(self.current(slot));
         // Hindsight goal transitions: the missed attempt as one toward the board it ended on.
@@ -519,7 +535,13 @@ impl Hac {
         };
         let mut goals = vec![last];
         for _ in 1..HINDSIGHT_GOALS {
-            goals.push(self.progress.streams.collect.random_range(0..ended.len()));
+            goals.push(
+                self.progress
+                    .shared
+                    .streams
+                    .collect
+                    .random_range(0..ended.len()),
+            );
         }
         let d = self.spec.symbolic_len;
         let mut bits = vec![0.0; d];
@@ -550,7 +572,7 @@ impl Hac {
             &TaskSet::standard(boards),
             |_, _, _, _| {},
         )?;
-        self.progress.timings.evaluate += start.elapsed().as_secs_f64();
+        self.progress.shared.timings.evaluate += start.elapsed().as_secs_f64();
         Ok(results)
     }
 
@@ -560,9 +582,10 @@ impl Hac {
         self.low.save_as(dir, LOW_PREFIX)?;
         self.high_replay.save(&dir.join(HIGH_REPLAY_FILE))?;
         self.low_replay.save(&dir.join(LOW_REPLAY_FILE))?;
-        let path = dir.join(HAC_PROGRESS_FILE);
-        let text = serde_json::to_string(&self.progress).map_err(|e| RlError::io(&path, e))?;
-        std::fs::write(&path, text).map_err(|e| RlError::io(&path, e))
+        write_progress(
+            &dir.join(HAC_PROGRESS_FILE),
+            &ProgressFile::from(&self.progress),
+        )
     }
 
     /// Restores what [`Hac::save`] wrote, replaying each environment's open episode.
@@ -572,38 +595,21 @@ impl Hac {
         self.high_replay.load(&dir.join(HIGH_REPLAY_FILE))?;
         self.low_replay.load(&dir.join(LOW_REPLAY_FILE))?;
         let path = dir.join(HAC_PROGRESS_FILE);
-        let text = std::fs::read_to_string(&path).map_err(|e| RlError::io(&path, e))?;
-        let progress: Progress =
-            serde_json::from_str(&text).map_err(|e| RlError::unreadable(&path, e))?;
-        let n = self.envs.len();
-        if progress.open.len() != n
-            || progress.subgoals.len() != n
-            || progress.ended_attempts.len() != n
-        {
+        let progress = Progress::from(read_progress::<ProgressFile>(&path)?);
+        let n = self.episodes.len();
+        if progress.subgoals.len() != n || progress.ended_attempts.len() != n {
             return Err(RlError::Checkpoint {
                 path: path.display().to_string(),
-                reason: format!(
-                    "{} open episodes and {} subgoals for {n} environments",
-                    progress.open.len(),
-                    progress.subgoals.len()
-                ),
+                reason: format!("{} subgoals for {n} environments", progress.subgoals.len()),
             });
         }
-        let (a, o) = (self.spec.action_dim, self.spec.obs_dim);
-        for (slot, open) in progress.open.iter().enumerate() {
-            let env = &mut self.envs[slot];
-            env.seed(open.seed);
-            env.reset()?;
-            let obs = &mut self.observations[slot];
-            obs.clear();
-            obs.resize(o, 0.0);
-            env.observe(obs);
-            for action in open.actions.chunks(a) {
-                env.step(action)?;
-                let rows = obs.len();
-                obs.resize(rows + o, 0.0);
-                env.observe(&mut obs[rows..]);
-            }
+        let observations = &mut self.observations;
+        observations.iter_mut().for_each(Vec::clear);
+        self.episodes.replay(&progress.shared, &path, |slot, obs| {
+            observations[slot].extend_from_slice(obs)
+        })?;
+        let a = self.spec.action_dim;
+        for (slot, open) in progress.shared.open.iter().enumerate() {
             let steps = open.actions.len() / a;
             let late = progress.subgoals[slot]
                 .as_ref()
@@ -734,7 +740,7 @@ impl Learner for Hac {
         &self.config
     }
     fn epoch(&self) -> u64 {
-        self.progress.epoch
+        self.progress.shared.epoch
     }
     fn finished(&self) -> bool {
         Hac::finished(self)
@@ -750,14 +756,7 @@ impl Learner for Hac {
     fn metrics(&mut self, stats: &TaskEpochStats, wall_s: f64) -> Result<TaskMetrics, RlError> {
         let results = self.task_success(self.config.baseline.eval_boards)?;
         let p = &mut self.progress;
-        let mut line = TaskMetrics::new(
-            &results,
-            (p.epoch, p.env_steps),
-            wall_s,
-            p.solved as f64 / p.ended.max(1) as f64,
-            stats,
-            p.timings,
-        );
+        let mut line = TaskMetrics::new(&results, &p.shared, wall_s, stats);
         let (attempts, reached) = (p.attempts - p.reported.0, p.reached - p.reported.1);
         line.subgoals_reached = Some(reached as f64 / attempts.max(1) as f64);
         p.reported = (p.attempts, p.reached);

@@ -50,6 +50,7 @@ mod run;
 mod sac;
 mod seeds;
 mod store;
+mod task_episodes;
 mod task_policy;
 mod task_sac;
 mod trainer;
@@ -77,8 +78,9 @@ pub use store::{
     checkpoint_name, checkpoints, is_copy_without_checkpoints, last_env_steps, latest_checkpoint,
     read_json_lines, read_metrics_as, run_is_locked, write_atomic,
 };
+pub use task_episodes::{TaskEpochStats, TaskTimings, updates_due};
 pub use task_policy::{TaskPolicy, task_success};
-pub use task_sac::{TaskEpochStats, TaskMetrics, TaskSac, TaskTimings, updates_due};
+pub use task_sac::{TaskMetrics, TaskSac};
 pub use trainer::{COVERAGE_SEED, EpochStats, Timings, Trainer};
 
 /// Sets the number of libtorch intra-op threads of the process.
