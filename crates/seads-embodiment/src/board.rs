@@ -100,6 +100,12 @@ impl BoardState {
         self.rng = ChaCha8Rng::seed_from_u64(seed);
     }
 
+    /// The board's random stream, for an environment that draws the rest of its reset from it
+    /// after the board (the robot's twin draws the pen's position there).
+    pub fn rng(&mut self) -> &mut ChaCha8Rng {
+        &mut self.rng
+    }
+
     /// Draws a new board from the reset distribution.
     pub fn reset(&mut self) {
         let depth = if self.random_depth {

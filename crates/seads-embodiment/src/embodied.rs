@@ -242,10 +242,9 @@ impl<M: Manipulator> Environment for Embodied<M> {
     }
 
     fn observe(&self, out: &mut [f32]) {
-        let (m, d) = (self.spec.manipulator_dim, self.spec.symbolic_len);
-        self.manipulator.observe(&mut out[..m]);
-        self.board.board().write_f32(&mut out[m..m + d]);
-        out[m + d] = self.spec.remaining_time(self.steps);
+        self.manipulator
+            .observe(&mut out[..self.spec.manipulator_dim]);
+        self.spec.observe_board(self.board.board(), self.steps, out);
     }
 
     fn board(&self) -> SymbolicState {

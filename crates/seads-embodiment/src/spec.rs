@@ -45,6 +45,15 @@ impl EnvSpec {
         }
     }
 
+    /// Writes the board side of an observation after the manipulator's `manipulator_dim`
+    /// entries: the board's bits, then the remaining time after `steps` steps. Every environment
+    /// observes its board through this one rule.
+    pub fn observe_board(&self, board: SymbolicState, steps: usize, out: &mut [f32]) {
+        let (m, d) = (self.manipulator_dim, self.symbolic_len);
+        board.write_f32(&mut out[m..m + d]);
+        out[m + d] = self.remaining_time(steps);
+    }
+
     /// Checks an action's length and that every entry is finite.
     pub fn check_action(&self, action: &[f32]) -> Result<(), crate::EnvError> {
         if action.len() != self.action_dim {

@@ -4,12 +4,12 @@
 use std::sync::{Arc, Mutex, MutexGuard};
 use std::time::Duration;
 
-use rand::{RngExt, SeedableRng};
-use rand_chacha::ChaCha8Rng;
+use rand::RngExt;
 use seads_embodiment::{
-    EnvError, EnvSpec, Environment, FieldView, Layout, Push, Scene, Shape, StepOutcome,
+    BoardState, EnvConfig, EnvError, EnvSpec, Environment, FieldView, Layout, Push, Scene, Shape,
+    StepOutcome,
 };
-use seads_games::{BoardDataset, BoardGame, GameKind, LightsOut, Split, SymbolicState};
+use seads_games::{BoardGame, GameKind, LightsOut, SymbolicState};
 use serde::{Deserialize, Serialize};
 
 use crate::UarmError;
@@ -161,9 +161,10 @@ struct Hardware {
     calibration: Calibration,
     /// Pen position over the screen, normalised.
     cursor: [f64; 2],
-    board: SymbolicState,
+    /// The board side every environment has: the board the tablet last reported and the reset
+    /// distribution with its stream (the twin's resets draw the pen's position after the board).
+    board: BoardState,
     seq: u64,
-    rng: ChaCha8Rng,
 }
 
 /// The arm and the tablet as an [`Environment`]. Clones share the hardware (`spec().exclusive`):
@@ -174,7 +175,6 @@ pub struct UarmEnv {
     config: UarmConfig,
     hardware: Arc<Mutex<Hardware>>,
     steps: usize,
-    boards: Arc<BoardDataset>,
 }
 
 impl UarmEnv {
@@ -219,22 +219,24 @@ impl UarmEnv {
         let centre = [0.5, 0.5];
         arm.move_to(calibration.to_arm(0.5, 0.5, HOVER_DISPLACEMENT))?;
         let report = tablet.latest(Duration::from_secs_f64(config.tap_timeout_s.max(1.0)))?;
+        let mut board = BoardState::new(GameKind::LightsOut, 5, &EnvConfig::default())
+            .expect("LightsOut 5×5 has boards of depth 1 to 5");
+        board
+            .set(report.board)
+            .expect("every 5×5 pattern is a LightsOut board");
         let hardware = Hardware {
             arm,
             tablet,
             calibration,
             cursor: centre,
-            board: report.board,
+            board,
             seq: report.seq,
-            rng: ChaCha8Rng::seed_from_u64(0),
         };
-        let boards = Arc::new(BoardDataset::build(&game, 5).expect("enumerable"));
         Ok(Self {
             spec,
             config,
             hardware: Arc::new(Mutex::new(hardware)),
             steps: 0,
-            boards,
         })
     }
 
@@ -267,8 +269,10 @@ impl UarmEnv {
         Ok(match report {
             Some(r) => {
                 hw.seq = r.seq;
-                let changed = r.board != hw.board;
-                hw.board = r.board;
+                let changed = r.board != hw.board.board();
+                hw.board
+                    .set(r.board)
+                    .map_err(|e| UarmError::Tablet(e.to_string()))?;
                 match r.game_move {
                     Some(m) if changed => Push::Move(m),
                     _ => Push::Miss,
@@ -314,7 +318,7 @@ impl Environment for UarmEnv {
     }
 
     fn seed(&mut self, seed: u64) {
-        self.lock().rng = ChaCha8Rng::seed_from_u64(seed);
+        self.lock().board.seed(seed);
     }
 
     fn reset(&mut self) -> Result<(), EnvError> {
@@ -323,15 +327,16 @@ impl Environment for UarmEnv {
             return Ok(());
         }
         let mut hw = self.lock();
-        let depth = hw.rng.random_range(1..=5);
-        let board = self
-            .boards
-            .sample(depth, Split::Train, &mut hw.rng)
-            .expect("LightsOut has boards of depth 1..5");
-        let cursor = [hw.rng.random::<f64>(), hw.rng.random::<f64>()];
+        let before = hw.board.board();
+        hw.board.reset();
+        let board = hw.board.board();
+        let rng = hw.board.rng();
+        let cursor = [rng.random::<f64>(), rng.random::<f64>()];
         let result = (|| {
-            hw.tablet.set_board(board)?;
-            hw.board = board;
+            if let Err(e) = hw.tablet.set_board(board) {
+                let _ = hw.board.set(before); // the tablet still shows it
+                return Err(e);
+            }
             hw.seq = hw.tablet.latest(Duration::ZERO)?.seq;
             let target = hw.calibration.to_arm(cursor[0], cursor[1], self.hover());
             hw.arm.move_to(target)?;
@@ -372,23 +377,24 @@ impl Environment for UarmEnv {
         let hw = self.lock();
         out[0] = hw.cursor[0] as f32;
         out[1] = hw.cursor[1] as f32;
-        hw.board.write_f32(&mut out[2..27]);
-        out[27] = self.spec.remaining_time(self.steps);
+        self.spec.observe_board(hw.board.board(), self.steps, out);
     }
 
     fn board(&self) -> SymbolicState {
-        self.lock().board
+        self.lock().board.board()
     }
 
     fn set_board(&mut self, board: SymbolicState) -> Result<(), EnvError> {
         let mut hw = self.lock();
-        hw.tablet
-            .set_board(board)
-            .map_err(|e| EnvError::Unsupported {
+        let before = hw.board.board();
+        hw.board.set(board)?;
+        if let Err(e) = hw.tablet.set_board(board) {
+            let _ = hw.board.set(before); // the tablet still shows it
+            return Err(EnvError::Unsupported {
                 env: self.spec.name.clone(),
                 what: e.to_string(),
-            })?;
-        hw.board = board;
+            });
+        }
         if let Ok(r) = hw.tablet.latest(Duration::ZERO) {
             hw.seq = r.seq;
         }
@@ -430,7 +436,7 @@ impl Environment for UarmEnv {
             .enumerate()
             .map(|(d, rect)| FieldView {
                 rect,
-                lit: Some(hw.board.get(d)),
+                lit: Some(hw.board.board().get(d)),
                 label: None,
                 height: 0.0,
             })

@@ -348,31 +348,48 @@ fn episodes_on_one_robot_run_one_after_another() {
     }
 }
 
-/// The robot observes its remaining time by the rule every environment shares: after each step,
-/// with a step limit of 10, of 1, and with none (as when recording), the twin's last entry is the
-/// LightsOutCursor's.
+/// The robot's board side is every environment's (`BoardState`, `EnvSpec::observe_board`):
+/// seeded alike, the twin that resets its board and the LightsOutCursor draw the same boards;
+/// given the same board, both observe it and their remaining time alike after every step, with a
+/// step limit of 10, of 1, and with none (as when recording).
 #[test]
-fn the_twin_observes_remaining_time_as_the_cursor_does() {
+fn the_twin_observes_its_board_and_remaining_time_as_the_cursor_does() {
     let twin = Twin::new(8);
     let mut robot = env(&twin, ActionSpace::Displacement);
     let mut cursor =
         seads_embodiment::make_env("lightsout-cursor", &seads_embodiment::EnvConfig::default())
             .unwrap();
+    let board_side = |obs: Vec<f32>| obs[2..].to_vec();
+    for seed in [1, 2, 3, 40] {
+        robot.seed(seed);
+        cursor.seed(seed);
+        robot.reset().unwrap();
+        cursor.reset().unwrap();
+        assert_eq!(robot.board(), cursor.board(), "seed {seed}");
+        assert_eq!(
+            board_side(robot.observation()),
+            board_side(cursor.observation()),
+            "seed {seed}"
+        );
+    }
+    let board = LightsOut::new(5)
+        .unwrap()
+        .apply_all(Default::default(), &[0, 7, 24]);
     for limit in [Some(10), Some(1), None] {
         robot.set_step_limit(limit);
         cursor.set_step_limit(limit);
+        robot.set_board(board).unwrap();
+        cursor.set_board(board).unwrap();
         robot.reset_step_counter();
         cursor.reset_step_counter();
-        for step in 0..limit.unwrap_or(3) {
+        for step in 0..=limit.unwrap_or(3) {
             let (r, c) = (robot.observation(), cursor.observation());
-            assert_eq!(r[27], c[27], "limit {limit:?}, step {step}");
+            assert_eq!(board_side(r), board_side(c), "limit {limit:?}, step {step}");
+            if Some(step) == limit {
+                break;
+            }
             robot.step(&[0.0, 0.0, -1.0]).unwrap();
             cursor.step(&[0.0, 0.0, -1.0]).unwrap();
         }
-        assert_eq!(
-            robot.observation()[27],
-            cursor.observation()[27],
-            "limit {limit:?}"
-        );
     }
 }
