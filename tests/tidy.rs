@@ -108,18 +108,20 @@ fn normal_graph(meta: &serde_json::Value) -> Vec<(String, String, Vec<String>)> 
 /// The internal dependencies are the ones docs/ARCHITECTURE.md states, and only the crates it
 /// names link libtorch (tch), counting dependencies of dependencies.
 #[test]
-fn crate_dependencies_point_one_way_and_only_four_crates_link_libtorch() {
+fn crate_dependencies_point_one_way_and_only_five_crates_link_libtorch() {
     let meta = metadata();
     let graph = normal_graph(&meta);
     let expected: &[(&str, &[&str])] = &[
         ("seads-games", &[]),
+        ("seads-nn", &[]),
         ("seads-embodiment", &["seads-games"]),
-        ("seads-skillmodel", &["seads-games"]),
+        ("seads-skillmodel", &["seads-games", "seads-nn"]),
         (
             "seads-rl",
             &[
                 "seads-embodiment",
                 "seads-games",
+                "seads-nn",
                 "seads-planner",
                 "seads-skillmodel",
             ],
@@ -185,7 +187,13 @@ fn crate_dependencies_point_one_way_and_only_four_crates_link_libtorch() {
         .collect();
     assert_eq!(
         linking,
-        ["seads-skillmodel", "seads-rl", "seads-study", "seads-cli"]
+        [
+            "seads-nn",
+            "seads-skillmodel",
+            "seads-rl",
+            "seads-study",
+            "seads-cli"
+        ]
     );
 }
 

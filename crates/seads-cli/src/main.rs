@@ -110,9 +110,9 @@ pub fn study_error(e: seads_study::StudyError) -> anyhow::Error {
 }
 
 /// Takes the run directory `dir` for this command, the one writer it may have at a time (see
-/// [`seads_rl::RunLock`]); another writer holding it is exit 2, naming it. Waits a moment, for a
+/// [`seads_rl::store::RunLock`]); another writer holding it is exit 2, naming it. Waits a moment, for a
 /// `sweep status` that looks at the lock.
-pub fn lock_run(dir: &std::path::Path) -> anyhow::Result<seads_rl::RunLock> {
+pub fn lock_run(dir: &std::path::Path) -> anyhow::Result<seads_rl::store::RunLock> {
     use anyhow::Context as _;
     // Only a run directory is locked: anything else is said as such.
     seads_rl::load_config(dir).with_context(|| format!("loading run {}", dir.display()))?;
@@ -121,7 +121,7 @@ pub fn lock_run(dir: &std::path::Path) -> anyhow::Result<seads_rl::RunLock> {
         .collect::<Vec<_>>()
         .join(" ");
     command.truncate(200);
-    seads_rl::RunLock::acquire(dir, &command, std::time::Duration::from_secs(2)).map_err(
+    seads_rl::store::RunLock::acquire(dir, &command, std::time::Duration::from_secs(2)).map_err(
         |e| match e {
             seads_rl::RlError::Busy { .. } => BadInput(e.into()).into(),
             other => anyhow::Error::from(other),

@@ -122,7 +122,7 @@ pub fn train(args: TrainArgs) -> Result<()> {
 fn create<L: Learner>(
     out: &std::path::Path,
     config: TrainConfig,
-) -> Result<(Run<L>, seads_rl::RunLock)> {
+) -> Result<(Run<L>, seads_rl::store::RunLock)> {
     let run = Run::create(out, config).map_err(|e| match e {
         seads_rl::RlError::Config(_) => anyhow::Error::from(BadInput(e.into())),
         other => anyhow::Error::from(other),
@@ -211,7 +211,7 @@ pub fn drive<L: InWords>(run: &mut Run<L>, quiet: bool) -> Result<()> {
     );
     bar.set_position(run.trainer().steps().min(budget));
     // A resumed run shows its last evaluation until the next one.
-    let mut headline = seads_rl::read_metrics_as::<L::Metrics>(run.dir())
+    let mut headline = seads_rl::store::read_metrics_as::<L::Metrics>(run.dir())
         .ok()
         .and_then(|m| m.last().map(|m| run.trainer().headline(m)))
         .unwrap_or_default();

@@ -7,11 +7,11 @@ use seads_embodiment::{EnvSpec, SkillPolicy, make_env};
 use seads_skillmodel::{ForwardModel, SkillModel, SkillModelKind};
 use tch::Device;
 
+use crate::episode::policy_input;
 use crate::hac::HacPolicy;
+use crate::store::{checkpoints, latest_checkpoint};
 use crate::task_policy::TaskPolicy;
-use crate::{
-    Algorithm, RlError, Sac, TrainConfig, checkpoints, latest_checkpoint, load_config, policy_input,
-};
+use crate::{Algorithm, RlError, Sac, TrainConfig, load_config};
 
 /// The skill policy π(a | s, k) of a trained agent, executed deterministically.
 pub struct AgentPolicy {

@@ -49,7 +49,7 @@ mod replay;
 mod run;
 mod sac;
 mod seeds;
-mod store;
+pub mod store;
 mod task_episodes;
 mod task_policy;
 mod task_sac;
@@ -58,26 +58,21 @@ mod trainer;
 use std::path::Path;
 
 pub use agent::{Agent, AgentPolicy, find_checkpoint, load_policy};
-pub use buffers::{RelabelBatch, RelabelObserver, Relabelling};
+pub use buffers::{RelabelBatch, Relabelling};
 pub use config::{
-    Algorithm, BaselineConfig, HacConfig, RelabelConfig, TrainConfig, config_difference,
-    machine_memory_bytes, merge_toml,
+    Algorithm, BaselineConfig, HacConfig, RelabelConfig, TrainConfig, machine_memory_bytes,
+    merge_toml,
 };
-pub use episode::{Episode, policy_input, run_episodes, skill_coverage};
+pub use episode::{Episode, run_episodes, skill_coverage};
 pub use hac::{Hac, HacPolicy};
 pub use in_words::{BaselineInWords, InWords};
 pub use learner::{Hook, Learner, Moment};
 pub use metrics::{Metrics, read_metrics};
-pub use numerics::{FAST_KERNELS, PORTABLE_KERNELS, kernel_environment, portable_kernels_active};
+pub use numerics::{PORTABLE_KERNELS, kernel_environment, portable_kernels_active};
 pub use relaxed::RelaxedBernoulli;
 pub use run::{Run, RunEvent, load_config, raise_budget};
 pub use sac::{Sac, SacConfig, SacLosses, TransitionBatch, checkpoint_files};
-pub use seeds::{Purpose, derived_seed, stream, train_env_seed};
-pub use store::{
-    METRICS, MetricsLine, RUN_LOCK, RunLock, append_json_line, check_origin, checkpoint_id,
-    checkpoint_name, checkpoints, is_copy_without_checkpoints, last_env_steps, latest_checkpoint,
-    read_json_lines, read_metrics_as, run_is_locked, write_atomic,
-};
+pub use seeds::{Purpose, derived_seed, stream};
 pub use task_episodes::{TaskEpochStats, TaskTimings, updates_due};
 pub use task_policy::{TaskPolicy, task_success};
 pub use task_sac::{TaskMetrics, TaskSac};

@@ -9,7 +9,7 @@ use std::path::Path;
 use rand::{Rng, RngExt, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use rand_distr::{Distribution, StandardNormal};
-use seads_skillmodel::nn::{Adam, Mlp, flatten_parameters, mean_f32, xavier_linear};
+use seads_nn::{Adam, Mlp, flatten_parameters, mean_f32, xavier_linear};
 use serde::{Deserialize, Serialize};
 use tch::nn::{self, Module};
 use tch::{Device, Kind, Tensor};

@@ -1,9 +1,14 @@
-//! The files of a run directory and how they are written, so that a crash at any point leaves a
-//! directory that resumes to exactly the run it would have been.
+//! The run store: the files of a run directory and how they are written, so that a crash at any
+//! point leaves a directory that resumes to exactly the run it would have been. Its public API is
+//! what studies and the command line read and write beside a run: atomic writes
+//! ([`write_atomic`]), JSON Lines ([`read_json_lines`], [`append_json_line`]), the metrics
+//! ([`METRICS`], [`read_metrics_as`], [`last_env_steps`]), the checkpoints ([`checkpoints`],
+//! [`latest_checkpoint`], [`checkpoint_id`], [`is_copy_without_checkpoints`]) and the run's one
+//! writer ([`RunLock`], [`run_is_locked`]); the rest serves [`Run`](crate::Run) alone.
 //!
 //! The contract (docs/ARCHITECTURE.md, "Invariants"):
 //! - every file is written to a temporary name, fsynced, renamed into place and its folder
-//!   fsynced ([`write_atomic`]); a checkpoint is a folder written the same way ([`commit_dir`]);
+//!   fsynced ([`write_atomic`]); a checkpoint is a folder written the same way (`commit_dir`);
 //! - `metrics.jsonl` only grows by whole lines, each fsynced before the checkpoint that follows
 //!   it; a line cut by a crash has no newline and is dropped when read ([`read_metrics_as`]);
 //! - the two newest checkpoints keep what resuming needs, so one that cannot be read has a
@@ -39,15 +44,15 @@ pub trait MetricsLine: Serialize + DeserializeOwned {
 }
 
 /// The folder of checkpoints in a run directory.
-pub const CHECKPOINTS: &str = "checkpoints";
+pub(crate) const CHECKPOINTS: &str = "checkpoints";
 /// The file in [`CHECKPOINTS`] that names the latest complete checkpoint.
-pub const LATEST: &str = "latest";
+pub(crate) const LATEST: &str = "latest";
 /// The evaluation log of a run directory.
 pub const METRICS: &str = "metrics.jsonl";
 /// The configuration of a run directory.
-pub const CONFIG: &str = "config.toml";
+pub(crate) const CONFIG: &str = "config.toml";
 /// In every checkpoint folder: the environment and algorithm that wrote it.
-pub const ORIGIN: &str = "origin.json";
+pub(crate) const ORIGIN: &str = "origin.json";
 
 /// Where a checkpoint comes from.
 #[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
@@ -81,7 +86,7 @@ pub(crate) fn check_config(checkpoint: &Path, config: &crate::TrainConfig) -> Re
     };
     let trained =
         crate::TrainConfig::from_toml(&text).map_err(|e| RlError::unreadable(&path, e))?;
-    match crate::config_difference(config, &trained) {
+    match crate::config::config_difference(config, &trained) {
         None => Ok(()),
         Some((field, now, then)) => Err(RlError::Config(format!(
             "config.toml differs from the configuration that checkpoint {} was trained with: \
@@ -93,7 +98,7 @@ pub(crate) fn check_config(checkpoint: &Path, config: &crate::TrainConfig) -> Re
 
 /// Refuses a checkpoint written by a run of another environment or algorithm than `config`'s,
 /// naming both. A checkpoint without an origin (written before it was recorded) passes.
-pub fn check_origin(checkpoint: &Path, config: &crate::TrainConfig) -> Result<(), RlError> {
+pub(crate) fn check_origin(checkpoint: &Path, config: &crate::TrainConfig) -> Result<(), RlError> {
     let path = checkpoint.join(ORIGIN);
     let Ok(text) = fs::read_to_string(&path) else {
         return Ok(());
@@ -124,7 +129,7 @@ pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<(), RlError> {
 }
 
 /// fsyncs a folder, so that the names created or renamed in it survive a power loss.
-pub fn sync_dir(dir: &Path) -> Result<(), RlError> {
+pub(crate) fn sync_dir(dir: &Path) -> Result<(), RlError> {
     fs::File::open(dir)
         .and_then(|d| d.sync_all())
         .map_err(|e| RlError::io(dir, e))
@@ -134,7 +139,7 @@ pub fn sync_dir(dir: &Path) -> Result<(), RlError> {
 /// moves an existing `dest` aside, renames, fsyncs the parent, then removes what was aside.
 /// A crash leaves either the old `dest` or the new one (and at most a hidden leftover that
 /// [`clean_leftovers`] removes).
-pub fn commit_dir(tmp: &Path, dest: &Path) -> Result<(), RlError> {
+pub(crate) fn commit_dir(tmp: &Path, dest: &Path) -> Result<(), RlError> {
     for entry in fs::read_dir(tmp).map_err(|e| RlError::io(tmp, e))? {
         let path = entry.map_err(|e| RlError::io(tmp, e))?.path();
         fs::File::open(&path)
@@ -157,7 +162,7 @@ pub fn commit_dir(tmp: &Path, dest: &Path) -> Result<(), RlError> {
 }
 
 /// `.NAME.SUFFIX` beside `path`: where a checkpoint folder is written or set aside.
-pub fn hidden_sibling(path: &Path, suffix: &str) -> PathBuf {
+pub(crate) fn hidden_sibling(path: &Path, suffix: &str) -> PathBuf {
     let name = path
         .file_name()
         .map_or_else(Default::default, |n| n.to_string_lossy());
@@ -166,7 +171,7 @@ pub fn hidden_sibling(path: &Path, suffix: &str) -> PathBuf {
 
 /// Removes the hidden leftovers of interrupted writes in `dir` (temporary checkpoint folders,
 /// folders set aside, temporary files). Returns their names.
-pub fn clean_leftovers(dir: &Path) -> Result<Vec<String>, RlError> {
+pub(crate) fn clean_leftovers(dir: &Path) -> Result<Vec<String>, RlError> {
     let mut removed = Vec::new();
     let entries = match fs::read_dir(dir) {
         Ok(entries) => entries,
@@ -192,7 +197,7 @@ pub fn clean_leftovers(dir: &Path) -> Result<Vec<String>, RlError> {
 }
 
 /// The lock file of a run directory.
-pub const RUN_LOCK: &str = "task.lock";
+pub(crate) const RUN_LOCK: &str = "task.lock";
 
 /// The right to write into a run directory, held by one process at a time: an OS file lock on
 /// `task.lock`, which the operating system releases when the process dies, so it is never stale.
@@ -257,14 +262,14 @@ pub fn run_is_locked(dir: &Path) -> bool {
 /// The name of the checkpoint of epoch `epoch`.
 ///
 /// ```
-/// assert_eq!(seads_rl::checkpoint_name(1800), "epoch-001800");
+/// assert_eq!(seads_rl::store::checkpoint_name(1800), "epoch-001800");
 /// ```
 pub fn checkpoint_name(epoch: u64) -> String {
     format!("epoch-{epoch:06}")
 }
 
 /// The epoch of a checkpoint folder name (`epoch-` and digits only), or `None`.
-pub fn checkpoint_epoch(name: &str) -> Option<u64> {
+pub(crate) fn checkpoint_epoch(name: &str) -> Option<u64> {
     let digits = name.strip_prefix("epoch-")?;
     if digits.is_empty() || !digits.bytes().all(|b| b.is_ascii_digit()) {
         return None;
@@ -292,7 +297,7 @@ pub fn checkpoints(dir: &Path) -> Result<Vec<(u64, PathBuf)>, RlError> {
 
 /// What `checkpoints/latest` holds.
 #[derive(Debug, Clone, PartialEq, Eq)]
-pub enum Latest {
+pub(crate) enum Latest {
     /// There is no pointer.
     Absent,
     /// The pointer names this checkpoint folder of the run (which may be missing).
@@ -304,7 +309,7 @@ pub enum Latest {
 
 /// Reads `checkpoints/latest`. Only a checkpoint name (`epoch-NNNNNN`) is followed, so the
 /// pointer never leads outside the run.
-pub fn read_latest(dir: &Path) -> Result<Latest, RlError> {
+pub(crate) fn read_latest(dir: &Path) -> Result<Latest, RlError> {
     let pointer = dir.join(CHECKPOINTS).join(LATEST);
     match fs::read(&pointer) {
         Ok(bytes) => Ok(match std::str::from_utf8(&bytes).map(str::trim) {
@@ -328,7 +333,7 @@ pub fn read_latest(dir: &Path) -> Result<Latest, RlError> {
 
 /// The checkpoint `checkpoints/latest` names, if the pointer exists and names one of the run's
 /// checkpoints; the folder may be missing.
-pub fn latest_pointer(dir: &Path) -> Result<Option<PathBuf>, RlError> {
+pub(crate) fn latest_pointer(dir: &Path) -> Result<Option<PathBuf>, RlError> {
     Ok(match read_latest(dir)? {
         Latest::Names(path) => Some(path),
         Latest::Absent | Latest::Unusable(_) => None,
@@ -439,7 +444,7 @@ pub fn read_json_lines<T: DeserializeOwned>(path: &Path) -> Result<(Vec<T>, bool
 }
 
 /// Appends one line to `dir/metrics.jsonl` and fsyncs it.
-pub fn append_metrics<M: MetricsLine>(dir: &Path, metrics: &M) -> Result<(), RlError> {
+pub(crate) fn append_metrics<M: MetricsLine>(dir: &Path, metrics: &M) -> Result<(), RlError> {
     append_json_line(&dir.join(METRICS), metrics)
 }
 
@@ -465,7 +470,7 @@ pub fn append_json_line<T: Serialize>(path: &Path, value: &T) -> Result<(), RlEr
 }
 
 /// Rewrites `dir/metrics.jsonl` with exactly `metrics`.
-pub fn write_metrics<M: MetricsLine>(dir: &Path, metrics: &[M]) -> Result<(), RlError> {
+pub(crate) fn write_metrics<M: MetricsLine>(dir: &Path, metrics: &[M]) -> Result<(), RlError> {
     let path = dir.join(METRICS);
     let mut text = String::new();
     for m in metrics {

@@ -3,9 +3,9 @@
 //! SEADS protocol's boards, and the presets against the seed's settings.
 
 use seads_planner::TaskSet;
+use seads_rl::store::read_metrics_as;
 use seads_rl::{
-    Algorithm, Hac, Learner, Run, TaskMetrics, TaskSac, TrainConfig, read_metrics_as, task_success,
-    updates_due,
+    Algorithm, Hac, Learner, Run, TaskMetrics, TaskSac, TrainConfig, task_success, updates_due,
 };
 
 /// A small baseline run on LightsOutCursor: 8 environments, one update per epoch once 32
@@ -431,7 +431,7 @@ fn a_checkpoint_of_another_environment_is_refused_naming_both() {
         text.contains("a sac run on lightsout-cursor, not a sac run on tileswap-cursor"),
         "{text}"
     );
-    let latest = seads_rl::latest_checkpoint(tileswap.path())
+    let latest = seads_rl::store::latest_checkpoint(tileswap.path())
         .unwrap()
         .unwrap();
     let e = seads_rl::load_policy(&config, &latest)

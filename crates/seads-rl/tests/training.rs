@@ -3,10 +3,8 @@
 
 use rand::{RngExt, SeedableRng};
 use rand_chacha::ChaCha8Rng;
-use seads_rl::{
-    RlError, Run, Sac, SacConfig, TrainConfig, Trainer, TransitionBatch, checkpoints,
-    latest_checkpoint, read_metrics,
-};
+use seads_rl::store::{checkpoints, latest_checkpoint};
+use seads_rl::{RlError, Run, Sac, SacConfig, TrainConfig, Trainer, TransitionBatch, read_metrics};
 use tch::Device;
 
 mod common;

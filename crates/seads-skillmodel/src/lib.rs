@@ -1,10 +1,10 @@
 //! The symbolic skill model of SEADS (SPEC §3.4–3.6, §3.9): the forward model q(z_T | z_0, k)
 //! and the VIC discriminator behind [`SkillModel`], the intrinsic reward with its clip,
 //! second-best normalisation and novelty bonus, and relabelling by a minimum-cost assignment.
-//! It also holds the small tch building blocks ([`nn::Mlp`], [`nn::Adam`]) that `seads-rl` reuses.
+//! Its networks are built from `seads-nn`'s blocks, as SAC's are.
 //!
-//! Architecture invariant: with `seads-rl`, the only crate that links libtorch. Rewards and
-//! relabelling are plain functions on slices, testable without a network.
+//! Architecture invariant: rewards and relabelling are plain functions on slices, testable
+//! without a network.
 //!
 //! # Example: the reward of an episode, and relabelling
 //!
@@ -29,7 +29,6 @@
 
 mod groundtruth;
 mod model;
-pub mod nn;
 mod relabel;
 mod reward;
 mod screen;

@@ -11,8 +11,8 @@ use tch::nn::{self, Module};
 use tch::{Device, Kind, Tensor};
 
 use crate::SkillModelError;
-use crate::nn::{Adam, Mlp, mean_f32};
 use crate::screen::{Int8Screen, MAX_WIDTH, MIN_ROWS};
+use seads_nn::{Adam, Mlp, mean_f32};
 
 /// float32 machine epsilon: α is clamped to [ε, 1 − ε] as PyTorch's Bernoulli does.
 const EPS: f64 = 1.192_092_9e-7;

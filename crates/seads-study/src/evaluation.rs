@@ -18,8 +18,8 @@ use crate::{Context as _, Result, StudyError};
 /// Which checkpoint `agent` is, and `None` where it is the run's latest (whose evaluation takes
 /// the plain file names) or `Some(epoch)` for an earlier one.
 pub fn checkpoint_of(run: &Path, checkpoint: &Path) -> Result<(CheckpointId, Option<u64>)> {
-    let id = seads_rl::checkpoint_id(run, checkpoint)?;
-    let latest = seads_rl::latest_checkpoint(run)?;
+    let id = seads_rl::store::checkpoint_id(run, checkpoint)?;
+    let latest = seads_rl::store::latest_checkpoint(run)?;
     let named = (latest.as_deref() != Some(checkpoint)).then_some(id.epoch);
     Ok((id, named))
 }
@@ -36,12 +36,12 @@ pub fn save_evaluation(
         .protocol
         .as_ref()
         .ok_or_else(|| StudyError::failed("an evaluation is saved with its protocol"))?;
-    seads_rl::write_atomic(
+    seads_rl::store::write_atomic(
         &run.join(protocol.results_file(named_epoch)),
         record.to_json().as_bytes(),
     )?;
     if let Some(lines) = task_lines {
-        seads_rl::write_atomic(
+        seads_rl::store::write_atomic(
             &run.join(protocol.tasks_file(named_epoch)),
             lines.as_bytes(),
         )?;
@@ -109,7 +109,7 @@ pub fn read_over_training(run: &Path) -> Result<Vec<CheckpointEvaluation>> {
     if !path.exists() {
         return Ok(Vec::new());
     }
-    Ok(seads_rl::read_json_lines(&path)?.0)
+    Ok(seads_rl::store::read_json_lines(&path)?.0)
 }
 
 /// The evaluations over training of the run in `run` made on `tasks` with `limits` (the file may

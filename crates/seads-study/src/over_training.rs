@@ -121,7 +121,7 @@ pub fn evaluate_checkpoints(
     mut progress: impl FnMut(Progress),
 ) -> Result<usize> {
     let config = seads_rl::load_config(run).doing(|| format!("reading {}", run.display()))?;
-    let kept = seads_rl::checkpoints(run).doing(|| format!("reading {}", run.display()))?;
+    let kept = seads_rl::store::checkpoints(run).doing(|| format!("reading {}", run.display()))?;
     if kept.is_empty() {
         return Err(StudyError::invalid(format!(
             "{} has no checkpoint to evaluate",
@@ -163,7 +163,7 @@ pub fn evaluate_checkpoints(
                 progress(Progress::Task { depth: t.depth });
             },
         )?;
-        let env_steps = seads_rl::checkpoint_id(run, dir)?
+        let env_steps = seads_rl::store::checkpoint_id(run, dir)?
             .env_steps
             .ok_or_else(|| {
                 StudyError::failed(format!(
@@ -181,7 +181,7 @@ pub fn evaluate_checkpoints(
             max_expanded: limits.max_expanded,
             results,
         };
-        seads_rl::append_json_line(&path, &line)?;
+        seads_rl::store::append_json_line(&path, &line)?;
     }
     Ok(todo.len())
 }

@@ -82,7 +82,7 @@ impl Provenance {
         if !path.is_file() {
             return Ok(Vec::new());
         }
-        let (lines, _) = seads_rl::read_json_lines::<Provenance>(&path)?;
+        let (lines, _) = seads_rl::store::read_json_lines::<Provenance>(&path)?;
         let mut seen: Vec<String> = Vec::new();
         for line in lines {
             let cpu = line.cpu_model.unwrap_or_else(|| "unknown".to_owned());
@@ -95,7 +95,7 @@ impl Provenance {
 
     /// Appends this line to `run_dir`'s provenance file (a torn last line is repaired first).
     pub fn append(&self, run_dir: &Path) -> Result<(), seads_rl::RlError> {
-        seads_rl::append_json_line(&run_dir.join(PROVENANCE), self)
+        seads_rl::store::append_json_line(&run_dir.join(PROVENANCE), self)
     }
 }
 

@@ -141,7 +141,7 @@ fn train_and_evaluate_baseline<L: InWords>(sweep: &Sweep, run: &Path, cores: usi
     drop(training);
     if sweep.evaluation.last {
         // The final checkpoint holds the trained policy.
-        let checkpoint = seads_rl::latest_checkpoint(run)?
+        let checkpoint = seads_rl::store::latest_checkpoint(run)?
             .with_context(|| format!("{} has no checkpoint", run.display()))?;
         let results = run_policy_evaluation(
             &config,

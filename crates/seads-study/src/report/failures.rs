@@ -105,7 +105,7 @@ pub(super) fn read_tasks(run: &Path) -> Result<Option<Vec<TaskLine>>> {
     if !path.exists() {
         return Ok(None);
     }
-    Ok(Some(seads_rl::read_json_lines(&path)?.0))
+    Ok(Some(seads_rl::store::read_json_lines(&path)?.0))
 }
 
 /// The markdown section (without its heading) and two CSV tables (`failures.csv` per group,

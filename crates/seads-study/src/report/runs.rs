@@ -191,8 +191,11 @@ fn noisy_evaluations(
 
 /// The metrics lines of the run in `dir`; none without a metrics file (not started), and none
 /// with the reason added to `damage` when the file exists but cannot be read.
-fn metrics_or_damage<M: seads_rl::MetricsLine>(dir: &Path, damage: &mut Vec<String>) -> Vec<M> {
-    match seads_rl::read_metrics_as::<M>(dir) {
+fn metrics_or_damage<M: seads_rl::store::MetricsLine>(
+    dir: &Path,
+    damage: &mut Vec<String>,
+) -> Vec<M> {
+    match seads_rl::store::read_metrics_as::<M>(dir) {
         Ok(lines) => lines,
         Err(e) => {
             if dir.join("metrics.jsonl").exists() {

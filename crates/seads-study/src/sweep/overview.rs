@@ -43,7 +43,9 @@ pub fn progress(run: &Path, done: bool) -> u64 {
     if done {
         return budget;
     }
-    seads_rl::last_env_steps(run).unwrap_or(0).min(budget)
+    seads_rl::store::last_env_steps(run)
+        .unwrap_or(0)
+        .min(budget)
 }
 
 /// Every run of a sweep and the counts per status (the JSON of `seads sweep status --json`).
@@ -89,7 +91,7 @@ impl Overview {
                 seed: run.seed,
                 dir: path.display().to_string(),
                 status,
-                env_steps: seads_rl::last_env_steps(&path).unwrap_or(0),
+                env_steps: seads_rl::store::last_env_steps(&path).unwrap_or(0),
                 budget: seads_rl::load_config(&path).map_or(0, |c| c.env_steps),
                 attempts: record.as_ref().map_or(0, |r| r.attempts),
                 error,

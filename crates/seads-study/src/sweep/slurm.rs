@@ -93,8 +93,8 @@ pub fn write_scripts(
     std::fs::create_dir_all(folder.join("logs"))
         .doing(|| format!("creating {}", folder.display()))?;
     let paths = (folder.join("array.sbatch"), folder.join("report.sbatch"));
-    seads_rl::write_atomic(&paths.0, array.as_bytes())?;
-    seads_rl::write_atomic(&paths.1, report.as_bytes())?;
+    seads_rl::store::write_atomic(&paths.0, array.as_bytes())?;
+    seads_rl::store::write_atomic(&paths.1, report.as_bytes())?;
     Ok(paths)
 }
 

@@ -1,6 +1,6 @@
 //! The state of one run of a sweep, read from its directory alone (never from Slurm), so that
 //! `seads sweep status` tells the same on a laptop, a login node or inside a job:
-//! - `task.lock` is locked (the run's [`seads_rl::RunLock`], an OS file lock) while a task or any
+//! - `task.lock` is locked (the run's [`seads_rl::store::RunLock`], an OS file lock) while a task or any
 //!   other writer works on the run: a killed one releases it, so "running" can never be stale;
 //! - `task.json` records the last task's outcome: running, done or failed (with the error).
 
@@ -84,7 +84,7 @@ impl Record {
                 .map_or(0, |d| d.as_secs()),
             error,
         };
-        seads_rl::write_atomic(
+        seads_rl::store::write_atomic(
             &run.join(RECORD),
             (serde_json::to_string_pretty(&record)? + "\n").as_bytes(),
         )?;
@@ -101,7 +101,7 @@ fn present_outputs(run: &Path) -> Vec<String> {
         .filter(|n| n.starts_with("evaluation") && n.ends_with(".json"))
         .collect();
     outputs.sort();
-    outputs.insert(0, seads_rl::METRICS.to_owned());
+    outputs.insert(0, seads_rl::store::METRICS.to_owned());
     outputs
 }
 
@@ -124,8 +124,8 @@ pub fn check_outputs(run: &Path, record: &Record) -> std::result::Result<(), Mis
     };
     for name in listed {
         let path = run.join(&name);
-        let readable = if name == seads_rl::METRICS {
-            match seads_rl::read_json_lines::<serde_json::Value>(&path) {
+        let readable = if name == seads_rl::store::METRICS {
+            match seads_rl::store::read_json_lines::<serde_json::Value>(&path) {
                 Ok((lines, false)) if !lines.is_empty() => Ok(()),
                 Ok(_) => Err("it is empty or ends in a torn line".to_owned()),
                 Err(e) => Err(format!("{e}")),
@@ -160,11 +160,11 @@ fn hostname() -> String {
         .unwrap_or_default()
 }
 
-/// The exclusive claim of a task on a run (its [`seads_rl::RunLock`]), held until dropped (or
+/// The exclusive claim of a task on a run (its [`seads_rl::store::RunLock`]), held until dropped (or
 /// the process dies).
 #[derive(Debug)]
 pub struct Claim {
-    _lock: seads_rl::RunLock,
+    _lock: seads_rl::store::RunLock,
 }
 
 /// How long a Slurm task or a task started by hand waits for a run that another task holds:
@@ -179,7 +179,7 @@ impl Claim {
     /// Claims `run`, waiting up to `patience` for another task to release it; [`Taken`] if it
     /// does not.
     pub fn take(run: &Path, patience: Duration) -> Result<Self> {
-        match seads_rl::RunLock::acquire(run, "seads sweep task", patience) {
+        match seads_rl::store::RunLock::acquire(run, "seads sweep task", patience) {
             Ok(lock) => Ok(Self { _lock: lock }),
             Err(seads_rl::RlError::Busy { .. }) => Err(Taken(run.to_path_buf()).into()),
             Err(e) => Err(e).doing(|| format!("locking {}", run.display())),
@@ -189,7 +189,7 @@ impl Claim {
 
 /// Whether a task holds `run` now.
 pub fn is_claimed(run: &Path) -> bool {
-    seads_rl::run_is_locked(run)
+    seads_rl::store::run_is_locked(run)
 }
 
 /// Where a run stands.
@@ -254,7 +254,7 @@ pub fn status(run: &Path) -> Result<(Status, Option<Record>)> {
                 Err(Missing::Gone(_)) => Status::Pending,
                 Err(Missing::Unreadable(_)) => Status::Damaged,
             },
-            _ if seads_rl::is_copy_without_checkpoints(run) => Status::Copied,
+            _ if seads_rl::store::is_copy_without_checkpoints(run) => Status::Copied,
             Some(Outcome::Failed) => Status::Failed,
             Some(Outcome::Running) | None => Status::Pending,
         }

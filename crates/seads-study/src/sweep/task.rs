@@ -59,7 +59,7 @@ impl Task {
         }
         // Training it again from scratch would replace the data it holds; nothing is recorded,
         // so the run stays "copied".
-        if work != Work::Nothing && seads_rl::is_copy_without_checkpoints(&run) {
+        if work != Work::Nothing && seads_rl::store::is_copy_without_checkpoints(&run) {
             return Err(StudyError::Invalid(format!(
                 "{} holds a run's data but no checkpoints folder (copied in by `seads report \
                  --copy-runs`?): it is reported as it is and cannot be trained further",

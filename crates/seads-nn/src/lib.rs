@@ -1,5 +1,7 @@
-//! Small tch building blocks shared with `seads-rl`: MLPs with the reference's initialisation and
-//! an Adam whose state can be checkpointed.
+//! The network blocks of SEADS's learners, on tch: MLPs with the reference's (Xavier)
+//! initialisation drawn from a seeded stream, a flat view of a variable store's parameters, and an
+//! Adam whose state can be checkpointed. The skill model (`seads-skillmodel`) and SAC (`seads-rl`)
+//! are built from them.
 
 use rand::{Rng, RngExt};
 use tch::nn::{self, Module};
