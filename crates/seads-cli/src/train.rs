@@ -6,6 +6,7 @@ use std::path::PathBuf;
 use anyhow::{Context, Result};
 use clap::Args;
 use indicatif::{ProgressBar, ProgressStyle};
+use seads_rl::store::MetricsLine as _;
 use seads_rl::{
     Algorithm, Hac, Hook, InWords, Learner, Moment, Run, TaskSac, TrainConfig, Trainer,
 };
@@ -219,7 +220,7 @@ pub fn drive<L: InWords>(run: &mut Run<L>, quiet: bool) -> Result<()> {
         let event = run.step().context("training")?;
         if let Some(m) = &event.metrics {
             headline = run.trainer().headline(m);
-            let (epoch, steps, per_s) = L::metrics_steps(m);
+            let (epoch, steps, per_s) = (m.epoch(), m.env_steps(), m.steps_per_s());
             let line =
                 format!("epoch {epoch:>6}  steps {steps:>9}  {headline}  {per_s:>6.0} steps/s");
             // A hidden bar (quiet, or output not a terminal) drops `println`: print directly.
@@ -229,7 +230,7 @@ pub fn drive<L: InWords>(run: &mut Run<L>, quiet: bool) -> Result<()> {
                 bar.println(line);
             }
         }
-        let (epoch, steps) = L::stats_steps(&event.stats);
+        let (epoch, steps) = (run.trainer().epoch(), run.trainer().steps());
         let steps_per_s = steps as f64 / run.wall_s().max(1e-9);
         bar.set_position(steps.min(budget));
         bar.set_message(format!(

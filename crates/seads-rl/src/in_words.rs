@@ -8,10 +8,6 @@ use crate::{Hac, TaskEpochStats, TaskMetrics, TaskSac, Trainer};
 pub trait InWords: Learner {
     /// Environment steps so far.
     fn steps(&self) -> u64;
-    /// (epoch, environment steps) after an epoch.
-    fn stats_steps(stats: &Self::Stats) -> (u64, u64);
-    /// (epoch, environment steps, steps per second) of an evaluation.
-    fn metrics_steps(m: &Self::Metrics) -> (u64, u64, f64);
     /// What an evaluation found, in a few words ("coverage 24.10/25").
     fn headline(&self, m: &Self::Metrics) -> String;
     /// The time per phase, one line.
@@ -21,12 +17,6 @@ pub trait InWords: Learner {
 impl InWords for Trainer {
     fn steps(&self) -> u64 {
         self.env_steps()
-    }
-    fn stats_steps(stats: &Self::Stats) -> (u64, u64) {
-        (stats.epoch, stats.env_steps)
-    }
-    fn metrics_steps(m: &Self::Metrics) -> (u64, u64, f64) {
-        (m.epoch, m.env_steps, m.steps_per_s)
     }
     fn headline(&self, m: &Self::Metrics) -> String {
         format!(
@@ -59,12 +49,6 @@ pub trait BaselineInWords: Learner<Stats = TaskEpochStats, Metrics = TaskMetrics
 impl<B: BaselineInWords> InWords for B {
     fn steps(&self) -> u64 {
         self.env_steps()
-    }
-    fn stats_steps(stats: &Self::Stats) -> (u64, u64) {
-        (stats.epoch, stats.env_steps)
-    }
-    fn metrics_steps(m: &Self::Metrics) -> (u64, u64, f64) {
-        (m.epoch, m.env_steps, m.steps_per_s)
     }
     fn headline(&self, m: &Self::Metrics) -> String {
         format!("{}{}", task_headline(m), self.extra(m))

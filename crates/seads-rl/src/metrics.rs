@@ -42,6 +42,12 @@ impl MetricsLine for Metrics {
     fn wall_s(&self) -> f64 {
         self.wall_s
     }
+    fn env_steps(&self) -> u64 {
+        self.env_steps
+    }
+    fn steps_per_s(&self) -> f64 {
+        self.steps_per_s
+    }
 }
 
 /// The lines of `dir/metrics.jsonl`. A last line without its newline is the trace of a crash

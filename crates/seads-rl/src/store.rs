@@ -41,6 +41,10 @@ pub trait MetricsLine: Serialize + DeserializeOwned {
     fn epoch(&self) -> u64;
     /// Wall-clock seconds of the run when it was written.
     fn wall_s(&self) -> f64;
+    /// Environment steps when it was written.
+    fn env_steps(&self) -> u64;
+    /// Environment steps per wall-clock second of the run until then.
+    fn steps_per_s(&self) -> f64;
 }
 
 /// The folder of checkpoints in a run directory.

@@ -108,6 +108,12 @@ impl MetricsLine for TaskMetrics {
     fn wall_s(&self) -> f64 {
         self.wall_s
     }
+    fn env_steps(&self) -> u64 {
+        self.env_steps
+    }
+    fn steps_per_s(&self) -> f64 {
+        self.steps_per_s
+    }
 }
 
 /// A flat SAC agent in training on the task reward.
