@@ -70,18 +70,9 @@ pub fn record(args: RecordArgs) -> Result<()> {
     env.seed(args.seed);
     let mut rng = ChaCha8Rng::seed_from_u64(args.seed);
     // Written beside the output and renamed over it when complete: never a half-written file.
-    let name = args
-        .out
-        .file_name()
-        .map_or_else(|| "episodes".into(), |n| n.to_string_lossy().into_owned());
-    let tmp = args.out.with_file_name(format!(".{name}.tmp"));
-    let result = write_episodes(&args, &tmp, env.as_mut(), agent.as_ref(), &mut rng);
-    if let Err(e) = result {
-        let _ = std::fs::remove_file(&tmp);
-        return Err(e);
-    }
-    std::fs::rename(&tmp, &args.out)
-        .with_context(|| format!("renaming {} to {}", tmp.display(), args.out.display()))?;
+    let mut file = atomic_file(&args.out)?;
+    write_episodes(&args, &mut file, env.as_mut(), agent.as_ref(), &mut rng)?;
+    commit(file, &args.out)?;
     outln!(
         "recorded {} episodes of {} steps into {}",
         args.episodes,
@@ -91,10 +82,29 @@ pub fn record(args: RecordArgs) -> Result<()> {
     Ok(())
 }
 
-/// Records the episodes of `args` into the file `path`, synced to disk.
+/// A file written beside `path` and renamed over it, synced, only by [`commit`]: dropped
+/// without it (an error on the way), `path` stays as it was.
+fn atomic_file(path: &std::path::Path) -> Result<BufWriter<atomic_write_file::AtomicWriteFile>> {
+    let file = atomic_write_file::AtomicWriteFile::open(path)
+        .with_context(|| format!("creating {}", path.display()))?;
+    Ok(BufWriter::new(file))
+}
+
+/// Puts what [`atomic_file`] wrote in place of `path`.
+fn commit(
+    out: BufWriter<atomic_write_file::AtomicWriteFile>,
+    path: &std::path::Path,
+) -> Result<()> {
+    out.into_inner()
+        .map_err(|e| e.into_error())
+        .and_then(|file| file.commit())
+        .with_context(|| format!("writing {}", path.display()))
+}
+
+/// Records the episodes of `args` into `out`.
 fn write_episodes(
     args: &RecordArgs,
-    path: &std::path::Path,
+    out: &mut impl Write,
     env: &mut dyn seads_embodiment::Environment,
     agent: Option<&seads_rl::Agent>,
     rng: &mut ChaCha8Rng,
@@ -103,9 +113,6 @@ fn write_episodes(
         env.spec().action_low.clone(),
         env.spec().action_high.clone(),
     );
-    let file =
-        std::fs::File::create(path).with_context(|| format!("creating {}", path.display()))?;
-    let mut out = BufWriter::new(file);
     for i in 0..args.episodes {
         let mut episode = match &agent {
             None => record_episode(env, args.steps, |_, action| {
@@ -124,12 +131,8 @@ fn write_episodes(
         };
         episode.env = args.env.clone();
         writeln!(out, "{}", serde_json::to_string(&episode)?)
-            .with_context(|| format!("writing {}", path.display()))?;
+            .with_context(|| format!("writing {}", args.out.display()))?;
     }
-    out.into_inner()
-        .map_err(|e| e.into_error())
-        .and_then(|f| f.sync_all())
-        .with_context(|| format!("writing {}", path.display()))?;
     Ok(())
 }
 
@@ -158,9 +161,8 @@ pub fn replay(args: ReplayArgs) -> Result<()> {
     let m = env.spec().manipulator_dim;
     let input = std::fs::File::open(&args.input)
         .with_context(|| format!("opening {}", args.input.display()))?;
-    let file = std::fs::File::create(&args.out)
-        .with_context(|| format!("creating {}", args.out.display()))?;
-    let mut out = BufWriter::new(file);
+    // Written beside the output and renamed over it when every line is replayed.
+    let mut out = atomic_file(&args.out)?;
     let (mut episodes, mut differing) = (0, 0);
     for (number, line) in BufReader::new(input).lines().enumerate() {
         let line = line.with_context(|| format!("reading {}", args.input.display()))?;
@@ -187,7 +189,7 @@ pub fn replay(args: ReplayArgs) -> Result<()> {
         }
         episodes += 1;
     }
-    out.flush()?;
+    commit(out, &args.out)?;
     if differing > 0 {
         bail!("the board differs from the recording in {differing} of {episodes} episodes");
     }

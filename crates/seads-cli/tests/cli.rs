@@ -612,7 +612,9 @@ fn replay_reports_bad_lines_with_their_number() {
     assert!(out.status.success());
     let line = std::fs::read_to_string(&good).unwrap();
     let line = line.trim();
+    // A replay that fails leaves its output as it was: never half-written.
     let out_file = dir.path().join("out.jsonl");
+    std::fs::write(&out_file, "an earlier replay\n").unwrap();
     let cases = [
         (format!("{line}\n{{not json\n"), ":2: not an episode"),
         (
@@ -641,6 +643,11 @@ fn replay_reports_bad_lines_with_their_number() {
                 out_file.to_str().unwrap(),
             ],
             needle,
+        );
+        assert_eq!(
+            std::fs::read_to_string(&out_file).unwrap(),
+            "an earlier replay\n",
+            "{needle}"
         );
     }
     check_bad_input(
