@@ -810,8 +810,9 @@ fn a_deleted_run_is_planned_again_and_done_needs_readable_outputs() {
     assert_eq!(std::fs::read(&evaluation).unwrap(), b"{ torn");
 }
 
-/// `report --copy-runs` of a sweep in progress copies its finished runs only (an unfinished one
-/// resumes where it is), and the copy is reported again, naming the runs it lacks, none damaged.
+/// `report --copy-runs` of a sweep in progress copies its finished runs only (an unfinished one,
+/// or one a task still holds, resumes where it is), and the copy is reported again, naming the
+/// runs it lacks, none damaged.
 #[test]
 fn a_copy_of_a_sweep_in_progress_holds_its_finished_runs_and_reports_again() {
     let tmp = tempfile::tempdir().unwrap();
@@ -819,6 +820,21 @@ fn a_copy_of_a_sweep_in_progress_holds_its_finished_runs_and_reports_again() {
     let sweep = tmp.path().join("sweep");
     seads_ok(&["sweep", "plan", s(&manifest), "--out", s(&sweep)]);
     seads_ok(&["sweep", "run", s(&sweep), "--seeds", "1", "--quiet"]);
+    // While a task holds the run (as one does while it evaluates after the last step), the run
+    // is not finished, whatever its metrics say, and is not copied.
+    let seed_1 = sweep.join("runs/lightsout-cursor/seads/seed-1");
+    let held = std::fs::File::create(seed_1.join("task.lock")).unwrap();
+    held.lock().unwrap();
+    let busy = tmp.path().join("busy");
+    seads_ok(&["report", s(&sweep), "--out", s(&busy), "--copy-runs"]);
+    let md = std::fs::read_to_string(busy.join("report.md")).unwrap();
+    assert!(md.contains("a task works on it"), "{md}");
+    assert!(
+        !busy
+            .join("runs/tiny/runs/lightsout-cursor/seads/seed-1")
+            .exists()
+    );
+    drop(held);
     let out = tmp.path().join("report");
     seads_ok(&["report", s(&sweep), "--out", s(&out), "--copy-runs"]);
     let copied = out.join("runs/tiny/runs/lightsout-cursor/seads");

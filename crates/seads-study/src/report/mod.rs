@@ -138,9 +138,10 @@ pub fn write_report(options: &ReportOptions, out: &Path) -> Result<ReportSummary
         }
         let _ = writeln!(
             md,
-            "- unfinished: `{}` ({steps} of {} steps)",
+            "- unfinished: `{}` ({steps} of {} steps{})",
             run.dir.display(),
-            run.config.env_steps
+            run.config.env_steps,
+            if run.busy { "; a task works on it" } else { "" }
         );
     }
     if not_started > 0 {

@@ -49,12 +49,16 @@ pub struct RunData {
     /// Files of the run that could not be read, with why: such a run is left out of every
     /// table and listed as damaged.
     pub damage: Vec<String>,
+    /// A sweep's task holds the run now (training, or evaluating after its last step): not
+    /// finished, whatever its metrics say.
+    pub busy: bool,
 }
 
 impl RunData {
-    /// Whether training spent its budget.
+    /// Whether training spent its budget and no task works on the run any more (a sweep's task
+    /// evaluates a run after its last step).
     pub fn finished(&self) -> bool {
-        self.env_steps() >= self.config.env_steps
+        self.env_steps() >= self.config.env_steps && !self.busy
     }
 
     /// Environment steps at the last evaluation (0 before the first).
@@ -130,6 +134,7 @@ impl RunData {
             evaluation_notes,
             unrecorded_evaluations,
             damage,
+            busy: crate::sweep::is_claimed(dir),
             over_training: crate::evaluation::read_over_training(dir)?,
             processors: crate::provenance::Provenance::processors(dir)
                 .doing(|| format!("reading the provenance of {}", dir.display()))?,
@@ -385,5 +390,6 @@ pub(crate) fn bare_run(seed: u32) -> RunData {
         evaluation_notes: Vec::new(),
         unrecorded_evaluations: 0,
         damage: Vec::new(),
+        busy: false,
     }
 }
