@@ -183,14 +183,20 @@ impl Calibration {
             "# uArm screen calibration (seads uarm calibrate). Corners: TL, TR, BR, BL in mm.\n{}",
             toml::to_string(&self.file).expect("serialises")
         );
-        let io = |e: std::io::Error| UarmError::Io {
-            what: path.display().to_string(),
-            source: Box::new(e),
-        };
-        let mut file = atomic_write_file::AtomicWriteFile::open(path).map_err(io)?;
-        std::io::Write::write_all(&mut file, text.as_bytes()).map_err(io)?;
-        file.commit().map_err(io)
+        write_atomic(path, &text)
     }
+}
+
+/// Writes `text` to `path` atomically and durably (temporary file, fsync, rename): the uArm's
+/// settings files are never half-written.
+pub(crate) fn write_atomic(path: &Path, text: &str) -> Result<(), UarmError> {
+    let io = |e: std::io::Error| UarmError::Io {
+        what: format!("writing {}", path.display()),
+        source: Box::new(e),
+    };
+    let mut file = atomic_write_file::AtomicWriteFile::open(path).map_err(io)?;
+    std::io::Write::write_all(&mut file, text.as_bytes()).map_err(io)?;
+    file.commit().map_err(io)
 }
 
 /// The quadrilateral (in order) must be convex and wind consistently, with a real area.

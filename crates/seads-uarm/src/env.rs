@@ -111,15 +111,8 @@ impl RobotSettings {
 
     /// Writes them into the run in `run`, atomically.
     pub fn write(&self, run: &std::path::Path) -> Result<(), UarmError> {
-        let path = run.join(Self::FILE);
-        let io = |e: std::io::Error| UarmError::Io {
-            what: format!("writing {}", path.display()),
-            source: Box::new(e),
-        };
         let text = toml::to_string(self).expect("two plain fields serialise");
-        let mut file = atomic_write_file::AtomicWriteFile::open(&path).map_err(io)?;
-        std::io::Write::write_all(&mut file, text.as_bytes()).map_err(io)?;
-        file.commit().map_err(io)
+        crate::calibration::write_atomic(&run.join(Self::FILE), &text)
     }
 }
 
