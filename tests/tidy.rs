@@ -129,6 +129,10 @@ fn crate_dependencies_point_one_way_and_only_five_crates_link_libtorch() {
         ("seads-planner", &["seads-embodiment", "seads-games"]),
         ("seads-uarm", &["seads-embodiment", "seads-games"]),
         (
+            "seads-py",
+            &["seads-embodiment", "seads-games", "seads-planner"],
+        ),
+        (
             "seads-study",
             &[
                 "seads-embodiment",
@@ -243,6 +247,8 @@ fn light_crates_pull_in_neither_libtorch_nor_rapier() {
             &["tch", "torch-sys", "rapier3d"],
         ),
         (&["-p", "seads-embodiment"], &["tch", "torch-sys"]),
+        // The Python package: PyTorch's process must not get a second libtorch.
+        (&["-p", "seads-py"], &["tch", "torch-sys"]),
     ] {
         let packages = tree(args);
         assert!(
@@ -312,6 +318,24 @@ fn nothing_uses_libtorchs_global_generator() {
     }
 }
 
+/// The Python bindings allow `unsafe_code` for pyo3's macros only: their own source has none.
+#[test]
+fn the_python_bindings_write_no_unsafe_code() {
+    let sources = sources();
+    let bindings: Vec<_> = sources
+        .iter()
+        .filter(|(path, _)| path.starts_with(root().join("crates/seads-py/src")))
+        .collect();
+    assert!(bindings.len() >= 4, "found the bindings' files");
+    for (path, text) in bindings {
+        assert!(
+            !words(text).any(|w| w == "unsafe"),
+            "{} has unsafe code",
+            path.display()
+        );
+    }
+}
+
 /// Every registered environment has a shipped preset, and the trainer embeds every preset.
 #[test]
 fn every_environment_has_a_preset() {
@@ -355,7 +379,7 @@ fn generated(path: &str) -> bool {
 
 /// Every file path and test name that the two reference documents cite in backticks exists: a
 /// path (with a `/`, or a file name with an extension) somewhere in the repository, a test name
-/// (four or more words joined by `_`) as a `fn` in some Rust file.
+/// (four or more words joined by `_`) as a `fn` in some Rust file or a `def` in a Python one.
 #[test]
 fn the_documents_cite_only_files_and_tests_that_exist() {
     let mut files: Vec<String> = Vec::new();
@@ -390,6 +414,12 @@ fn the_documents_cite_only_files_and_tests_that_exist() {
         .filter(|f| f.ends_with(".rs"))
         .map(|f| std::fs::read_to_string(root().join(f)).unwrap())
         .collect();
+    // The Python package's tests (pytest) are cited by name too.
+    let python: String = files
+        .iter()
+        .filter(|f| f.ends_with(".py"))
+        .map(|f| std::fs::read_to_string(root().join(f)).unwrap())
+        .collect();
     let extensions = [
         ".rs", ".toml", ".md", ".py", ".json", ".jsonl", ".csv", ".sh", ".gz",
     ];
@@ -408,7 +438,9 @@ fn the_documents_cite_only_files_and_tests_that_exist() {
             let is_path = (cited.contains('/') && !cited.contains("://"))
                 || extensions.iter().any(|e| cited.ends_with(e));
             if is_test {
-                if !rust.contains(&format!("fn {cited}(")) {
+                if !rust.contains(&format!("fn {cited}("))
+                    && !python.contains(&format!("def {cited}("))
+                {
                     missing.push(format!("{doc}: test {cited}"));
                 }
             } else if is_path && !generated(cited) {

@@ -8,7 +8,8 @@ use anyhow::{Context, Result, bail};
 use crate::{PACKAGE, root, setup, step, step_with_env};
 
 /// Set-up, formatting, lints (warnings are errors), then every test of every crate, the
-/// integration tests under `tests/` and the benches in test mode (each bench runs once). Ends
+/// integration tests under `tests/`, the benches in test mode (each bench runs once) and the
+/// Python package's pytest suite. Ends
 /// with one line summing up every test binary: `N passed, M failed`.
 pub fn run() -> Result<()> {
     setup()?;
@@ -40,7 +41,80 @@ pub fn run() -> Result<()> {
     let mut totals = Totals::default();
     test(&["test", "--workspace", "--doc"], &mut totals)?;
     test(&["test", "--workspace", "--all-targets"], &mut totals)?;
+    python_tests(&mut totals)?;
     println!("ci: {} passed, {} failed", totals.passed, totals.failed);
+    Ok(())
+}
+
+/// The Python package: installed from `crates/seads-py` into the virtual environment
+/// `target/py-venv` (made on first use; pip fetches maturin, NumPy, Gymnasium and pytest), built
+/// with the dev profile, whose dependencies the Rust tests have just compiled, then its pytest
+/// suite, whose closing line is added to the totals.
+fn python_tests(totals: &mut Totals) -> Result<()> {
+    let venv = root().join("target").join("py-venv");
+    let python = venv.join("bin").join("python");
+    if !python.exists() {
+        step("python3", &["-m", "venv", &venv.to_string_lossy()])?;
+    }
+    let python = python.to_string_lossy().into_owned();
+    step_with_env(
+        &python,
+        &[
+            "-m",
+            "pip",
+            "install",
+            "--quiet",
+            "--disable-pip-version-check",
+            "./crates/seads-py[test]",
+        ],
+        &[("MATURIN_PEP517_ARGS", "--profile dev")],
+    )?;
+    eprintln!("xtask: $ {python} -m pytest crates/seads-py/tests");
+    let output = Command::new(&python)
+        .args([
+            "-m",
+            "pytest",
+            "-q",
+            "-p",
+            "no:cacheprovider",
+            "crates/seads-py/tests",
+        ])
+        .current_dir(root())
+        .output()
+        .context("could not start pytest")?;
+    let text = String::from_utf8_lossy(&output.stdout);
+    print!("{text}");
+    eprint!("{}", String::from_utf8_lossy(&output.stderr));
+    // The closing line: "3 failed, 29 passed, 14 warnings in 1.11s".
+    let last = text
+        .lines()
+        .rev()
+        .find(|l| l.contains(" in "))
+        .unwrap_or("");
+    let counted = |label: &str| {
+        last.trim_matches('=')
+            .split(',')
+            .find_map(|part| {
+                part.trim()
+                    .split(" in ")
+                    .next()?
+                    .strip_suffix(label)?
+                    .trim()
+                    .parse()
+                    .ok()
+            })
+            .unwrap_or(0u64)
+    };
+    totals.passed += counted(" passed");
+    totals.failed += counted(" failed") + counted(" error") + counted(" errors");
+    if !output.status.success() {
+        println!(
+            "ci: {} passed, {} failed",
+            totals.passed,
+            totals.failed.max(1)
+        );
+        bail!("pytest failed ({})", output.status);
+    }
     Ok(())
 }
 

@@ -15,7 +15,8 @@ cargo xtask <command>
 
 Commands:
   run          set up libtorch if needed, build in release mode and run `seads run` (the main job)
-  ci           set up, then fmt --check, clippy -D warnings, doc -D warnings, package, every test (CI)
+  ci           set up, then fmt --check, clippy -D warnings, doc -D warnings, package, every test,
+               and the Python package's pytest suite in target/py-venv (CI)
   setup        install libtorch for tch into .venv / .libtorch (idempotent; scripts/setup.sh)
   package      cargo package every library crate in dependency order, building each package (slow)
   gen-splits   write data/depth_counts.csv and data/split_counts.csv from a fresh enumeration
@@ -67,14 +68,17 @@ fn root() -> PathBuf {
         .to_path_buf()
 }
 
-/// `cargo package` of every library crate (the workspace without xtask and the tests crate).
-const PACKAGE: [&str; 6] = [
+/// `cargo package` of every library crate (the workspace without xtask, the tests crate and
+/// the Python package, which is distributed as a wheel).
+const PACKAGE: [&str; 8] = [
     "package",
     "--workspace",
     "--exclude",
     "xtask",
     "--exclude",
     "seads-tests",
+    "--exclude",
+    "seads-py",
 ];
 
 /// Runs a command in the repository root and fails if it fails.

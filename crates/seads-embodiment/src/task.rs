@@ -6,8 +6,9 @@
 //! skill).
 
 use std::collections::BTreeMap;
+use std::sync::{Arc, Mutex, OnceLock};
 
-use seads_games::SymbolicState;
+use seads_games::{BoardGame, GameKind, SymbolicState};
 
 use crate::{EnvError, EnvSpec, Environment};
 
@@ -20,6 +21,8 @@ pub struct TaskStep {
     pub solved: bool,
     /// The episode ends: solved, or the time limit T_lim is reached.
     pub done: bool,
+    /// The game move the step made, if any.
+    pub game_move: Option<seads_games::MoveId>,
 }
 
 /// An environment in task mode. The observation is the environment's own, whose last value (the
@@ -27,8 +30,9 @@ pub struct TaskStep {
 pub struct TaskEnv {
     env: Box<dyn Environment>,
     goal: SymbolicState,
-    /// Solution depth of every board up to the environment's largest reset depth.
-    depths: BTreeMap<SymbolicState, usize>,
+    /// Solution depth of every board up to the environment's largest reset depth (shared by
+    /// every task environment of the same game, size and depth).
+    depths: Arc<BTreeMap<SymbolicState, usize>>,
     steps_per_depth: usize,
     max_depth: usize,
     depth: usize,
@@ -59,24 +63,8 @@ impl TaskEnv {
             ))
         })?;
         let game = spec.game.build(spec.board_size)?;
-        // Breadth-first from the goal: both games' moves undo themselves, so the distance from
-        // the goal is the distance to it.
         let goal = game.goal();
-        let mut depths = BTreeMap::from([(goal, 0)]);
-        let mut layer = vec![goal];
-        for depth in 1..=max_depth {
-            let mut next = Vec::new();
-            for &board in &layer {
-                for mv in 0..game.num_moves() {
-                    let after = game.apply(board, mv);
-                    if let std::collections::btree_map::Entry::Vacant(e) = depths.entry(after) {
-                        e.insert(depth);
-                        next.push(after);
-                    }
-                }
-            }
-            layer = next;
-        }
+        let depths = depth_map(spec.game, spec.board_size, max_depth, game.as_ref());
         Ok(Self {
             env,
             goal,
@@ -149,6 +137,7 @@ impl TaskEnv {
             reward: if solved { 1.0 } else { 0.0 },
             solved,
             done: self.over,
+            game_move: outcome.game_move(),
         })
     }
 
@@ -161,4 +150,44 @@ impl TaskEnv {
     pub fn env(&self) -> &dyn Environment {
         self.env.as_ref()
     }
+}
+
+/// The solution depth of every board of `game` up to `max_depth`, by breadth-first search from
+/// the goal (both games' moves undo themselves, so the distance from the goal is the distance
+/// to it). Computed once per game, size and depth and shared, so that many task environments
+/// (a vector of them) cost one map.
+fn depth_map(
+    kind: GameKind,
+    size: usize,
+    max_depth: usize,
+    game: &dyn BoardGame,
+) -> Arc<BTreeMap<SymbolicState, usize>> {
+    type Cache = BTreeMap<(GameKind, usize, usize), Arc<BTreeMap<SymbolicState, usize>>>;
+    static CACHE: OnceLock<Mutex<Cache>> = OnceLock::new();
+    let mut cache = CACHE
+        .get_or_init(Default::default)
+        .lock()
+        .unwrap_or_else(|e| e.into_inner());
+    cache
+        .entry((kind, size, max_depth))
+        .or_insert_with(|| {
+            let goal = game.goal();
+            let mut depths = BTreeMap::from([(goal, 0)]);
+            let mut layer = vec![goal];
+            for depth in 1..=max_depth {
+                let mut next = Vec::new();
+                for &board in &layer {
+                    for mv in 0..game.num_moves() {
+                        let after = game.apply(board, mv);
+                        if let std::collections::btree_map::Entry::Vacant(e) = depths.entry(after) {
+                            e.insert(depth);
+                            next.push(after);
+                        }
+                    }
+                }
+                layer = next;
+            }
+            Arc::new(depths)
+        })
+        .clone()
 }

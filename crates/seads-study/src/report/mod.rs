@@ -5,6 +5,7 @@
 //! by [`write_report`].
 
 mod curves;
+mod deep;
 mod failed_tasks;
 mod failures;
 mod figures;
@@ -89,6 +90,10 @@ pub fn write_report(options: &ReportOptions, out: &Path) -> Result<ReportSummary
     let noise = tables::noise_tables(&groups);
     if let Some((_, csv)) = &noise {
         write("noise.csv", csv)?;
+    }
+    let deep = deep::deep_tables(&groups);
+    if let Some((_, csv)) = &deep {
+        write("deep-search.csv", csv)?;
     }
     let (length_md, length_csv) = tables::length_tables(&groups);
     write("lengths.csv", &length_csv)?;
@@ -193,6 +198,11 @@ pub fn write_report(options: &ReportOptions, out: &Path) -> Result<ReportSummary
         let _ = writeln!(md, "## Task success under action noise\n");
         md += noise_md;
         let _ = writeln!(md, "\nAs CSV: `noise.csv`.\n");
+    }
+    if let Some((deep_md, _)) = &deep {
+        let _ = writeln!(md, "## The deeper search (Fig. S.7)\n");
+        md += deep_md;
+        let _ = writeln!(md, "\nAs CSV: `deep-search.csv`.\n");
     }
     let _ = writeln!(md, "## Skill and solution length\n");
     md += &length_md;

@@ -6,11 +6,23 @@ use std::path::{Path, PathBuf};
 
 use crate::error::{fail, failure};
 use crate::{Context as _, Result};
-use seads_planner::{DepthResult, EvaluationKind, STANDARD_DEPTHS};
+use seads_planner::{DepthResult, EvaluationKind, Protocol, STANDARD_DEPTHS, SearchLimits};
 use seads_rl::{Algorithm, Metrics, TaskMetrics, TrainConfig};
 
 use crate::evaluation::CheckpointEvaluation;
 use crate::sweep::Sweep;
+
+/// A run's evaluation with re-planning at depths beyond the standard ones (the paper's Fig.
+/// S.7), at the end of training.
+#[derive(Debug, Clone)]
+pub struct DeepSearch {
+    /// Its search limits (one set for all its depths).
+    pub limits: SearchLimits,
+    /// Boards per depth.
+    pub boards: usize,
+    /// Per depth, in order.
+    pub results: Vec<DepthResult>,
+}
 
 /// One run, as read from its directory.
 pub struct RunData {
@@ -36,6 +48,8 @@ pub struct RunData {
     /// Final task evaluations under action noise: (σ, with re-planning, per depth), in the
     /// order of their files' names.
     pub noisy: Vec<(f64, bool, Vec<DepthResult>)>,
+    /// The deeper search (depths beyond the standard ones, with re-planning), if evaluated.
+    pub deep: Option<DeepSearch>,
     /// Task success over training, if evaluated.
     pub over_training: Vec<CheckpointEvaluation>,
     /// The processors that trained it (`provenance.jsonl`; empty for older runs).
@@ -122,7 +136,8 @@ impl RunData {
             evaluation(EvaluationKind::PlanOnce)?,
             evaluation(EvaluationKind::Policy)?,
         );
-        let noisy = noisy_evaluations(dir, last_epoch, &mut damage);
+        let further = further_evaluations(dir, last_epoch, &mut damage);
+        let (noisy, deep) = (noisy_evaluations(&further), deep_search(&further));
         Ok(Self {
             dir: dir.to_path_buf(),
             copy_to,
@@ -131,6 +146,7 @@ impl RunData {
             plan_once,
             policy,
             noisy,
+            deep,
             evaluation_notes,
             unrecorded_evaluations,
             damage,
@@ -145,18 +161,31 @@ impl RunData {
     }
 }
 
-/// The run's planning evaluations of the standard depths under action noise that evaluated its
-/// last checkpoint (`evaluation-replan-noise-0.05.json`, …); an unreadable one is damage.
-fn noisy_evaluations(
+/// The run's planning evaluations, other than the standard ones, that evaluated its last
+/// checkpoint on the test split with the standard seeds (`evaluation-replan-noise-0.05.json`,
+/// `evaluation-replan-depths-6-10.json`, …), in the order of their files' names; an
+/// unreadable one is damage.
+fn further_evaluations(
     dir: &Path,
     last_epoch: Option<u64>,
     damage: &mut Vec<String>,
-) -> Vec<(f64, bool, Vec<DepthResult>)> {
+) -> Vec<(Protocol, Vec<DepthResult>)> {
+    let standard_files = [
+        EvaluationKind::Replan,
+        EvaluationKind::PlanOnce,
+        EvaluationKind::Policy,
+    ]
+    .map(|kind| kind.results_file(&STANDARD_DEPTHS, None));
     let mut names: Vec<String> = std::fs::read_dir(dir)
         .into_iter()
         .flatten()
         .filter_map(|e| e.ok()?.file_name().into_string().ok())
-        .filter(|n| n.contains("-noise-") && n.ends_with(".json") && !n.contains("-epoch-"))
+        .filter(|n| {
+            n.starts_with("evaluation-")
+                && n.ends_with(".json")
+                && !n.contains("-epoch-")
+                && !standard_files.contains(n)
+        })
         .collect();
     names.sort();
     let mut found = Vec::new();
@@ -169,29 +198,70 @@ fn noisy_evaluations(
                 continue;
             }
         };
-        let Some(protocol) = record.protocol else {
-            continue;
-        };
-        let standard = protocol.tasks.depths == STANDARD_DEPTHS
-            && protocol.tasks.split == seads_games::Split::Test
-            && protocol.tasks.seed.is_none();
         let at_end = record
             .checkpoint
             .is_some_and(|c| Some(c.epoch) == last_epoch);
-        if let (Some(std), true, true, Some(replan)) = (
-            protocol.action_noise,
-            standard,
-            at_end,
-            match protocol.kind {
-                EvaluationKind::Replan => Some(true),
-                EvaluationKind::PlanOnce => Some(false),
-                EvaluationKind::Policy => None,
-            },
-        ) {
-            found.push((std, replan, record.results));
+        if let (Some(protocol), true) = (record.protocol, at_end)
+            && protocol.tasks.split == seads_games::Split::Test
+            && protocol.tasks.seed.is_none()
+            && protocol.kind != EvaluationKind::Policy
+        {
+            found.push((protocol, record.results));
         }
     }
     found
+}
+
+/// The evaluations of the standard depths under action noise among `further`: (σ, with
+/// re-planning, per depth).
+fn noisy_evaluations(
+    further: &[(Protocol, Vec<DepthResult>)],
+) -> Vec<(f64, bool, Vec<DepthResult>)> {
+    further
+        .iter()
+        .filter(|(p, _)| p.tasks.depths == STANDARD_DEPTHS)
+        .filter_map(|(p, results)| {
+            Some((
+                p.action_noise?,
+                p.kind == EvaluationKind::Replan,
+                results.clone(),
+            ))
+        })
+        .collect()
+}
+
+/// The deeper search among `further`: evaluations with re-planning and without noise of depths
+/// other than the standard ones, merged per depth (the first file of a depth counts).
+fn deep_search(further: &[(Protocol, Vec<DepthResult>)]) -> Option<DeepSearch> {
+    let mut deep: Option<DeepSearch> = None;
+    for (protocol, results) in further {
+        let Some(limits) = protocol.limits else {
+            continue;
+        };
+        if protocol.kind != EvaluationKind::Replan
+            || protocol.action_noise.is_some()
+            || protocol.tasks.depths == STANDARD_DEPTHS
+        {
+            continue;
+        }
+        let deep = deep.get_or_insert_with(|| DeepSearch {
+            limits,
+            boards: protocol.tasks.boards,
+            results: Vec::new(),
+        });
+        if deep.limits != limits || deep.boards != protocol.tasks.boards {
+            continue;
+        }
+        for r in results {
+            if !deep.results.iter().any(|d| d.depth == r.depth) {
+                deep.results.push(r.clone());
+            }
+        }
+    }
+    if let Some(deep) = &mut deep {
+        deep.results.sort_by_key(|r| r.depth);
+    }
+    deep
 }
 
 /// The metrics lines of the run in `dir`; none without a metrics file (not started), and none
@@ -385,6 +455,7 @@ pub(crate) fn bare_run(seed: u32) -> RunData {
         replan: None,
         plan_once: None,
         noisy: Vec::new(),
+        deep: None,
         over_training: Vec::new(),
         processors: Vec::new(),
         evaluation_notes: Vec::new(),

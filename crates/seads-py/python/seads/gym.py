@@ -1,0 +1,205 @@
+"""Gymnasium wrappers of the Rust environments: :class:`SeadsEnv` and :class:`SeadsVectorEnv`.
+
+Two modes. Skill mode (the default) is what SEADS's skills see: an episode ends with the first
+game move (``terminated``) or at the skill's step limit T_max (``truncated``), and the reward is
+always 0 (the environments are reward-free; ``info["move"]`` says which move a step made).
+Task mode (``task=True``) is the flat baselines' setting: the board has solution depth S (from
+``max_solution_depth`` and ``random_solution_depth``), the step that solves it pays 1 and
+terminates, and the episode is truncated after T_max·S steps.
+
+Environment options are keyword arguments: ``max_solution_depth``, ``random_solution_depth``,
+``reset_split`` ("train" or "test"), ``board_size`` and ``spacing`` (LightsOutCursor),
+``step_limit``, ``physics_substeps`` (Jaco).
+"""
+
+from __future__ import annotations
+
+import json
+from typing import Any
+
+import numpy as np
+import gymnasium
+from gymnasium import spaces
+from gymnasium.vector import AutoresetMode, VectorEnv
+from gymnasium.vector.utils import batch_space
+
+from . import _seads
+
+_WORDS = {
+    "lightsout": "LightsOut",
+    "lightsout3d": "LightsOut3D",
+    "tileswap": "TileSwap",
+    "cursor": "Cursor",
+    "reacher": "Reacher",
+    "jaco": "Jaco",
+}
+
+
+def gym_id(env_name: str) -> str:
+    """The Gymnasium id of a Rust environment name: ``lightsout-cursor`` -> ``seads/LightsOutCursor-v0``."""
+    camel = "".join(_WORDS.get(part, part.capitalize()) for part in env_name.split("-"))
+    return f"seads/{camel}-v0"
+
+
+def _options(options: dict[str, Any]) -> str | None:
+    return json.dumps(options) if options else None
+
+
+def _spaces(spec: dict[str, Any]) -> tuple[spaces.Box, spaces.Box]:
+    """Observation ``[manipulator state, board bits, remaining time]`` and action spaces."""
+    m, obs_dim = spec["manipulator_dim"], spec["obs_dim"]
+    low = np.zeros(obs_dim, dtype=np.float32)
+    high = np.ones(obs_dim, dtype=np.float32)
+    low[:m], high[:m] = -np.inf, np.inf
+    observation = spaces.Box(low=low, high=high, dtype=np.float32)
+    action = spaces.Box(
+        low=np.asarray(spec["action_low"], dtype=np.float32),
+        high=np.asarray(spec["action_high"], dtype=np.float32),
+        dtype=np.float32,
+    )
+    return observation, action
+
+
+def _seed_from(rng: np.random.Generator) -> int:
+    return int(rng.integers(0, 2**63))
+
+
+class SeadsEnv(gymnasium.Env):
+    """One environment (see the module's docstring for the modes and options).
+
+    ``info`` holds ``board`` (the board's values, uint8, row-major: LightsOut 0/1 per field,
+    TileSwap the tile on each field), ``move`` (the game move a step made, -1 for none) and, in
+    task mode, ``depth`` (the board's solution depth S).
+    """
+
+    metadata = {"render_modes": ["rgb_array"], "render_fps": 10}
+
+    def __init__(self, env_name: str, render_mode: str | None = None, task: bool = False, **options: Any):
+        if render_mode not in (None, "rgb_array"):
+            raise ValueError(f"render_mode {render_mode!r}: only 'rgb_array' is supported")
+        self.env_name = env_name
+        self.task = task
+        self.render_mode = render_mode
+        self._core = _seads.Env(env_name, _options(options), task)
+        self.spec_dict = self._core.spec()
+        self.observation_space, self.action_space = _spaces(self.spec_dict)
+        self._seeded = False
+
+    def reset(self, *, seed: int | None = None, options: dict[str, Any] | None = None):
+        super().reset(seed=seed)
+        if seed is not None:
+            self._core.seed(seed)
+            self._seeded = True
+        elif not self._seeded:
+            self._core.seed(_seed_from(self.np_random))
+            self._seeded = True
+        obs = self._core.reset()
+        return obs, self._info(-1)
+
+    def step(self, action):
+        action = np.asarray(action, dtype=np.float32)
+        if action.shape != self.action_space.shape:
+            raise ValueError(
+                f"{self.env_name}: an action has shape {self.action_space.shape}, got {action.shape}"
+            )
+        obs, reward, terminated, truncated, move = self._core.step(np.ascontiguousarray(action))
+        return obs, float(reward), terminated, truncated, self._info(move)
+
+    def render(self):
+        if self.render_mode == "rgb_array":
+            return self._core.render()
+        return None
+
+    def board(self) -> np.ndarray:
+        """The board's values (see ``info["board"]``)."""
+        return self._core.board()
+
+    def _info(self, move: int) -> dict[str, Any]:
+        info: dict[str, Any] = {"board": self._core.board(), "move": move}
+        if self.task:
+            info["depth"] = self._core.depth()
+        return info
+
+
+class SeadsVectorEnv(VectorEnv):
+    """``num_envs`` environments stepped in parallel in Rust, writing into NumPy arrays.
+
+    Autoreset is Gymnasium's default (next step): the step after an episode ended resets that
+    environment and returns its first observation with reward 0. ``info["move"]`` holds each
+    environment's game move (-1 for none); :meth:`boards` returns every board.
+    """
+
+    metadata = {"render_modes": ["rgb_array"], "autoreset_mode": AutoresetMode.NEXT_STEP}
+
+    def __init__(
+        self,
+        env_name: str,
+        num_envs: int,
+        render_mode: str | None = None,
+        task: bool = False,
+        **options: Any,
+    ):
+        if render_mode not in (None, "rgb_array"):
+            raise ValueError(f"render_mode {render_mode!r}: only 'rgb_array' is supported")
+        if not isinstance(num_envs, (int, np.integer)) or num_envs < 1:
+            raise ValueError(f"num_envs {num_envs!r}: must be a positive integer")
+        self.env_name = env_name
+        self.num_envs = int(num_envs)
+        self.render_mode = render_mode
+        self._core = _seads.VecEnv(env_name, self.num_envs, _options(options), task)
+        self.spec_dict = self._core.spec()
+        self.single_observation_space, self.single_action_space = _spaces(self.spec_dict)
+        self.observation_space = batch_space(self.single_observation_space, self.num_envs)
+        self.action_space = batch_space(self.single_action_space, self.num_envs)
+        n, obs_dim = self.num_envs, self.spec_dict["obs_dim"]
+        self._obs = np.zeros((n, obs_dim), dtype=np.float32)
+        self._reward = np.zeros(n, dtype=np.float32)
+        self._terminated = np.zeros(n, dtype=np.bool_)
+        self._truncated = np.zeros(n, dtype=np.bool_)
+        self._move = np.full(n, -1, dtype=np.int64)
+        self._seeded = False
+
+    def reset(self, *, seed: int | list[int] | None = None, options: dict[str, Any] | None = None):
+        if isinstance(seed, (list, tuple)):
+            if len(seed) != self.num_envs:
+                raise ValueError(f"{len(seed)} seeds for {self.num_envs} environments")
+            super().reset(seed=None)
+            seeds = [int(s) for s in seed]
+        else:
+            super().reset(seed=seed)
+            if seed is not None:
+                seeds = [int(seed) + i for i in range(self.num_envs)]
+            elif not self._seeded:
+                seeds = [_seed_from(self.np_random) for _ in range(self.num_envs)]
+            else:
+                seeds = None
+        self._seeded = True
+        self._core.reset(self._obs, seeds)
+        self._move.fill(-1)
+        return self._obs.copy(), {}
+
+    def step(self, actions):
+        actions = np.ascontiguousarray(actions, dtype=np.float32)
+        if actions.shape != self.action_space.shape:
+            raise ValueError(
+                f"{self.env_name}: actions have shape {self.action_space.shape}, got {actions.shape}"
+            )
+        self._core.step(actions, self._obs, self._reward, self._terminated, self._truncated, self._move)
+        info = {"move": self._move.copy(), "_move": np.ones(self.num_envs, dtype=np.bool_)}
+        return (
+            self._obs.copy(),
+            self._reward.copy(),
+            self._terminated.copy(),
+            self._truncated.copy(),
+            info,
+        )
+
+    def boards(self) -> np.ndarray:
+        """Every environment's board values (num_envs x board values, uint8)."""
+        return self._core.boards()
+
+    def render(self):
+        """The first environment's top view (RGB), as Gymnasium's vector environments do."""
+        if self.render_mode == "rgb_array":
+            return self._core.render(0)
+        return None

@@ -1,0 +1,65 @@
+"""Bad input raises a Python exception with a clear message; the interpreter never crashes."""
+
+import gymnasium
+import numpy as np
+import pytest
+
+import seads
+
+
+def test_a_wrong_action_shape_is_a_value_error():
+    env = gymnasium.make("seads/LightsOutCursor-v0")
+    env.reset(seed=0)
+    with pytest.raises(ValueError, match="shape"):
+        env.step(np.zeros(4, dtype=np.float32))
+    core = seads.Env("lightsout-cursor")
+    core.reset()
+    with pytest.raises(ValueError, match="3 values, got 2"):
+        core.step(np.zeros(2, dtype=np.float32))
+
+
+@pytest.mark.parametrize("bad", [np.nan, np.inf])
+def test_a_non_finite_action_is_a_value_error(bad):
+    env = seads.SeadsEnv("lightsout-reacher")
+    env.reset(seed=0)
+    with pytest.raises(ValueError, match="not a finite number"):
+        env.step(np.array([0.0, bad, 0.0], dtype=np.float32))
+    vec = seads.SeadsVectorEnv("lightsout-cursor", 4)
+    vec.reset(seed=0)
+    actions = np.zeros((4, 3), dtype=np.float32)
+    actions[2, 1] = bad
+    with pytest.raises(ValueError, match="environment 2"):
+        vec.step(actions)
+    with pytest.raises(ValueError, match="shape"):
+        vec.step(np.zeros((3, 3), dtype=np.float32))
+
+
+def test_unknown_environments_and_options_are_named():
+    with pytest.raises(gymnasium.error.Error):
+        gymnasium.make("seads/NoSuchGame-v0")
+    with pytest.raises(ValueError, match="unknown environment"):
+        seads.SeadsEnv("no-such-game")
+    with pytest.raises(ValueError, match="max_depth"):
+        seads.SeadsEnv("lightsout-cursor", max_depth=3)
+    with pytest.raises(ValueError, match="max_solution_depth"):
+        seads.SeadsEnv("lightsout-cursor", max_solution_depth=0)
+    with pytest.raises(ValueError, match="num_envs"):
+        seads.SeadsVectorEnv("lightsout-cursor", 0)
+
+
+def test_wrong_boards_and_moves_are_value_errors():
+    game = seads.Game("lightsout")
+    with pytest.raises(ValueError):
+        game.solve([2] * 25)
+    with pytest.raises(ValueError):
+        game.depth([0] * 24)
+    with pytest.raises(ValueError, match="move 25"):
+        game.apply(game.goal(), 25)
+    with pytest.raises(ValueError):
+        seads.Game("tileswap").depth([0] * 9)
+    with pytest.raises(ValueError, match="split"):
+        game.boards(2, "validation")
+    with pytest.raises(ValueError, match="game"):
+        seads.Game("chess")
+    with pytest.raises(ValueError, match="bit"):
+        seads.Env("lightsout-cursor").set_state(np.full(27, 0.5, dtype=np.float32))
