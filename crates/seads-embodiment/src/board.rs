@@ -141,24 +141,29 @@ impl BoardState {
     }
 }
 
-/// Enumerated boards are shared by every environment of the same game, size and depth.
-fn dataset(kind: GameKind, size: usize, max_depth: usize) -> Arc<BoardDataset> {
-    type Cache = BTreeMap<(GameKind, usize, usize), Arc<BoardDataset>>;
-    static CACHE: OnceLock<Mutex<Cache>> = OnceLock::new();
-    let mut cache = CACHE
+/// A cache of values built once per key and shared, for data every environment of a kind needs
+/// (enumerated boards, depth maps): one per process, whatever the number of environments.
+pub(crate) type Shared<K, V> = OnceLock<Mutex<BTreeMap<K, Arc<V>>>>;
+
+/// The value of `key` in `cache`, built by `make` the first time.
+pub(crate) fn shared<K: Ord, V>(cache: &Shared<K, V>, key: K, make: impl FnOnce() -> V) -> Arc<V> {
+    let mut cache = cache
         .get_or_init(Default::default)
         .lock()
         .unwrap_or_else(|e| e.into_inner());
-    cache
-        .entry((kind, size, max_depth))
-        .or_insert_with(|| {
-            let data = match kind {
-                GameKind::LightsOut => {
-                    BoardDataset::build(&LightsOut::new(size).expect("size checked"), max_depth)
-                }
-                GameKind::TileSwap => BoardDataset::build(&TileSwap::new(), max_depth),
-            };
-            Arc::new(data.expect("LightsOut ≤ 5×5 and TileSwap are enumerable"))
-        })
-        .clone()
+    cache.entry(key).or_insert_with(|| Arc::new(make())).clone()
+}
+
+/// Enumerated boards are shared by every environment of the same game, size and depth.
+fn dataset(kind: GameKind, size: usize, max_depth: usize) -> Arc<BoardDataset> {
+    static CACHE: Shared<(GameKind, usize, usize), BoardDataset> = OnceLock::new();
+    shared(&CACHE, (kind, size, max_depth), || {
+        let data = match kind {
+            GameKind::LightsOut => {
+                BoardDataset::build(&LightsOut::new(size).expect("size checked"), max_depth)
+            }
+            GameKind::TileSwap => BoardDataset::build(&TileSwap::new(), max_depth),
+        };
+        data.expect("LightsOut ≤ 5×5 and TileSwap are enumerable")
+    })
 }

@@ -6,7 +6,9 @@
 //! skill).
 
 use std::collections::BTreeMap;
-use std::sync::{Arc, Mutex, OnceLock};
+use std::sync::{Arc, OnceLock};
+
+use crate::board::{Shared, shared};
 
 use seads_games::{BoardGame, GameKind, SymbolicState};
 
@@ -162,32 +164,25 @@ fn depth_map(
     max_depth: usize,
     game: &dyn BoardGame,
 ) -> Arc<BTreeMap<SymbolicState, usize>> {
-    type Cache = BTreeMap<(GameKind, usize, usize), Arc<BTreeMap<SymbolicState, usize>>>;
-    static CACHE: OnceLock<Mutex<Cache>> = OnceLock::new();
-    let mut cache = CACHE
-        .get_or_init(Default::default)
-        .lock()
-        .unwrap_or_else(|e| e.into_inner());
-    cache
-        .entry((kind, size, max_depth))
-        .or_insert_with(|| {
-            let goal = game.goal();
-            let mut depths = BTreeMap::from([(goal, 0)]);
-            let mut layer = vec![goal];
-            for depth in 1..=max_depth {
-                let mut next = Vec::new();
-                for &board in &layer {
-                    for mv in 0..game.num_moves() {
-                        let after = game.apply(board, mv);
-                        if let std::collections::btree_map::Entry::Vacant(e) = depths.entry(after) {
-                            e.insert(depth);
-                            next.push(after);
-                        }
+    static CACHE: Shared<(GameKind, usize, usize), BTreeMap<SymbolicState, usize>> =
+        OnceLock::new();
+    shared(&CACHE, (kind, size, max_depth), || {
+        let goal = game.goal();
+        let mut depths = BTreeMap::from([(goal, 0)]);
+        let mut layer = vec![goal];
+        for depth in 1..=max_depth {
+            let mut next = Vec::new();
+            for &board in &layer {
+                for mv in 0..game.num_moves() {
+                    let after = game.apply(board, mv);
+                    if let std::collections::btree_map::Entry::Vacant(e) = depths.entry(after) {
+                        e.insert(depth);
+                        next.push(after);
                     }
                 }
-                layer = next;
             }
-            Arc::new(depths)
-        })
-        .clone()
+            layer = next;
+        }
+        depths
+    })
 }
