@@ -75,6 +75,7 @@ pub use policy::{SkillPolicy, SkillRun, execute_skill};
 pub use reacher::Reacher;
 pub use record::{
     Comparison, EpisodeRecord, ReplayError, StepRecord, compare, record_episode, replay_episode,
+    restore_state,
 };
 pub use registry::{EnvInfo, env_names, list_envs, make_env};
 pub use runner::{Throughput, random_rollout};

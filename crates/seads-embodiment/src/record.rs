@@ -97,6 +97,33 @@ pub enum ReplayError {
     Env(#[from] EnvError),
 }
 
+/// Puts `env` into the state an episode file's `initial_obs` describes (manipulator state, then
+/// the board's bits, no remaining-time entry) and lifts its step limit, as a replay starts. An
+/// initial observation of the wrong length or with a board entry other than 0 or 1 is
+/// [`ReplayError::Invalid`]; a manipulator that cannot be restored is the environment's error.
+pub fn restore_state(env: &mut dyn Environment, initial_obs: &[f32]) -> Result<(), ReplayError> {
+    let spec = env.spec();
+    let (m, d) = (spec.manipulator_dim, spec.symbolic_len);
+    let invalid = |m: String| ReplayError::Invalid(m);
+    if initial_obs.len() != m + d {
+        return Err(invalid(format!(
+            "initial_obs has {} values; {} has {m} manipulator values and {d} board bits",
+            initial_obs.len(),
+            spec.name
+        )));
+    }
+    if let Some(i) = initial_obs[m..].iter().position(|&b| b != 0.0 && b != 1.0) {
+        return Err(invalid(format!(
+            "initial_obs board bit {i} is {}, not 0 or 1",
+            initial_obs[m + i]
+        )));
+    }
+    env.set_step_limit(None);
+    env.restore_manipulator(&initial_obs[..m])?;
+    env.set_board(SymbolicState::from_observation(&initial_obs[m..]))
+        .map_err(|e| invalid(e.to_string()))
+}
+
 /// Puts `env` into `record.initial_obs` and applies the recorded actions in order (no step
 /// limit, no reset after moves); returns the episode with observations and moves recomputed.
 ///
@@ -120,28 +147,12 @@ pub fn replay_episode(
     record: &EpisodeRecord,
 ) -> Result<EpisodeRecord, ReplayError> {
     let spec = env.spec().clone();
-    let (m, d, a) = (spec.manipulator_dim, spec.symbolic_len, spec.action_dim);
+    let a = spec.action_dim;
     let invalid = |m: String| ReplayError::Invalid(m);
     if record.env != spec.name {
         return Err(invalid(format!(
             "the episode is of environment {:?}, not {:?}",
             record.env, spec.name
-        )));
-    }
-    if record.initial_obs.len() != m + d {
-        return Err(invalid(format!(
-            "initial_obs has {} values; {} has {m} manipulator values and {d} board bits",
-            record.initial_obs.len(),
-            spec.name
-        )));
-    }
-    if let Some(i) = record.initial_obs[m..]
-        .iter()
-        .position(|&b| b != 0.0 && b != 1.0)
-    {
-        return Err(invalid(format!(
-            "initial_obs board entry {i} is {}, not 0 or 1",
-            record.initial_obs[m + i]
         )));
     }
     for (t, step) in record.steps.iter().enumerate() {
@@ -153,10 +164,7 @@ pub fn replay_episode(
             )));
         }
     }
-    env.set_step_limit(None);
-    env.restore_manipulator(&record.initial_obs[..m])?;
-    env.set_board(SymbolicState::from_observation(&record.initial_obs[m..]))
-        .map_err(|e| invalid(e.to_string()))?;
+    restore_state(env, &record.initial_obs)?;
     let mut obs = env.observation();
     let mut steps = Vec::with_capacity(record.steps.len());
     for step in &record.steps {

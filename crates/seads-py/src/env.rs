@@ -4,10 +4,10 @@
 //! are reward-free). Task mode is the flat baselines' setting: a board of solution depth S,
 //! reward 1 on the step that solves it, at most T_max·S steps.
 
-use numpy::{PyArray1, PyArray3, PyArrayMethods, PyReadonlyArray1};
+use numpy::{PyArray1, PyArray3, PyReadonlyArray1};
 use pyo3::prelude::*;
 use seads_embodiment::{EnvConfig, EnvError, EnvSpec, Environment, TaskEnv, make_env};
-use seads_games::SymbolicState;
+use seads_games::BoardGame;
 
 use crate::value_error;
 
@@ -111,6 +111,12 @@ impl Core {
         self.env().observe(out);
     }
 
+    /// Its board game.
+    pub fn game(&self) -> Result<Box<dyn BoardGame>, seads_games::GameError> {
+        let spec = self.spec();
+        spec.game.build(spec.board_size)
+    }
+
     /// The task's solution depth S (task mode only).
     pub fn depth(&self) -> Option<usize> {
         match self {
@@ -124,6 +130,8 @@ impl Core {
 #[pyclass(module = "seads._seads")]
 pub struct Env {
     core: Core,
+    /// The board game, for the board's values (built once, not per step).
+    game: Box<dyn BoardGame>,
 }
 
 #[pymethods]
@@ -135,9 +143,9 @@ impl Env {
     #[pyo3(signature = (name, options=None, task=false))]
     fn new(name: &str, options: Option<&str>, task: bool) -> PyResult<Self> {
         let config = parse_options(options)?;
-        Ok(Self {
-            core: Core::new(name, &config, task).map_err(value_error)?,
-        })
+        let core = Core::new(name, &config, task).map_err(value_error)?;
+        let game = core.game().map_err(value_error)?;
+        Ok(Self { core, game })
     }
 
     /// The environment's specification as a dict (name, game, board_size, obs_dim, action_dim,
@@ -185,10 +193,8 @@ impl Env {
 
     /// The board's values (LightsOut: 0/1 per field; TileSwap: the tile on each field),
     /// row-major.
-    fn board<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArray1<u8>>> {
-        let spec = self.core.spec();
-        let game = spec.game.build(spec.board_size).map_err(value_error)?;
-        Ok(PyArray1::from_vec(py, game.values(self.core.env().board())))
+    fn board<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<u8>> {
+        PyArray1::from_vec(py, self.game.values(self.core.env().board()))
     }
 
     /// Puts the environment into the state an episode file's `initial_obs` describes
@@ -199,25 +205,7 @@ impl Env {
         let Core::Skill(env) = &mut self.core else {
             return Err(value_error("set_state is for skill mode, not task mode"));
         };
-        let spec = env.spec();
-        let (m, d) = (spec.manipulator_dim, spec.symbolic_len);
-        if state.len() != m + d {
-            return Err(value_error(format!(
-                "{}: a state has {m} manipulator values and {d} board bits, got {} values",
-                spec.name,
-                state.len()
-            )));
-        }
-        if let Some(i) = state[m..].iter().position(|&b| b != 0.0 && b != 1.0) {
-            return Err(value_error(format!(
-                "board bit {i} is {}, not 0 or 1",
-                state[m + i]
-            )));
-        }
-        env.set_step_limit(None);
-        env.restore_manipulator(&state[..m]).map_err(value_error)?;
-        env.set_board(SymbolicState::from_observation(&state[m..]))
-            .map_err(value_error)
+        seads_embodiment::restore_state(env.as_mut(), state).map_err(value_error)
     }
 
     /// The task's solution depth S (`None` in skill mode).
@@ -228,13 +216,7 @@ impl Env {
     /// A top view as an RGB image of `size` × `size` pixels.
     #[pyo3(signature = (size=256))]
     fn render<'py>(&self, py: Python<'py>, size: usize) -> PyResult<Bound<'py, PyArray3<u8>>> {
-        if !(16..=4096).contains(&size) {
-            return Err(value_error(format!(
-                "render size {size}: must be 16 to 4096 pixels"
-            )));
-        }
-        let pixels = crate::render::rgb(&self.core.env().scene(), size).map_err(value_error)?;
-        PyArray1::from_vec(py, pixels).reshape([size, size, 3])
+        crate::render::image(py, self.core.env(), size)
     }
 }
 

@@ -2,8 +2,28 @@
 //! (fields, TileSwap's tiles by colour, its pivots, the manipulator). No text: the tiles'
 //! numbers are shown as colours, so no font is needed.
 
+use numpy::{PyArray1, PyArray3, PyArrayMethods};
 use plotters::prelude::*;
-use seads_embodiment::{Scene, Shape};
+use pyo3::prelude::*;
+use seads_embodiment::{Environment, Scene, Shape};
+
+use crate::value_error;
+
+/// `env`'s top view as a `size` × `size` × 3 NumPy array; a size outside 16 to 4096 pixels is a
+/// `ValueError`.
+pub fn image<'py>(
+    py: Python<'py>,
+    env: &dyn Environment,
+    size: usize,
+) -> PyResult<Bound<'py, PyArray3<u8>>> {
+    if !(16..=4096).contains(&size) {
+        return Err(value_error(format!(
+            "render size {size}: must be 16 to 4096 pixels"
+        )));
+    }
+    let pixels = rgb(&env.scene(), size).map_err(value_error)?;
+    PyArray1::from_vec(py, pixels).reshape([size, size, 3])
+}
 
 /// A lit LightsOut field.
 const LIT: RGBColor = RGBColor(245, 190, 40);

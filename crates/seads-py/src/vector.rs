@@ -4,7 +4,7 @@
 //! that environment instead of stepping it, and reports its first observation with reward 0 and
 //! neither flag set.
 
-use numpy::{PyArrayMethods, PyReadonlyArray2, PyReadwriteArray1, PyReadwriteArray2};
+use numpy::{PyReadonlyArray2, PyReadwriteArray1, PyReadwriteArray2};
 use pyo3::prelude::*;
 use rayon::prelude::*;
 use seads_embodiment::EnvError;
@@ -196,8 +196,7 @@ impl VecEnv {
 
     /// The boards of every environment (num_envs × board values, uint8), row-major.
     fn boards<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, numpy::PyArray2<u8>>> {
-        let spec = self.members[0].core.spec();
-        let game = spec.game.build(spec.board_size).map_err(value_error)?;
+        let game = self.members[0].core.game().map_err(value_error)?;
         let rows: Vec<Vec<u8>> = self
             .members
             .iter()
@@ -218,13 +217,7 @@ impl VecEnv {
             .members
             .get(index)
             .ok_or_else(|| value_error(format!("environment {index} of {}", self.members.len())))?;
-        if !(16..=4096).contains(&size) {
-            return Err(value_error(format!(
-                "render size {size}: must be 16 to 4096 pixels"
-            )));
-        }
-        let pixels = crate::render::rgb(&m.core.env().scene(), size).map_err(value_error)?;
-        numpy::PyArray1::from_vec(py, pixels).reshape([size, size, 3])
+        crate::render::image(py, m.core.env(), size)
     }
 }
 
