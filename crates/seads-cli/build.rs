@@ -1,5 +1,6 @@
 //! Stamps the binary with the commit it was built from (`VERGEN_GIT_SHA`, `VERGEN_GIT_DIRTY`), which
-//! every training process records in its run's `provenance.jsonl` (src/provenance.rs).
+//! every training process records in its run's `provenance.jsonl` (src/provenance.rs); with the
+//! `cuda` feature, links libtorch's CUDA library into the binary.
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
     // The full SHA; dirty counts tracked files only (as of the last build script run).
@@ -11,5 +12,12 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     vergen_gitcl::Emitter::default()
         .add_instructions(&git)?
         .emit()?;
+    // tch registers CUDA through the static initialisers of libtorch_cuda.so, of which no symbol
+    // is used: the linker's default `--as-needed` would drop it, and CUDA would then be absent.
+    // Only the binaries get the flag (a build script linked with it would fail where the CUDA
+    // libraries are not installed).
+    if std::env::var_os("CARGO_FEATURE_CUDA").is_some() {
+        println!("cargo:rustc-link-arg-bins=-Wl,--no-as-needed,-ltorch_cuda,--as-needed");
+    }
     Ok(())
 }

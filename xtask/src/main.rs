@@ -17,7 +17,8 @@ Commands:
   run          set up libtorch if needed, build in release mode and run `seads run` (the main job)
   ci           set up, then fmt --check, clippy -D warnings, doc -D warnings, package, every test,
                and the Python package's pytest suite in target/py-venv (CI)
-  setup        install libtorch for tch into .venv / .libtorch (idempotent; scripts/setup.sh)
+  setup        install libtorch for tch into .venv / .libtorch (idempotent; scripts/setup.sh);
+               `setup --cuda` adds the CUDA libraries (then build with --features cuda)
   package      cargo package every library crate in dependency order, building each package (slow)
   gen-splits   write data/depth_counts.csv and data/split_counts.csv from a fresh enumeration
   golden       train the golden run (data/golden/) and say whether this processor repeats it
@@ -29,7 +30,14 @@ fn main() -> ExitCode {
     let result = match args.first().map(String::as_str) {
         Some("run") => run_main_job(&args[1..]),
         Some("ci") => ci::run(),
-        Some("setup") => setup(),
+        Some("setup") => match args.get(1).map(String::as_str) {
+            None => setup(),
+            Some("--cuda") => step("bash", &["scripts/setup.sh", "--cuda"]),
+            Some(other) => {
+                eprint!("unknown option {other:?} of setup\n\n{HELP}");
+                return ExitCode::from(2);
+            }
+        },
         Some("package") => {
             setup().and_then(|()| step("cargo", &[&PACKAGE[..], &["--allow-dirty"]].concat()))
         }

@@ -67,7 +67,7 @@ pub fn run(args: RunArgs) -> Result<()> {
     crate::train::drive(&mut run, false)?;
     drop(run);
 
-    let mut agent = crate::plan::load_agent(&args.out, None)?;
+    let mut agent = crate::plan::load_agent(&args.out, None, seads_rl::ComputeDevice::Cpu)?;
     outln!(
         "\nsolving {} test boards per depth 1–5 by planning with the learned forward model:",
         args.boards

@@ -44,7 +44,11 @@ pub fn record(args: RecordArgs) -> Result<()> {
     let agent = match args.policy.as_str() {
         "random" => None,
         dir => {
-            let agent = crate::plan::load_agent(std::path::Path::new(dir), None)?;
+            let agent = crate::plan::load_agent(
+                std::path::Path::new(dir),
+                None,
+                seads_rl::ComputeDevice::Cpu,
+            )?;
             if agent.config.env != args.env {
                 bail!(BadInput(anyhow::anyhow!(
                     "the agent in {dir} was trained on {}, not {}",

@@ -95,6 +95,22 @@ pub fn build() -> seads_study::provenance::Build<'static> {
     }
 }
 
+/// A progress bar of `len` steps drawn with `template` (indicatif's), hidden when `quiet`.
+pub fn progress_bar(len: u64, quiet: bool, template: &str) -> indicatif::ProgressBar {
+    if quiet {
+        return indicatif::ProgressBar::hidden();
+    }
+    let style = indicatif::ProgressStyle::with_template(template).expect("a valid template");
+    indicatif::ProgressBar::new(len).with_style(style.progress_chars("=> "))
+}
+
+/// `device`, once it is known to be usable here; a device that is not (no CUDA in this build, no
+/// GPU, an index past the GPUs) is bad input, said in one line.
+pub fn usable_device(device: seads_rl::ComputeDevice) -> anyhow::Result<seads_rl::ComputeDevice> {
+    device.resolve().map_err(|e| BadInput(e.into()))?;
+    Ok(device)
+}
+
 /// Any error as bad input (exit 2).
 pub fn bad_input(e: impl Into<anyhow::Error>) -> BadInput {
     BadInput(e.into())
@@ -188,41 +204,6 @@ fn usage_error(e: clap::Error) -> ! {
         eprintln!("{} (see --help)", message.join(" "));
     }
     std::process::exit(2)
-}
-
-/// A command-line list of whole numbers, written as a range (`1-5`) or a list (`1,3,5`):
-/// sorted, each once, never empty.
-#[derive(Debug, Clone, PartialEq, Eq)]
-pub struct NumberList(pub Vec<u64>);
-
-impl NumberList {
-    /// The longest range taken (longer ones are surely typing errors).
-    const LONGEST: u64 = 100_000;
-
-    /// Parses `text`; anything else than a range or list of whole numbers is a usage error.
-    pub fn parse(text: &str) -> Result<Self, String> {
-        let bad = || format!("expected a range like 1-5 or a list like 1,3,5, got {text:?}");
-        let number = |t: &str| t.trim().parse::<u64>().map_err(|_| bad());
-        let mut numbers: Vec<u64> = match text.split_once('-') {
-            Some((a, b)) => {
-                let (a, b) = (number(a)?, number(b)?);
-                if b.saturating_sub(a) >= Self::LONGEST {
-                    return Err(format!(
-                        "{text:?} spans more than {} numbers",
-                        Self::LONGEST
-                    ));
-                }
-                (a..=b).collect()
-            }
-            None => text.split(',').map(number).collect::<Result<_, _>>()?,
-        };
-        if numbers.is_empty() {
-            return Err(bad());
-        }
-        numbers.sort_unstable();
-        numbers.dedup();
-        Ok(Self(numbers))
-    }
 }
 
 /// Keeps freed memory in the process: libtorch allocates and frees multi-megabyte temporaries
@@ -362,24 +343,6 @@ fn main() -> ExitCode {
             } else {
                 ExitCode::FAILURE
             }
-        }
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    use super::NumberList;
-
-    #[test]
-    fn number_lists_are_ranges_or_lists_sorted_once_each() {
-        assert_eq!(NumberList::parse("1-3").unwrap().0, vec![1, 2, 3]);
-        assert_eq!(NumberList::parse("4").unwrap().0, vec![4]);
-        assert_eq!(NumberList::parse("5, 2,2").unwrap().0, vec![2, 5]);
-        assert_eq!(NumberList::parse("0-0").unwrap().0, vec![0]);
-        for bad in [
-            "", "3-1", "a", "1,,2", "-3", "1-x", "1-2-3", "0-100000", "-1",
-        ] {
-            assert!(NumberList::parse(bad).is_err(), "{bad:?} was accepted");
         }
     }
 }

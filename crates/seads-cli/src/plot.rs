@@ -79,7 +79,11 @@ pub fn write_figures(
         // A robot run: its skills are shown on the twin, and its success is what `seads uarm
         // train` measured (with re-planning only).
         let spec = twin.spec().clone();
-        let agent = Agent::load_for(config, spec, &find_checkpoint(run, checkpoint)?)?;
+        let on_cpu = seads_rl::TrainConfig {
+            device: seads_rl::ComputeDevice::Cpu,
+            ..config
+        };
+        let agent = Agent::load_for(on_cpu, spec, &find_checkpoint(run, checkpoint)?)?;
         let k = seads_embodiment::SkillPolicy::num_skills(&agent.policy);
         both("coverage", &|p| coverage_figure(p, &metrics, k, &title))?;
         let file = EvaluationKind::Replan.results_file(&STANDARD_DEPTHS, None);
@@ -105,7 +109,7 @@ pub fn write_figures(
         skill_figures(&mut twin, &agent.policy, &title, both)?;
         return Ok(written);
     }
-    let mut agent = load_agent(run, checkpoint)?;
+    let mut agent = load_agent(run, checkpoint, seads_rl::ComputeDevice::Cpu)?;
     let k = seads_embodiment::SkillPolicy::num_skills(&agent.policy);
     both("coverage", &|p| coverage_figure(p, &metrics, k, &title))?;
     if agent.model.is_some() {

@@ -5,10 +5,10 @@ use std::path::PathBuf;
 
 use anyhow::{Context, Result};
 use clap::Args;
-use indicatif::{ProgressBar, ProgressStyle};
 use seads_rl::store::MetricsLine as _;
 use seads_rl::{
-    Algorithm, Hac, Hook, InWords, Learner, Moment, Run, TaskSac, TrainConfig, Trainer,
+    Algorithm, ComputeDevice, Hac, Hook, InWords, Learner, Moment, Run, TaskSac, TrainConfig,
+    Trainer,
 };
 
 use crate::BadInput;
@@ -41,6 +41,11 @@ pub struct TrainArgs {
     /// metrics line, an unreadable checkpoint, temporary files) is repaired and reported.
     #[arg(long, conflicts_with_all = ["env", "out", "seed", "config"])]
     resume: Option<PathBuf>,
+    /// Where the networks run: cpu, cuda (the first GPU) or cuda:N. Default: the config's
+    /// (cpu in the presets); with --resume, the run's, and a run may resume on another device.
+    /// Only the CPU repeats a run exactly from its seed.
+    #[arg(long)]
+    device: Option<ComputeDevice>,
     /// No progress bar; one line per evaluation instead.
     #[arg(long)]
     quiet: bool,
@@ -70,6 +75,10 @@ fn config(args: &TrainArgs) -> Result<TrainConfig> {
     if let Some(steps) = args.env_steps {
         config.env_steps = steps;
     }
+    if let Some(device) = args.device {
+        config.device = device;
+    }
+    crate::usable_device(config.device)?;
     config.validate().map_err(|e| BadInput(e.into()))?;
     Ok(config)
 }
@@ -88,6 +97,12 @@ pub fn train(args: TrainArgs) -> Result<()> {
     match &args.resume {
         Some(dir) => {
             let _lock = crate::lock_run(dir)?;
+            // The device is checked before anything is written.
+            let device = match args.device {
+                Some(device) => device,
+                None => seads_rl::load_config(dir)?.device,
+            };
+            crate::usable_device(device)?;
             if let Some(steps) = args.env_steps {
                 seads_rl::raise_budget(dir, steps).map_err(|e| match e {
                     seads_rl::RlError::Config(_) => BadInput(e.into()).into(),
@@ -98,11 +113,9 @@ pub fn train(args: TrainArgs) -> Result<()> {
                 .with_context(|| format!("resuming {}", dir.display()))?;
             crate::kernels::use_kernels(config.portable_numerics)?;
             match config.algorithm {
-                Algorithm::Seads => {
-                    drive(&mut resume(dir, Run::<Trainer>::resume(dir))?, args.quiet)
-                }
-                Algorithm::Sac => drive(&mut resume(dir, Run::<TaskSac>::resume(dir))?, args.quiet),
-                Algorithm::Hac => drive(&mut resume(dir, Run::<Hac>::resume(dir))?, args.quiet),
+                Algorithm::Seads => drive(&mut resume_on::<Trainer>(dir, device)?, args.quiet),
+                Algorithm::Sac => drive(&mut resume_on::<TaskSac>(dir, device)?, args.quiet),
+                Algorithm::Hac => drive(&mut resume_on::<Hac>(dir, device)?, args.quiet),
             }
         }
         None => {
@@ -130,6 +143,17 @@ fn create<L: Learner>(
     })?;
     let lock = crate::lock_run(out)?;
     Ok((run, lock))
+}
+
+/// The run in `dir` resumed on `device` (which may differ from the one it trained on so far).
+fn resume_on<L: Learner>(dir: &std::path::Path, device: ComputeDevice) -> Result<Run<L>> {
+    resume(
+        dir,
+        Run::resume_with(dir, |mut config| {
+            config.device = device;
+            L::build(config)
+        }),
+    )
 }
 
 /// The resumed run, after telling on stderr what resuming repaired.
@@ -190,26 +214,19 @@ pub fn drive<L: InWords>(run: &mut Run<L>, quiet: bool) -> Result<()> {
     }
     let budget = run.trainer().config().env_steps;
     if !run.finished() {
-        let portable = run.trainer().config().portable_numerics;
+        let config = run.trainer().config();
         seads_study::provenance::Provenance::here(
             run.trainer().epoch(),
             run.trainer().steps(),
-            portable,
+            config.portable_numerics,
+            config.device,
             &crate::build(),
         )
         .append(run.dir())
         .context("recording the run's provenance")?;
     }
-    let bar = if quiet {
-        ProgressBar::hidden()
-    } else {
-        ProgressBar::new(budget)
-    };
-    bar.set_style(
-        ProgressStyle::with_template("{elapsed_precise} [{bar:30}] {pos}/{len} steps {msg}")
-            .expect("valid template")
-            .progress_chars("=> "),
-    );
+    let template = "{elapsed_precise} [{bar:30}] {pos}/{len} steps {msg}";
+    let bar = crate::progress_bar(budget, quiet, template);
     bar.set_position(run.trainer().steps().min(budget));
     // A resumed run shows its last evaluation until the next one.
     let mut headline = seads_rl::store::read_metrics_as::<L::Metrics>(run.dir())

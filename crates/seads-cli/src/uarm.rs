@@ -5,7 +5,6 @@ use std::path::{Path, PathBuf};
 
 use anyhow::{Context, Result, bail};
 use clap::{Args, Subcommand};
-use indicatif::ProgressBar;
 use seads_embodiment::Environment;
 use seads_rl::{Run, TrainConfig, Trainer, find_checkpoint, load_config};
 use seads_uarm::{
@@ -394,11 +393,7 @@ fn evaluate(
     quiet: bool,
 ) -> Result<()> {
     let checkpoint = find_checkpoint(run, epoch).map_err(|e| BadInput(e.into()))?;
-    let bar = if quiet {
-        ProgressBar::hidden()
-    } else {
-        ProgressBar::new(5 * boards as u64)
-    };
+    let bar = crate::progress_bar(5 * boards as u64, quiet, "{wide_bar} {pos}/{len}");
     let record = seads_study::robot::evaluate_robot(
         run,
         &checkpoint,

@@ -547,6 +547,94 @@ fn planning_commands_reject_bad_input() {
     assert!(String::from_utf8_lossy(&missing.stderr).contains("loading the agent"));
 }
 
+/// A device that is not there, or not a device, is one line of bad input from every command
+/// that runs networks, and nothing is written: this binary has no CUDA (no `cuda` feature),
+/// GPU or not.
+#[test]
+fn devices_that_are_not_there_are_refused_before_anything_is_written() {
+    let run = tiny_run().join("run");
+    let run = run.to_str().unwrap();
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("new");
+    let out = out.to_str().unwrap();
+    let before = std::fs::read_dir(run).unwrap().count();
+    let no_cuda = "needs a CUDA build of seads";
+    for device in ["cuda", "cuda:0", "cuda:3"] {
+        check_bad_input(
+            &[
+                "train",
+                "--env",
+                "lightsout-cursor",
+                "--out",
+                out,
+                "--device",
+                device,
+            ],
+            no_cuda,
+        );
+        check_bad_input(&["train", "--resume", run, "--device", device], no_cuda);
+        check_bad_input(&["evaluate", "--run", run, "--device", device], no_cuda);
+        check_bad_input(
+            &[
+                "solve",
+                "--run",
+                run,
+                "--board",
+                "0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,1",
+                "--device",
+                device,
+            ],
+            no_cuda,
+        );
+        check_bad_input(
+            &["plan-bench", "--depths", "1", "--device", device],
+            no_cuda,
+        );
+    }
+    for bad in ["gpu", "cuda:", "cuda:-1", "cuda:1.5", "CUDA 0"] {
+        check_bad_input(
+            &["evaluate", "--run", run, "--device", bad],
+            "not one of cpu, cuda, cuda:N",
+        );
+        check_bad_input(
+            &["sweep", "run", out, "--device", bad],
+            "not one of cpu, cuda, cuda:N",
+        );
+        check_bad_input(
+            &["sweep", "slurm", out, "--device", bad],
+            "not one of cpu, cuda, cuda:N",
+        );
+    }
+    // A device in a config file is checked as on the command line.
+    let config = dir.path().join("gpu.toml");
+    std::fs::write(&config, "env = \"lightsout-cursor\"\ndevice = \"cuda:1\"\n").unwrap();
+    check_bad_input(
+        &["train", "--config", config.to_str().unwrap(), "--out", out],
+        no_cuda,
+    );
+    std::fs::write(&config, "env = \"lightsout-cursor\"\ndevice = \"tpu\"\n").unwrap();
+    check_bad_input(
+        &["train", "--config", config.to_str().unwrap(), "--out", out],
+        "not one of cpu, cuda, cuda:N",
+    );
+    assert!(
+        !std::path::Path::new(out).exists(),
+        "a refused command wrote {out}"
+    );
+    assert_eq!(
+        std::fs::read_dir(run).unwrap().count(),
+        before,
+        "a refused command wrote into the run"
+    );
+    // The CPU is always there, and a run's provenance says where it trained.
+    let provenance =
+        std::fs::read_to_string(std::path::Path::new(run).join("provenance.jsonl")).unwrap();
+    assert!(
+        provenance.lines().all(|l| l.contains("\"device\":\"cpu\"")),
+        "{provenance}"
+    );
+}
+
 #[test]
 fn record_and_replay_round_trip() {
     let dir = tempfile::tempdir().unwrap();

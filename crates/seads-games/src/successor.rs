@@ -12,6 +12,11 @@ pub trait Successor {
     /// Appends the successor of every state under every skill to `out`, state-major:
     /// entry `i · K + k` is the state after skill k from `states[i]`.
     fn successors(&mut self, states: &[SymbolicState], out: &mut Vec<SymbolicState>);
+    /// How many states one call should take to run efficiently (0: no preference). A GPU
+    /// wants tens of thousands; the planner then computes several of its chunks per call.
+    fn preferred_batch(&self) -> usize {
+        0
+    }
 }
 
 /// The ground-truth game as a successor function: skill k performs move k.

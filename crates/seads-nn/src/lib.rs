@@ -3,6 +3,10 @@
 //! Adam whose state can be checkpointed. The skill model (`seads-skillmodel`) and SAC (`seads-rl`)
 //! are built from them.
 
+mod device;
+
+pub use device::{ComputeDevice, DeviceError};
+
 use rand::{Rng, RngExt};
 use tch::nn::{self, Module};
 use tch::{Kind, Tensor};
@@ -133,6 +137,9 @@ pub struct Adam {
     m: Tensor,
     v: Tensor,
     step: Tensor,
+    /// `step`'s value on the host (read once after a restore), so that a step on a GPU does not
+    /// wait for the device to read it.
+    steps_taken: Option<f64>,
 }
 
 impl Adam {
@@ -158,6 +165,7 @@ impl Adam {
             m,
             v,
             step,
+            steps_taken: Some(0.0),
         }
     }
 
@@ -165,8 +173,12 @@ impl Adam {
     /// formula (the rounding may differ in the last bits); `g` is used as scratch space.
     fn step(&mut self, mut g: Tensor) {
         tch::no_grad(|| {
+            let t = 1.0
+                + self
+                    .steps_taken
+                    .unwrap_or_else(|| f64::try_from(&self.step).expect("scalar step count"));
+            self.steps_taken = Some(t);
             let _ = self.step.g_add_scalar_(1.0);
-            let t = f64::try_from(&self.step).expect("scalar step count");
             let (c1, c2) = (1.0 - Self::BETA1.powf(t), 1.0 - Self::BETA2.powf(t));
             // m ← β₁·m + (1 − β₁)·g and v ← β₂·v + (1 − β₂)·g², as interpolations.
             let _ = self.m.lerp_(&g, 1.0 - Self::BETA1);
@@ -217,6 +229,7 @@ impl Adam {
 
     /// The optimiser state, for restoring checkpoints.
     pub fn state_mut(&mut self) -> &mut nn::VarStore {
+        self.steps_taken = None;
         &mut self.state
     }
 }

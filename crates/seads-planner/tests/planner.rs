@@ -380,3 +380,46 @@ fn a_solved_board_is_solved_without_a_skill() {
         assert_eq!(outcome.manipulator_steps, 0);
     }
 }
+
+/// The ground truth asking for batches of `.1` states, as a GPU successor does.
+struct Grouped<'a>(GameSuccessor<'a>, usize);
+
+impl Successor for Grouped<'_> {
+    fn num_skills(&self) -> usize {
+        self.0.num_skills()
+    }
+    fn symbolic_len(&self) -> usize {
+        self.0.symbolic_len()
+    }
+    fn successors(&mut self, states: &[SymbolicState], out: &mut Vec<SymbolicState>) {
+        self.0.successors(states, out)
+    }
+    fn preferred_batch(&self) -> usize {
+        self.1
+    }
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(12))]
+
+    /// Computing several chunks per call (a GPU's batches) and deduplicating on several threads
+    /// change neither the plan nor its counts, nor where a state budget stops the search.
+    #[test]
+    fn batches_and_threads_do_not_change_the_search(
+        moves in proptest::collection::vec(0usize..25, 4..8),
+        batch in 1usize..700,
+        group in 0usize..40_000,
+        threads in 1usize..5,
+        budget in proptest::option::of(1usize..20_000),
+    ) {
+        let lo = &*LIGHTSOUT;
+        let board = lo.apply_all(lo.goal(), &moves);
+        let config = PlannerConfig { batch_size: batch, max_expanded: budget, ..PlannerConfig::default() };
+        let plain = bfs_plan(&mut GameSuccessor::new(lo), board, lo.goal(), &config);
+        let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
+        let grouped = pool.install(|| {
+            bfs_plan(&mut Grouped(GameSuccessor::new(lo), group), board, lo.goal(), &config)
+        });
+        prop_assert_eq!(plain, grouped);
+    }
+}

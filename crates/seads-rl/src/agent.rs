@@ -5,7 +5,6 @@ use std::path::{Path, PathBuf};
 
 use seads_embodiment::{EnvSpec, SkillPolicy, make_env};
 use seads_skillmodel::{ForwardModel, SkillModel, SkillModelKind};
-use tch::Device;
 
 use crate::episode::policy_input;
 use crate::hac::HacPolicy;
@@ -96,19 +95,20 @@ impl Agent {
         crate::numerics::check(config.portable_numerics)?;
         crate::store::check_origin(checkpoint, &config)?;
         let k = config.num_skills.unwrap_or(spec.num_skills);
+        let device = config.device.resolve()?;
         let mut sac = Sac::new(
             spec.obs_dim + k,
             &spec.action_low,
             &spec.action_high,
             &config.sac,
-            Device::Cpu,
+            device,
             0,
         );
         sac.load(checkpoint, true)?;
         let model = match config.skill_model.kind {
             SkillModelKind::Forward => {
                 let mut model =
-                    ForwardModel::new(spec.symbolic_len, k, &config.skill_model, Device::Cpu, 0);
+                    ForwardModel::new(spec.symbolic_len, k, &config.skill_model, device, 0);
                 model.load(checkpoint, false)?;
                 Some(model)
             }
@@ -159,7 +159,7 @@ pub fn load_policy(
                 &spec.action_low,
                 &spec.action_high,
                 &config.sac,
-                Device::Cpu,
+                config.device.resolve()?,
                 0,
             );
             sac.load(checkpoint, true)?;

@@ -1,6 +1,7 @@
 //! The training configuration: one TOML file per run, with a preset per environment.
 
 use seads_embodiment::{EnvConfig, env_names};
+use seads_nn::ComputeDevice;
 use seads_skillmodel::{RelabelKind, RewardConfig, SkillModelConfig};
 use serde::{Deserialize, Serialize};
 
@@ -160,12 +161,21 @@ pub struct TrainConfig {
     /// `COMPATIBLE` branch), so that the seed alone fixes the run. About 1.8× slower per SAC
     /// update; off in the presets, on for the demo and the tests (see `seads_rl::numerics`).
     pub portable_numerics: bool,
+    /// Where the networks run: `cpu` (the default) or `cuda`, `cuda:N`. Only the CPU is
+    /// bit-exact from the seed; a checkpoint from either loads on the other. Left out of the
+    /// written config when `cpu`, and set per command by `--device` (resuming may change it).
+    #[serde(skip_serializing_if = "is_cpu")]
+    pub device: ComputeDevice,
     /// The task-reward baselines' settings (`algorithm = "sac"` or `"hac"`).
     #[serde(skip_serializing_if = "is_default_baseline")]
     pub baseline: BaselineConfig,
     /// The HAC baseline's own settings (`algorithm = "hac"`).
     #[serde(skip_serializing_if = "is_default_hac")]
     pub hac: HacConfig,
+}
+
+fn is_cpu(device: &ComputeDevice) -> bool {
+    *device == ComputeDevice::Cpu
 }
 
 fn is_seads(algorithm: &Algorithm) -> bool {
@@ -203,6 +213,7 @@ impl Default for TrainConfig {
             threads: 1,
             sac_threads_alone: 2,
             portable_numerics: false,
+            device: ComputeDevice::Cpu,
             baseline: BaselineConfig::default(),
             hac: HacConfig::default(),
         }
@@ -737,6 +748,31 @@ fn one_line_toml_error(text: &str, e: &toml::de::Error) -> String {
 mod tests {
     use super::*;
     use proptest::prelude::*;
+
+    /// The device is written only when it is not the CPU, so the presets and every CPU run's
+    /// config.toml read as before devices existed; a GPU run's says so and reads back.
+    #[test]
+    fn the_device_is_written_only_for_a_gpu() {
+        let cpu = TrainConfig::default();
+        assert!(!cpu.to_toml().contains("device"));
+        let gpu = TrainConfig {
+            device: ComputeDevice::Cuda(1),
+            ..TrainConfig::default()
+        };
+        let text = gpu.to_toml();
+        assert!(text.contains("device = \"cuda:1\""), "{text}");
+        assert_eq!(TrainConfig::from_user_toml(&text, None, None).unwrap(), gpu);
+        let err = TrainConfig::from_user_toml(
+            "env = \"lightsout-cursor\"\ndevice = \"cuda:x\"",
+            None,
+            None,
+        )
+        .unwrap_err();
+        assert!(
+            err.to_string().contains("not one of cpu, cuda, cuda:N"),
+            "{err}"
+        );
+    }
 
     #[test]
     fn a_user_config_must_name_its_env_and_fills_from_its_preset() {

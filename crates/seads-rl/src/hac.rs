@@ -69,7 +69,6 @@ use seads_embodiment::EnvSpec;
 use seads_games::SymbolicState;
 use seads_planner::{DepthResult, TaskSet};
 use serde::{Deserialize, Serialize};
-use tch::Device;
 
 use crate::learner::Learner;
 use crate::replay::Replay;
@@ -240,7 +239,8 @@ fn game_goal(spec: &EnvSpec) -> Result<SymbolicState, RlError> {
 }
 
 /// The two levels' networks for `config` on an environment of `spec`.
-fn levels(config: &TrainConfig, spec: &EnvSpec) -> (Sac, Sac) {
+fn levels(config: &TrainConfig, spec: &EnvSpec) -> Result<(Sac, Sac), RlError> {
+    let device = config.device.resolve()?;
     let d = spec.symbolic_len;
     let high_config = SacConfig {
         alpha: config.hac.alpha_high,
@@ -251,7 +251,7 @@ fn levels(config: &TrainConfig, spec: &EnvSpec) -> (Sac, Sac) {
         d,
         config.hac.temperature,
         &high_config,
-        Device::Cpu,
+        device,
         derived_seed(config.seed, Purpose::SacInit, 1),
     );
     let low = Sac::new(
@@ -259,10 +259,10 @@ fn levels(config: &TrainConfig, spec: &EnvSpec) -> (Sac, Sac) {
         &spec.action_low,
         &spec.action_high,
         &config.sac,
-        Device::Cpu,
+        device,
         derived_seed(config.seed, Purpose::SacInit, 2),
     );
-    (high, low)
+    Ok((high, low))
 }
 
 impl Hac {
@@ -270,7 +270,7 @@ impl Hac {
     pub fn new(config: TrainConfig) -> Result<Self, RlError> {
         let (episodes, shared) = TaskEpisodes::new(&config)?;
         let spec = episodes.spec().clone();
-        let (high, low) = levels(&config, &spec);
+        let (high, low) = levels(&config, &spec)?;
         let d = spec.symbolic_len;
         let goal = game_goal(&spec)?;
         let capacity = config.baseline.replay_capacity;
@@ -689,7 +689,7 @@ impl HacPolicy<'static> {
     /// The policy saved in a checkpoint folder of a HAC run with `config` on `spec` (only the
     /// actors are read).
     pub fn load(config: &TrainConfig, spec: &EnvSpec, checkpoint: &Path) -> Result<Self, RlError> {
-        let (mut high, mut low) = levels(config, spec);
+        let (mut high, mut low) = levels(config, spec)?;
         high.load_as(checkpoint, HIGH_PREFIX, true)?;
         low.load_as(checkpoint, LOW_PREFIX, true)?;
         Ok(Self {

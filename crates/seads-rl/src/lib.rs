@@ -72,6 +72,7 @@ pub use numerics::{PORTABLE_KERNELS, kernel_environment, portable_kernels_active
 pub use relaxed::RelaxedBernoulli;
 pub use run::{Run, RunEvent, load_config, raise_budget};
 pub use sac::{Sac, SacConfig, SacLosses, TransitionBatch, checkpoint_files};
+pub use seads_nn::{ComputeDevice, DeviceError};
 pub use seeds::{Purpose, derived_seed, stream};
 pub use task_episodes::{TaskEpochStats, TaskTimings, updates_due};
 pub use task_policy::{TaskPolicy, task_success};
@@ -92,6 +93,9 @@ pub enum RlError {
     /// A configuration value that cannot be used.
     #[error("invalid configuration: {0}")]
     Config(String),
+    /// The device asked for is not there.
+    #[error(transparent)]
+    Device(#[from] seads_nn::DeviceError),
     /// The environment failed.
     #[error(transparent)]
     Env(#[from] seads_embodiment::EnvError),

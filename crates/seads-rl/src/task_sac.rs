@@ -26,7 +26,6 @@ use std::time::Instant;
 
 use seads_planner::{DepthResult, TaskSet};
 use serde::{Deserialize, Serialize};
-use tch::Device;
 
 use crate::learner::Learner;
 use crate::replay::Replay;
@@ -140,7 +139,7 @@ impl TaskSac {
             &spec.action_low,
             &spec.action_high,
             &config.sac,
-            Device::Cpu,
+            config.device.resolve()?,
             derived_seed(config.seed, Purpose::SacInit, 0),
         );
         let replay = Replay::new(

@@ -12,7 +12,6 @@ use seads_embodiment::{EnvConfig, EnvSpec, Environment, make_env};
 use seads_games::Split;
 use seads_skillmodel::{SkillModel, SkillTransition};
 use serde::{Deserialize, Serialize};
-use tch::Device;
 
 use crate::buffers::{Buffers, RelabelObserver};
 use crate::checkpoint::{self, Prepared};
@@ -136,7 +135,7 @@ impl Trainer {
         let envs = (0..config.episodes_per_epoch)
             .map(|_| template.box_clone())
             .collect();
-        let device = Device::Cpu;
+        let device = config.device.resolve()?;
         let sac = Sac::new(
             spec.obs_dim + k,
             &spec.action_low,

@@ -5,6 +5,7 @@ use std::path::{Path, PathBuf};
 
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
+use rayon::prelude::*;
 use seads_games::SymbolicState;
 use serde::{Deserialize, Serialize};
 use tch::nn::{self, Module};
@@ -13,6 +14,11 @@ use tch::{Device, Kind, Tensor};
 use crate::SkillModelError;
 use crate::screen::{Int8Screen, MAX_WIDTH, MIN_ROWS};
 use seads_nn::{Adam, Mlp, mean_f32};
+
+/// States per successor call on a GPU (25 skills: 8·10⁵ network rows, about 2 GiB of
+/// activations for 256-unit layers): enough rows that a call's launches and copies are a small
+/// part of it.
+const DEVICE_BATCH: usize = 32_768;
 
 /// float32 machine epsilon: α is clamped to [ε, 1 − ε] as PyTorch's Bernoulli does.
 const EPS: f64 = 1.192_092_9e-7;
@@ -174,6 +180,27 @@ impl ForwardModel {
         self.int8_screen = on;
     }
 
+    /// A copy of this model's weights on `device`, built with `config` (the one this model was
+    /// built with; the optimiser state is not copied): to plan on a GPU with a model fitted on
+    /// the CPU, or the other way round.
+    pub fn on_device(
+        &self,
+        config: &SkillModelConfig,
+        device: Device,
+    ) -> Result<Self, SkillModelError> {
+        let mut model = Self::new(self.d, self.k, config, device, 0);
+        model
+            .network
+            .vs
+            .copy(&self.network.vs)
+            .map_err(|e| SkillModelError::Checkpoint {
+                path: format!("(the model's weights, copied to {device:?})"),
+                reason: e.to_string(),
+            })?;
+        model.int8_screen = self.int8_screen;
+        Ok(model)
+    }
+
     /// Length D of the symbolic state.
     pub fn symbolic_len(&self) -> usize {
         self.d
@@ -209,34 +236,15 @@ impl ForwardModel {
             .clamp(EPS.ln(), (1.0 - EPS).ln())
     }
 
-    /// The first layer split into its z_0 part, computed once per state with the bias (n × H),
-    /// and each skill's column (K × H), added per skill.
-    fn first_layer_parts(&self, z0: &Tensor) -> (Tensor, Tensor) {
-        let first = &self.network.net.layers()[0];
-        let (d, k) = (self.d as i64, self.k as i64);
-        let w_state = first.ws.narrow(1, 0, d);
-        let bias = first.bs.as_ref().expect("layers have biases");
-        let per_state = z0.matmul(&w_state.transpose(0, 1)) + bias;
-        (per_state, first.ws.narrow(1, d, k).transpose(0, 1))
-    }
-
-    /// The layers after the first, on rectified first-layer activations (rows × H → rows × D).
-    fn after_first_layer(&self, hidden: Tensor) -> Tensor {
-        let layers = &self.network.net.layers()[1..];
-        layers.iter().enumerate().fold(hidden, |h, (i, layer)| {
-            let h = layer.forward(&h);
-            if i + 1 < layers.len() { h.relu() } else { h }
-        })
+    /// The network's layers as handles for inference on one thread.
+    fn inference(&self) -> Inference {
+        Inference::of(&self.network.net, self.d, self.k)
     }
 
     /// Flip logits of every state under every skill (n × K × D), the first layer factorised
-    /// (`first_layer_parts`).
+    /// (z₀'s part once per state, each skill's column added per skill).
     pub fn flip_logits_all_skills(&self, z0: &Tensor) -> Tensor {
-        let (per_state, w_skill) = self.first_layer_parts(z0);
-        let hidden = (per_state.unsqueeze(1) + w_skill.unsqueeze(0)).relu(); // n × K × H
-        let (n, k) = (z0.size()[0], self.k as i64);
-        self.after_first_layer(hidden.reshape([n * k, -1]))
-            .view([n, k, self.d as i64])
+        self.inference().flip_logits_all_skills(z0)
     }
 
     /// Flip logits for each `(z_0, k)` (n × D): bit d flips in the mode iff its logit > 0.
@@ -248,6 +256,119 @@ impl ForwardModel {
     /// and how many of them it computed in float32 because a logit lay within the screen's bound.
     pub fn screen_counts(&self) -> (u64, u64) {
         self.screen_counts
+    }
+    /// The successors of every state under every skill (state-major), computed where the model
+    /// is: the mode's next bits in float32, packed 32 to an integer, so that only the new states
+    /// leave the device. The planner's path on a GPU; on the CPU it gives the same states as the
+    /// other paths (tested), only with more copying.
+    pub fn device_successors(&self, states: &[SymbolicState]) -> Vec<SymbolicState> {
+        if states.is_empty() {
+            return Vec::new();
+        }
+        let (d, k) = (self.d, self.k);
+        let words = d.div_ceil(32);
+        let packed = tch::no_grad(|| {
+            let z0 = states_tensor(states.iter().copied(), d, self.device);
+            let logits = self.flip_logits_all_skills(&z0); // n × K × D
+            let ones = z0.unsqueeze(1).gt(0.5);
+            let flip = logits
+                .gt(0.0)
+                .logical_or(&ones.logical_and(&logits.eq(0.0)));
+            let next = flip.logical_xor(&ones).to_kind(Kind::Int64); // n × K × D
+            let next = next.constant_pad_nd([0, (words * 32 - d) as i64]);
+            let weights = Tensor::from_slice(&(0..32).map(|b| 1i64 << b).collect::<Vec<_>>())
+                .to_device(self.device);
+            let packed = (next.view([states.len() as i64, k as i64, words as i64, 32]) * weights)
+                .sum_dim_intlist(3, false, Kind::Int64);
+            Vec::<i64>::try_from(packed.view([-1]).to_device(Device::Cpu)).expect("packed states")
+        });
+        packed
+            .chunks(words)
+            .map(|chunk| {
+                let mut state = [0u64; 3];
+                for (i, &half) in chunk.iter().enumerate() {
+                    state[i / 2] |= (half as u64) << (32 * (i % 2));
+                }
+                SymbolicState::from_words(state)
+            })
+            .collect()
+    }
+
+    /// The 8-bit screen for the current weights (built on first use), or `None` where it does
+    /// not apply: switched off, not on the CPU, not two hidden layers, or a layer wider than
+    /// 1,024.
+    fn screen(&mut self) -> Option<&Int8Screen> {
+        let layers = self.network.net.layers();
+        let narrow = layers.iter().all(|l| l.ws.size()[1] <= MAX_WIDTH);
+        if !self.int8_screen || self.device != Device::Cpu || layers.len() != 3 || !narrow {
+            return None;
+        }
+        let bias = |l: &nn::Linear| l.bs.as_ref().expect("layers have biases").shallow_clone();
+        Some(self.screen.get_or_insert_with(|| {
+            tch::no_grad(|| {
+                Int8Screen::new(
+                    &layers[1].ws,
+                    &bias(&layers[1]),
+                    &layers[2].ws,
+                    &bias(&layers[2]),
+                )
+            })
+        }))
+    }
+}
+
+/// States per part of a CPU successor call: the parts are computed on the rayon pool's threads,
+/// always cut the same way, so that the successors do not depend on the number of threads.
+const CPU_PART: usize = 512;
+
+/// A forward model's layers for inference on one thread: shallow handles on its weights (a
+/// tensor may be used from one thread at a time; the handles share the storage).
+struct Inference {
+    layers: Vec<nn::Linear>,
+    d: usize,
+    k: usize,
+}
+
+impl Inference {
+    fn of(net: &Mlp, d: usize, k: usize) -> Self {
+        let layers = net
+            .layers()
+            .iter()
+            .map(|l| nn::Linear {
+                ws: l.ws.shallow_clone(),
+                bs: l.bs.as_ref().map(Tensor::shallow_clone),
+            })
+            .collect();
+        Self { layers, d, k }
+    }
+
+    /// The first layer split into its z_0 part, computed once per state with the bias (n × H),
+    /// and each skill's column (K × H), added per skill.
+    fn first_layer_parts(&self, z0: &Tensor) -> (Tensor, Tensor) {
+        let first = &self.layers[0];
+        let (d, k) = (self.d as i64, self.k as i64);
+        let w_state = first.ws.narrow(1, 0, d);
+        let bias = first.bs.as_ref().expect("layers have biases");
+        let per_state = z0.matmul(&w_state.transpose(0, 1)) + bias;
+        (per_state, first.ws.narrow(1, d, k).transpose(0, 1))
+    }
+
+    /// The layers after the first, on rectified first-layer activations (rows × H → rows × D).
+    fn after_first_layer(&self, hidden: Tensor) -> Tensor {
+        let layers = &self.layers[1..];
+        layers.iter().enumerate().fold(hidden, |h, (i, layer)| {
+            let h = layer.forward(&h);
+            if i + 1 < layers.len() { h.relu() } else { h }
+        })
+    }
+
+    /// Flip logits of every state under every skill (n × K × D).
+    fn flip_logits_all_skills(&self, z0: &Tensor) -> Tensor {
+        let (per_state, w_skill) = self.first_layer_parts(z0);
+        let hidden = (per_state.unsqueeze(1) + w_skill.unsqueeze(0)).relu(); // n × K × H
+        let (n, k) = (z0.size()[0], self.k as i64);
+        self.after_first_layer(hidden.reshape([n * k, -1]))
+            .view([n, k, self.d as i64])
     }
 
     /// The mode's flips (n × K × D, 1: the bit flips) in float32.
@@ -261,27 +382,16 @@ impl ForwardModel {
             .expect("flip table")
     }
 
-    /// The same flips through the 8-bit screen (`screen.rs`), or `None` where it does not apply
-    /// (switched off, not on the CPU, not two hidden layers, a layer wider than 1,024, or a batch
-    /// too small to gain).
-    fn screened_flips(&mut self, z0: &Tensor) -> Option<Vec<u8>> {
-        let layers = self.network.net.layers();
-        let narrow = layers.iter().all(|l| l.ws.size()[1] <= MAX_WIDTH);
-        let rows = z0.size()[0] as usize * self.k;
-        if !self.int8_screen
-            || self.device != Device::Cpu
-            || layers.len() != 3
-            || !narrow
-            || rows < MIN_ROWS
-        {
-            return None;
-        }
+    /// The same flips through the 8-bit screen (`screen.rs`), and the number of (state, skill)
+    /// rows it left to float32.
+    fn screened_flips(&self, z0: &Tensor, screen: &Int8Screen) -> (Vec<u8>, usize) {
         // The first layer exactly as `flip_logits_all_skills` computes it.
         let (d, k) = (self.d, self.k);
         let (per_state, skill_cols) = self.first_layer_parts(z0);
         let h1 = per_state.size()[1] as usize;
-        let per_state = Vec::<f32>::try_from(per_state.contiguous().view([-1])).ok()?;
-        let skill_cols = Vec::<f32>::try_from(skill_cols.contiguous().view([-1])).ok()?;
+        let floats = |t: Tensor| Vec::<f32>::try_from(t.contiguous().view([-1])).expect("floats");
+        let per_state = floats(per_state);
+        let skill_cols = floats(skill_cols);
         let n = per_state.len() / h1;
         let mut hidden = Vec::with_capacity(n * k * h1);
         for state in per_state.chunks(h1) {
@@ -289,15 +399,6 @@ impl ForwardModel {
                 hidden.extend(state.iter().zip(col).map(|(&a, &b)| (a + b).max(0.0)));
             }
         }
-        let bias = |l: &nn::Linear| l.bs.as_ref().expect("layers have biases").shallow_clone();
-        let screen = self.screen.get_or_insert_with(|| {
-            Int8Screen::new(
-                &layers[1].ws,
-                &bias(&layers[1]),
-                &layers[2].ws,
-                &bias(&layers[2]),
-            )
-        });
         let mut flips = vec![0u8; n * k * d];
         let redo = screen.decide(&hidden, n * k, &mut flips);
         if !redo.is_empty() {
@@ -307,9 +408,8 @@ impl ForwardModel {
                 .flat_map(|&row| hidden[row * h1..(row + 1) * h1].iter().copied())
                 .collect();
             let h = Tensor::from_slice(&rows).view([redo.len() as i64, h1 as i64]);
-            let logits = self.after_first_layer(h);
-            let logits = Vec::<f32>::try_from(logits.contiguous().view([-1])).ok()?;
-            let bits = Vec::<f32>::try_from(z0.contiguous().view([-1])).ok()?;
+            let logits = floats(self.after_first_layer(h));
+            let bits = floats(z0.shallow_clone());
             for (j, &row) in redo.iter().enumerate() {
                 let state = row / k;
                 for bit in 0..d {
@@ -319,9 +419,40 @@ impl ForwardModel {
                 }
             }
         }
-        self.screen_counts.0 += (n * k) as u64;
-        self.screen_counts.1 += redo.len() as u64;
-        Some(flips)
+        (flips, redo.len())
+    }
+
+    /// The successors of `states` (state-major), through the screen where there is one and the
+    /// part is large enough to gain from it; and the rows screened and recomputed.
+    fn successors(
+        &self,
+        states: &[SymbolicState],
+        screen: Option<&Int8Screen>,
+    ) -> (Vec<SymbolicState>, u64, u64) {
+        let (d, k) = (self.d, self.k);
+        let (flips, screened, redone) = tch::no_grad(|| {
+            let z0 = states_tensor(states.iter().copied(), d, Device::Cpu);
+            match screen {
+                Some(screen) if states.len() * k >= MIN_ROWS => {
+                    let (flips, redone) = self.screened_flips(&z0, screen);
+                    (flips, states.len() * k, redone)
+                }
+                _ => (self.exact_flips(&z0), 0, 0),
+            }
+        });
+        let mut out = Vec::with_capacity(states.len() * k);
+        for (&z, row) in states.iter().zip(flips.chunks(k * d)) {
+            for skill in row.chunks(d) {
+                let mut next = z;
+                for (bit, &f) in skill.iter().enumerate() {
+                    if f != 0 {
+                        next.flip(bit);
+                    }
+                }
+                out.push(next);
+            }
+        }
+        (out, screened as u64, redone as u64)
     }
 }
 
@@ -531,23 +662,37 @@ impl seads_games::Successor for ForwardModel {
         if states.is_empty() {
             return;
         }
-        let flips = tch::no_grad(|| {
-            let z0 = states_tensor(states.iter().copied(), self.d, self.device);
-            self.screened_flips(&z0)
-                .unwrap_or_else(|| self.exact_flips(&z0))
-        });
+        if self.device != Device::Cpu {
+            out.extend(self.device_successors(states));
+            return;
+        }
+        // Parts of a fixed size on the pool's threads, each with its own handles on the weights.
+        let screen = self.screen().map(Int8Screen::shallow_clone);
+        let parts: Vec<(Inference, Option<Int8Screen>, &[SymbolicState])> = states
+            .chunks(CPU_PART)
+            .map(|part| {
+                let screen = screen.as_ref().map(Int8Screen::shallow_clone);
+                (self.inference(), screen, part)
+            })
+            .collect();
+        let done: Vec<(Vec<SymbolicState>, u64, u64)> = parts
+            .into_par_iter()
+            .map(|(inference, screen, part)| inference.successors(part, screen.as_ref()))
+            .collect();
         out.reserve(states.len() * self.k);
-        for (i, &z) in states.iter().enumerate() {
-            for k in 0..self.k {
-                let row = &flips[(i * self.k + k) * self.d..(i * self.k + k + 1) * self.d];
-                let mut next = z;
-                for (d, &f) in row.iter().enumerate() {
-                    if f != 0 {
-                        next.flip(d);
-                    }
-                }
-                out.push(next);
-            }
+        for (next, screened, redone) in done {
+            out.extend(next);
+            self.screen_counts.0 += screened;
+            self.screen_counts.1 += redone;
+        }
+    }
+
+    fn preferred_batch(&self) -> usize {
+        if self.device == Device::Cpu {
+            // A part for each of the pool's threads.
+            4 * CPU_PART * rayon::current_num_threads()
+        } else {
+            DEVICE_BATCH
         }
     }
 }
@@ -601,6 +746,85 @@ mod tests {
                 );
             }
         }
+    }
+
+    /// The GPU's path (run here on the CPU) packs the float32 mode's states into words: the
+    /// same successors as the CPU's path, for states of one, two and three words.
+    #[test]
+    fn the_device_path_gives_the_float32_successors() {
+        use rand::RngExt;
+        use seads_games::Successor;
+        for (d, k, seed) in [(25, 25, 3), (70, 6, 4), (150, 4, 5)] {
+            let mut model =
+                ForwardModel::new(d, k, &SkillModelConfig::default(), Device::Cpu, seed);
+            model.set_int8_screen(false);
+            let mut rng = ChaCha8Rng::seed_from_u64(seed);
+            let states: Vec<SymbolicState> = (0..300)
+                .map(|_| {
+                    let mut z = SymbolicState::ZERO;
+                    for bit in 0..d {
+                        z.set(bit, rng.random::<bool>());
+                    }
+                    z
+                })
+                .collect();
+            let mut expected = Vec::new();
+            model.successors(&states, &mut expected);
+            // Every bit follows the mode's rule, computed one (state, skill) row at a time.
+            for (i, &z) in states.iter().enumerate().take(20) {
+                for skill in 0..k {
+                    let logits =
+                        Vec::<f32>::try_from(model.flip_logits(&[z], &[skill]).view([-1])).unwrap();
+                    let next = expected[i * k + skill];
+                    for (bit, &logit) in logits.iter().enumerate() {
+                        let flips = logit > 0.0 || (z.get(bit) && logit == 0.0);
+                        if (next.get(bit) != z.get(bit)) != flips {
+                            // The factorised first layer rounds differently from the plain
+                            // forward pass only next to 0.
+                            assert!(
+                                logit.abs() < 1e-4,
+                                "state {i} skill {skill} bit {bit}: {logit}"
+                            );
+                        }
+                    }
+                    for bit in d..SymbolicState::MAX_BITS {
+                        assert!(!next.get(bit));
+                    }
+                }
+            }
+            assert_eq!(model.device_successors(&states), expected, "d = {d}");
+        }
+    }
+
+    /// A copy to a device (here the CPU, the only one CI has) holds the same weights, so it
+    /// scores and plans as the original; the original keeps training on its own.
+    #[test]
+    fn a_model_copied_to_a_device_keeps_its_weights() {
+        use seads_games::Successor;
+        let config = SkillModelConfig::default();
+        let mut model = ForwardModel::new(25, 25, &config, Device::Cpu, 11);
+        let batch: Vec<SkillTransition> = (0..32)
+            .map(|i| SkillTransition {
+                z0: SymbolicState::from_u64(i * 7919 % (1 << 25)),
+                skill: (i % 25) as usize,
+                zt: SymbolicState::from_u64(i * 104_729 % (1 << 25)),
+            })
+            .collect();
+        model.train_step(&batch);
+        let mut copy = model.on_device(&config, Device::Cpu).unwrap();
+        let pairs: Vec<_> = batch.iter().map(|t| (t.z0, t.zt)).collect();
+        assert_eq!(model.scores(&pairs), copy.scores(&pairs));
+        let states: Vec<_> = batch.iter().map(|t| t.z0).collect();
+        let (mut a, mut b) = (Vec::new(), Vec::new());
+        model.successors(&states, &mut a);
+        copy.successors(&states, &mut b);
+        assert_eq!(a, b);
+        model.train_step(&batch);
+        assert_ne!(
+            model.scores(&pairs),
+            copy.scores(&pairs),
+            "the copy shares no storage"
+        );
     }
 
     #[test]

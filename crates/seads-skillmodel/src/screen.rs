@@ -108,6 +108,24 @@ fn floats(t: &Tensor) -> Vec<f32> {
 }
 
 impl Int8Screen {
+    /// Another handle on the same screen, for another thread (a tensor is used from one thread
+    /// at a time; the handles share their storage).
+    pub(crate) fn shallow_clone(&self) -> Self {
+        Self {
+            w2: self.w2.shallow_clone(),
+            t: self.t.clone(),
+            b2: self.b2.clone(),
+            w3_t: self.w3_t.shallow_clone(),
+            b3: self.b3.clone(),
+            sensitivity: self.sensitivity.shallow_clone(),
+            c_sum: self.c_sum.clone(),
+            v_t: self.v_t.clone(),
+            v_abs: self.v_abs.clone(),
+            v_b2: self.v_b2.clone(),
+            ..*self
+        }
+    }
+
     /// Prepares layers 2 and 3 (`w2`: H₂ × H₁, `w3`: D × H₂, as `nn::Linear` holds them).
     pub(crate) fn new(w2: &Tensor, b2: &Tensor, w3: &Tensor, b3: &Tensor) -> Self {
         let (h2, h1) = (w2.size()[0] as usize, w2.size()[1] as usize);

@@ -43,6 +43,7 @@ pub mod draw;
 mod error;
 pub mod evaluation;
 pub mod figures;
+pub mod numbers;
 pub mod over_training;
 pub mod provenance;
 pub mod report;

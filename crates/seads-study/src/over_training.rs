@@ -6,7 +6,7 @@
 use std::path::Path;
 
 use seads_planner::{Protocol, SearchLimits, TaskSet};
-use seads_rl::Agent;
+use seads_rl::{Agent, ComputeDevice};
 
 use crate::evaluation::{
     CheckpointEvaluation, OVER_TRAINING, evaluate_agent, over_training_protocol, read_over_training,
@@ -109,8 +109,8 @@ impl std::str::FromStr for Selection {
     }
 }
 
-/// Evaluates the selected checkpoints of `run` in both modes on `tasks` (test boards, the
-/// protocol's seeds), unless the file holds them evaluated with the same protocol already.
+/// Evaluates the selected checkpoints of `run` on `device` in both modes on `tasks` (test
+/// boards, the protocol's seeds), unless the file holds them evaluated with the same protocol already.
 /// Returns the number of lines appended. `progress` hears of the work as it goes. A run
 /// without the chosen checkpoints is [`StudyError::Invalid`].
 pub fn evaluate_checkpoints(
@@ -118,9 +118,11 @@ pub fn evaluate_checkpoints(
     selection: Selection,
     tasks: &TaskSet,
     limits: SearchLimits,
+    device: ComputeDevice,
     mut progress: impl FnMut(Progress),
 ) -> Result<usize> {
-    let config = seads_rl::load_config(run).doing(|| format!("reading {}", run.display()))?;
+    let mut config = seads_rl::load_config(run).doing(|| format!("reading {}", run.display()))?;
+    config.device = device;
     let kept = seads_rl::store::checkpoints(run).doing(|| format!("reading {}", run.display()))?;
     if kept.is_empty() {
         return Err(StudyError::invalid(format!(

@@ -9,6 +9,7 @@
 
 use std::path::Path;
 
+use seads_rl::ComputeDevice;
 use serde::{Deserialize, Serialize};
 
 /// The file in a run directory.
@@ -49,13 +50,26 @@ pub struct Provenance {
     pub logical_cpus: usize,
     /// The run's `portable_numerics` (MKL's `COMPATIBLE` branch when true).
     pub portable_numerics: bool,
+    /// Where the networks ran (`cpu`, `cuda:N`); lines from before devices say nothing: `cpu`.
+    #[serde(default)]
+    pub device: ComputeDevice,
+    /// The GPU's name as its driver reports it, for a CUDA device.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub gpu: Option<String>,
     /// When this process started, in seconds since the Unix epoch.
     pub started_unix_s: u64,
 }
 
 impl Provenance {
-    /// This process of the binary `build`, about to train from `epoch` and `env_steps`.
-    pub fn here(epoch: u64, env_steps: u64, portable_numerics: bool, build: &Build) -> Self {
+    /// This process of the binary `build`, about to train from `epoch` and `env_steps` on
+    /// `device`.
+    pub fn here(
+        epoch: u64,
+        env_steps: u64,
+        portable_numerics: bool,
+        device: ComputeDevice,
+        build: &Build,
+    ) -> Self {
         let (cpu_vendor, cpu_model, avx512) = cpu();
         Self {
             epoch,
@@ -68,6 +82,8 @@ impl Provenance {
             avx512,
             logical_cpus: std::thread::available_parallelism().map_or(1, |n| n.get()),
             portable_numerics,
+            device,
+            gpu: device.gpu_name(),
             started_unix_s: std::time::SystemTime::now()
                 .duration_since(std::time::UNIX_EPOCH)
                 .map_or(0, |d| d.as_secs()),

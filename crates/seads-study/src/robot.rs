@@ -28,7 +28,11 @@ pub fn evaluate_robot(
     timeout_s: f64,
     mut each: impl FnMut(),
 ) -> Result<EvaluationRecord> {
-    let config = seads_rl::load_config(run)?;
+    // The robot's agent runs on the CPU, wherever it trained.
+    let config = seads_rl::TrainConfig {
+        device: seads_rl::ComputeDevice::Cpu,
+        ..seads_rl::load_config(run)?
+    };
     let mut agent = Agent::load_for(config, env.spec().clone(), checkpoint)?;
     let (policy, model) = agent.parts()?;
     let game = LightsOut::new(5).expect("LightsOut 5×5 exists");

@@ -1,7 +1,7 @@
 //! `seads plan-bench`: breadth-first search with a forward model fitted to the LightsOut 5×5
 //! move table, timed per depth.
 
-use anyhow::Result;
+use anyhow::{Context, Result};
 use clap::Args;
 use seads_study::bench::PlanBench;
 
@@ -17,9 +17,16 @@ pub struct PlanBenchArgs {
     /// Boards per depth (test split).
     #[arg(long, default_value_t = 3)]
     boards: usize,
-    /// libtorch threads (1: the one-core figure).
-    #[arg(long, default_value_t = 1)]
-    threads: usize,
+    /// Threads of the search (libtorch's and the bookkeeping's; 1: the one-core figure).
+    #[arg(long, default_value_t = 1, value_parser = clap::value_parser!(u32).range(1..))]
+    threads: u32,
+    /// Where the forward model's successors are computed: cpu, cuda or cuda:N. The model is
+    /// fitted on the CPU either way, so the plans and counts are comparable.
+    #[arg(long, default_value = "cpu")]
+    device: seads_rl::ComputeDevice,
+    /// Time limit per search, seconds: the first depth that hits it is the last one run.
+    #[arg(long, value_parser = crate::positive_finite)]
+    timeout: Option<f64>,
     /// Compute every logit in float32, without the 8-bit screen (the same plans, more
     /// arithmetic; for comparison).
     #[arg(long)]
@@ -31,47 +38,39 @@ pub struct PlanBenchArgs {
 
 /// `seads plan-bench`: BFS with a forward model fitted to the LightsOut 5×5 move table.
 pub fn plan_bench(args: PlanBenchArgs) -> Result<()> {
-    seads_rl::set_threads(args.threads.max(1));
+    let device = crate::usable_device(args.device)?;
+    let threads = args.threads as usize;
+    // The search's parts and bookkeeping run on the pool, each part on one libtorch thread.
+    seads_rl::set_threads(1);
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(threads)
+        .build()
+        .context("starting the search's threads")?;
     let bench = PlanBench {
         hidden: args.hidden.clone(),
         depths: args.depths.clone(),
         boards: args.boards,
         float32: args.float32,
+        device,
+        timeout_s: args.timeout,
     };
     // A line per depth as it is timed; a failed write ends the command after the benchmark.
     let mut written = Ok(());
-    let report = bench
-        .run(|row| {
-            if !args.json && written.is_ok() {
-                use std::io::Write as _;
-                written = writeln!(
-                    std::io::stdout().lock(),
-                    "depth {}: mean {:.3} s per plan over {} boards (plan lengths {:?})",
-                    row.depth,
-                    row.mean_s,
-                    args.boards,
-                    row.plan_lengths
-                );
-            }
+    let report = pool
+        .install(|| {
+            bench.run(|row| {
+                if !args.json && written.is_ok() {
+                    use std::io::Write as _;
+                    written = writeln!(std::io::stdout().lock(), "{}", row.summary());
+                }
+            })
         })
         .map_err(crate::study_error)?;
     written.map_err(|e| anyhow::anyhow!("writing to standard output: {e}"))?;
     if args.json {
         outln!("{}", serde_json::to_string(&report)?);
     } else {
-        outln!(
-            "model hidden {:?}, agreement with the move table {:.5}, peak memory {:.0} MiB",
-            args.hidden,
-            report.model_agreement,
-            report.peak_rss_mib
-        );
-        if !args.float32 {
-            outln!(
-                "8-bit screen: {} (state, skill) pairs, {} of them computed again in float32",
-                report.screened,
-                report.recomputed
-            );
-        }
+        outln!("{}", report.summary());
     }
     Ok(())
 }

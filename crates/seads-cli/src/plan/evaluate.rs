@@ -7,27 +7,11 @@ use anyhow::{Context, Result, bail};
 use clap::Args;
 use seads_games::Split;
 use seads_planner::{EvaluationKind, Protocol, SearchLimits, TaskSet, summarise};
+use seads_rl::ComputeDevice;
 
 use super::{load_agent, run_evaluation};
 use crate::BadInput;
 use seads_study::evaluation::{self, run_policy_evaluation};
-
-/// Parses "1-5", "6,8,10" or "3": sorted, each once, none zero.
-fn parse_depths(text: &str) -> Result<Vec<usize>> {
-    let bad = || {
-        BadInput(anyhow::anyhow!(
-            "--depths takes a range like 1-5 or a list like 1,3,5 of depths from 1, got {text:?}"
-        ))
-    };
-    let numbers = crate::NumberList::parse(text).map_err(|_| bad())?.0;
-    if numbers.contains(&0) {
-        return Err(bad().into());
-    }
-    numbers
-        .into_iter()
-        .map(|d| usize::try_from(d).map_err(|_| bad().into()))
-        .collect()
-}
 
 /// A command-line number that must be finite and not negative (a standard deviation).
 fn non_negative_finite(text: &str) -> Result<f64, String> {
@@ -83,6 +67,10 @@ pub struct EvaluateArgs {
     /// seed; the files are named `evaluation-replan-noise-STD…`.
     #[arg(long, value_parser = non_negative_finite, conflicts_with = "checkpoints")]
     action_noise: Option<f64>,
+    /// Where the networks run: cpu, cuda (the first GPU) or cuda:N, whichever device the run
+    /// trained on. The plans are the same on either.
+    #[arg(long, default_value = "cpu")]
+    device: ComputeDevice,
     /// No progress bar.
     #[arg(long)]
     quiet: bool,
@@ -93,7 +81,10 @@ pub struct EvaluateArgs {
 
 /// `seads evaluate`.
 pub fn evaluate_run(args: EvaluateArgs) -> Result<()> {
-    let depths = parse_depths(&args.depths)?;
+    let depths = seads_study::numbers::depths(&args.depths)
+        .map_err(|e| BadInput(anyhow::anyhow!("--depths: {e}")))?;
+    // The planner's parts run on rayon's threads, each on one libtorch thread.
+    seads_rl::set_threads(1);
     let limits = SearchLimits {
         timeout_s: args.timeout,
         max_expanded: args
@@ -110,8 +101,9 @@ pub fn evaluate_run(args: EvaluateArgs) -> Result<()> {
             args.boards
         )));
     }
-    let config = seads_rl::load_config(&args.run)
+    let mut config = seads_rl::load_config(&args.run)
         .with_context(|| format!("loading run {}", args.run.display()))?;
+    config.device = crate::usable_device(args.device)?;
     let _lock = crate::lock_run(&args.run)?;
     if config.algorithm.is_baseline() {
         if args.action_noise.is_some() {
@@ -146,6 +138,7 @@ pub fn evaluate_run(args: EvaluateArgs) -> Result<()> {
             &tasks,
             limits,
             args.quiet || args.json,
+            args.device,
         )?;
         let lines = evaluation::read_over_training_of(&args.run, &tasks, limits)?;
         if args.json {
@@ -160,7 +153,7 @@ pub fn evaluate_run(args: EvaluateArgs) -> Result<()> {
         }
         return Ok(());
     }
-    let mut agent = load_agent(&args.run, args.checkpoint)?;
+    let mut agent = load_agent(&args.run, args.checkpoint, args.device)?;
     let protocol = Protocol {
         kind: EvaluationKind::planning(args.replan),
         tasks: TaskSet {
@@ -224,19 +217,4 @@ fn evaluate_policy(
         }
     }
     Ok(())
-}
-
-#[cfg(test)]
-mod tests {
-    use super::parse_depths;
-
-    #[test]
-    fn depths_are_a_range_or_a_list_sorted_once_each_and_never_zero() {
-        assert_eq!(parse_depths("1-5").unwrap(), vec![1, 2, 3, 4, 5]);
-        assert_eq!(parse_depths("6-6").unwrap(), vec![6]);
-        assert_eq!(parse_depths("5, 1,3,3").unwrap(), vec![1, 3, 5]);
-        for bad in ["", "0-3", "0", "5-1", "a", "1,,2", "-3", "1-x"] {
-            assert!(parse_depths(bad).is_err(), "{bad:?} was accepted");
-        }
-    }
 }

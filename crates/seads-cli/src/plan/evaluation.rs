@@ -4,7 +4,6 @@
 use std::path::Path;
 
 use anyhow::Result;
-use indicatif::{ProgressBar, ProgressStyle};
 use seads_planner::{EvaluationRecord, Protocol, SearchLimits, TaskSet};
 use seads_rl::Agent;
 use seads_study::over_training::{self, Progress, Selection};
@@ -17,11 +16,11 @@ pub fn run_evaluation(
     protocol: &Protocol,
     quiet: bool,
 ) -> Result<EvaluationRecord> {
-    let bar = if quiet {
-        ProgressBar::hidden()
-    } else {
-        ProgressBar::new(protocol.tasks.len() as u64)
-    };
+    let bar = crate::progress_bar(
+        protocol.tasks.len() as u64,
+        quiet,
+        "{wide_bar} {pos}/{len} {msg}",
+    );
     let record = seads_study::evaluation::run_evaluation(agent, run, protocol, |task| {
         bar.set_message(format!("depth {}", task.depth));
         bar.inc(1);
@@ -40,30 +39,22 @@ pub fn evaluate_checkpoints(
     tasks: &TaskSet,
     limits: SearchLimits,
     quiet: bool,
+    device: seads_rl::ComputeDevice,
 ) -> Result<usize> {
     let config = seads_rl::load_config(run)?;
     crate::kernels::use_kernels(config.portable_numerics)?;
-    let bar = if quiet {
-        ProgressBar::hidden()
-    } else {
-        ProgressBar::new(0)
-    };
-    bar.set_style(
-        ProgressStyle::with_template(
-            "{elapsed_precise} [{bar:30}] {pos}/{len} tasks {prefix} {msg}",
-        )
-        .expect("valid template")
-        .progress_chars("=> "),
-    );
-    let added = over_training::evaluate_checkpoints(run, selection, tasks, limits, |p| match p {
-        Progress::Planned { tasks } => bar.set_length(tasks as u64),
-        Progress::Checkpoint { epoch } => bar.set_prefix(format!("epoch {epoch}")),
-        Progress::Task { depth } => {
-            bar.set_message(format!("depth {depth}"));
-            bar.inc(1);
-        }
-    })
-    .map_err(crate::study_error)?;
+    let template = "{elapsed_precise} [{bar:30}] {pos}/{len} tasks {prefix} {msg}";
+    let bar = crate::progress_bar(0, quiet, template);
+    let added =
+        over_training::evaluate_checkpoints(run, selection, tasks, limits, device, |p| match p {
+            Progress::Planned { tasks } => bar.set_length(tasks as u64),
+            Progress::Checkpoint { epoch } => bar.set_prefix(format!("epoch {epoch}")),
+            Progress::Task { depth } => {
+                bar.set_message(format!("depth {depth}"));
+                bar.inc(1);
+            }
+        })
+        .map_err(crate::study_error)?;
     bar.finish_and_clear();
     Ok(added)
 }

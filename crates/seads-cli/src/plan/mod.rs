@@ -9,7 +9,7 @@ mod solve;
 use std::path::Path;
 
 use anyhow::{Context, Result, bail};
-use seads_rl::Agent;
+use seads_rl::{Agent, ComputeDevice};
 
 pub use bench::{PlanBenchArgs, plan_bench};
 pub use evaluate::{EvaluateArgs, evaluate_run};
@@ -18,10 +18,12 @@ pub use solve::{SolveArgs, solve_board};
 
 use crate::BadInput;
 
-/// Loads the agent of a run, turning a missing or foreign directory into a clear error.
-pub fn load_agent(run: &Path, checkpoint: Option<u64>) -> Result<Agent> {
-    let config = seads_rl::load_config(run)
+/// Loads the agent of a run onto `device` (whichever device it trained on), turning a missing or
+/// foreign directory into a clear error.
+pub fn load_agent(run: &Path, checkpoint: Option<u64>, device: ComputeDevice) -> Result<Agent> {
+    let mut config = seads_rl::load_config(run)
         .with_context(|| format!("loading the agent of run {}", run.display()))?;
+    config.device = crate::usable_device(device)?;
     crate::kernels::use_kernels(config.portable_numerics)?;
     if config.algorithm != seads_rl::Algorithm::Seads {
         bail!(BadInput(anyhow::anyhow!(
@@ -32,7 +34,8 @@ pub fn load_agent(run: &Path, checkpoint: Option<u64>) -> Result<Agent> {
         )));
     }
     // A checkpoint that is there but cannot be read or does not fit is a malformed input.
-    Agent::load(run, checkpoint)
+    seads_rl::find_checkpoint(run, checkpoint)
+        .and_then(|path| Agent::load_checkpoint(config, &path))
         .map_err(|e| match e {
             seads_rl::RlError::Checkpoint { .. }
             | seads_rl::RlError::Unreadable { .. }

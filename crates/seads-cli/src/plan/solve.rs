@@ -35,6 +35,9 @@ pub struct SolveArgs {
     /// Draw the board and the executed skills' paths into this image (.png or .svg).
     #[arg(long)]
     render: Option<PathBuf>,
+    /// Where the networks run: cpu, cuda (the first GPU) or cuda:N.
+    #[arg(long, default_value = "cpu")]
+    device: seads_rl::ComputeDevice,
     /// Print JSON.
     #[arg(long)]
     json: bool,
@@ -42,7 +45,9 @@ pub struct SolveArgs {
 
 /// `seads solve`.
 pub fn solve_board(args: SolveArgs) -> Result<()> {
-    let mut agent = load_agent(&args.run, args.checkpoint)?;
+    // The planner's parts run on rayon's threads, each on one libtorch thread.
+    seads_rl::set_threads(1);
+    let mut agent = load_agent(&args.run, args.checkpoint, args.device)?;
     let mut env = build_env(&agent.config.env, &agent.config.env_config)?;
     let game = env.spec().game.build(env.spec().board_size)?;
     let board = game.parse(&args.board).map_err(|e| BadInput(e.into()))?;

@@ -15,6 +15,7 @@ pub use manifest::Manifest;
 pub use state::TAKEN_EXIT;
 
 use crate::BadInput;
+use seads_rl::ComputeDevice;
 use seads_study::sweep::{Overview, index, manifest, slurm, state};
 
 /// `seads sweep …`.
@@ -74,8 +75,12 @@ pub struct RunArgs {
     cores: Option<u64>,
     /// Only the runs of these seeds, a list (1,2,3) or a range (1-3): finish a few seeds of every
     /// variant before starting more.
-    #[arg(long, value_parser = crate::NumberList::parse)]
-    seeds: Option<crate::NumberList>,
+    #[arg(long, value_parser = seads_study::numbers::NumberList::parse)]
+    seeds: Option<seads_study::numbers::NumberList>,
+    /// Where each run's networks train and evaluate: cpu, cuda (the first GPU) or cuda:N. The
+    /// workers share the device.
+    #[arg(long, default_value = "cpu")]
+    device: ComputeDevice,
     /// No progress bar.
     #[arg(long)]
     quiet: bool,
@@ -92,6 +97,9 @@ pub struct TaskArgs {
     /// Cores of this task; its libtorch threads follow them (Slurm: $SLURM_CPUS_PER_TASK).
     #[arg(long, default_value_t = 2)]
     cores: u64,
+    /// Where the run's networks train and evaluate: cpu, cuda or cuda:N.
+    #[arg(long, default_value = "cpu")]
+    device: ComputeDevice,
     /// Started by `seads sweep run`: die with the parent, and if another task holds the run,
     /// exit with status 3 (taken elsewhere) after two seconds instead of a minute.
     #[arg(long, hide = true)]
@@ -115,6 +123,10 @@ pub struct SlurmArgs {
     /// At most this many tasks at once (the array's %M throttle).
     #[arg(long)]
     max_parallel: Option<u64>,
+    /// Where each task's networks train and evaluate: cpu, or cuda for the GPU Slurm gives the
+    /// task (the script then asks for one GPU per task, `--gres=gpu:1`).
+    #[arg(long, default_value = "cpu")]
+    device: ComputeDevice,
     /// The seads binary the tasks run (default: this one; it must be reachable from the nodes).
     #[arg(long)]
     seads: Option<PathBuf>,
@@ -151,6 +163,7 @@ pub fn run(command: SweepCommand) -> Result<()> {
                 args.seeds.as_ref().map(|s| s.0.as_slice()),
                 workers,
                 cores,
+                crate::usable_device(args.device)?,
                 args.quiet,
             )
         }
@@ -164,7 +177,13 @@ pub fn run(command: SweepCommand) -> Result<()> {
                 state::PATIENCE
             };
             let cores = at_least_one("--cores", args.cores)?;
-            task::run_task(&args.dir, args.index, cores, patience)
+            let device = crate::usable_device(args.device)?;
+            // The task's threads: rayon's (environments, the planner) as libtorch's.
+            rayon::ThreadPoolBuilder::new()
+                .num_threads(cores)
+                .build_global()
+                .context("starting the task's threads")?;
+            task::run_task(&args.dir, args.index, cores, device, patience)
         }
         SweepCommand::Slurm(args) => slurm(args),
         SweepCommand::Status(args) => status(args),
@@ -223,6 +242,7 @@ fn slurm(args: SlurmArgs) -> Result<()> {
             .map(|m| at_least_one("--max-parallel", m))
             .transpose()?,
         seads,
+        device: args.device,
     };
     let (array, report) = slurm::write_scripts(&dir, &sweep, &options)?;
     outln!("wrote {} and {}", array.display(), report.display());

@@ -9,11 +9,11 @@ use std::sync::Mutex;
 use std::time::Duration;
 
 use anyhow::{Context, Result, bail};
-use indicatif::{ProgressBar, ProgressStyle};
+use seads_rl::ComputeDevice;
 
 use super::index::Sweep;
 use super::state::{LOG, Status, TAKEN_EXIT, status};
-use seads_study::sweep::overview::progress;
+use seads_study::sweep::overview::tally;
 
 /// What a worker reports for a run: whether its task succeeded, or `None` when another task
 /// had taken or finished the run by the time a worker came to it.
@@ -23,12 +23,13 @@ struct Finished {
 }
 
 /// Runs the sweep in `dir` (only the runs of `seeds`, if given) with `workers` parallel tasks
-/// sharing `cores` cores.
+/// sharing `cores` cores, their networks on `device`.
 pub fn run_sweep(
     dir: &Path,
     seeds: Option<&[u64]>,
     workers: usize,
     cores: usize,
+    device: ComputeDevice,
     quiet: bool,
 ) -> Result<()> {
     let sweep = Sweep::load(dir).map_err(crate::bad_input)?;
@@ -80,18 +81,8 @@ pub fn run_sweep(
             seads_rl::load_config(&run).map_or(0, |c| c.env_steps)
         })
         .sum();
-    let bar = if quiet {
-        ProgressBar::hidden()
-    } else {
-        ProgressBar::new(total)
-    };
-    bar.set_style(
-        ProgressStyle::with_template(
-            "{elapsed_precise} [{bar:30}] {percent}% of all steps, eta {eta} {msg}",
-        )
-        .expect("valid template")
-        .progress_chars("=> "),
-    );
+    let template = "{elapsed_precise} [{bar:30}] {percent}% of all steps, eta {eta} {msg}";
+    let bar = crate::progress_bar(total, quiet, template);
     let exe = std::env::current_exe().context("locating the seads binary")?;
     let queue = Mutex::new(todo.into_iter());
     let finished = Mutex::new(Vec::<Finished>::new());
@@ -124,6 +115,7 @@ pub fn run_sweep(
                         .arg(dir)
                         .args(["--index", &index.to_string()])
                         .args(["--cores", &per_task.to_string(), "--child"])
+                        .args(["--device", &device.to_string()])
                         .stdin(Stdio::null())
                         .stdout(log.try_clone()?)
                         .stderr(log)
@@ -142,22 +134,9 @@ pub fn run_sweep(
         }
         // The bar follows the runs' own files until every worker has finished.
         while handles.iter().any(|h| !h.is_finished()) {
-            let mut position = 0;
-            let mut counts = [0usize; Status::ALL.len()];
-            for &i in &chosen {
-                let run = dir.join(&sweep.runs[i].dir);
-                let s = status(&run).map_or(Status::Pending, |s| s.0);
-                counts[Status::ALL.iter().position(|x| *x == s).unwrap_or(3)] += 1;
-                position += progress(&run, s == Status::Done);
-            }
+            let (position, message) = tally(dir, &sweep, &chosen);
             bar.set_position(position);
-            let message: Vec<String> = Status::ALL
-                .iter()
-                .zip(counts)
-                .filter(|&(s, n)| n > 0 || *s != Status::Copied)
-                .map(|(s, n)| format!("{} {n}", s.name()))
-                .collect();
-            bar.set_message(message.join(" "));
+            bar.set_message(message);
             std::thread::sleep(Duration::from_millis(if quiet { 5000 } else { 1000 }));
         }
         for handle in handles {

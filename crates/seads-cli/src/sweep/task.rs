@@ -6,7 +6,7 @@ use std::path::Path;
 use std::time::Duration;
 
 use anyhow::{Context, Result};
-use seads_rl::{Algorithm, Hac, Run, TaskSac, Trainer};
+use seads_rl::{Algorithm, ComputeDevice, Hac, Run, TaskSac, Trainer};
 
 use seads_rl::InWords;
 use seads_skillmodel::SkillModelKind;
@@ -19,10 +19,16 @@ use seads_study::evaluation::run_policy_evaluation;
 use seads_study::over_training::Selection;
 use seads_study::sweep::{Task, Work};
 
-/// Runs task `index` of the sweep in `dir` with `cores` cores, waiting up to `patience` for
+/// Runs task `index` of the sweep in `dir` with `cores` cores and its networks on `device`, waiting up to `patience` for
 /// another task that holds the run. A run already done is left as it is. Errors are recorded in
 /// the run's `task.json` before they are returned.
-pub fn run_task(dir: &Path, index: usize, cores: usize, patience: Duration) -> Result<()> {
+pub fn run_task(
+    dir: &Path,
+    index: usize,
+    cores: usize,
+    device: ComputeDevice,
+    patience: Duration,
+) -> Result<()> {
     let task = Task::claim(dir, index, patience).map_err(crate::study_error)?;
     let run = task.run.display();
     if task.replanned {
@@ -37,24 +43,32 @@ pub fn run_task(dir: &Path, index: usize, cores: usize, patience: Duration) -> R
         Work::Run => {}
     }
     task.start()?;
-    let result = train_and_evaluate(&task.sweep, &task.run, cores);
+    let result = train_and_evaluate(&task.sweep, &task.run, cores, device);
     task.finish(&result)?;
     result
 }
 
-fn train_and_evaluate(sweep: &Sweep, run: &Path, cores: usize) -> Result<()> {
+fn train_and_evaluate(
+    sweep: &Sweep,
+    run: &Path,
+    cores: usize,
+    device: ComputeDevice,
+) -> Result<()> {
     let config =
         seads_rl::load_config(run).with_context(|| format!("loading {}", run.display()))?;
     crate::kernels::use_kernels(config.portable_numerics)?;
     match config.algorithm {
-        Algorithm::Sac => return train_and_evaluate_baseline::<TaskSac>(sweep, run, cores),
-        Algorithm::Hac => return train_and_evaluate_baseline::<Hac>(sweep, run, cores),
+        Algorithm::Sac => {
+            return train_and_evaluate_baseline::<TaskSac>(sweep, run, cores, device);
+        }
+        Algorithm::Hac => return train_and_evaluate_baseline::<Hac>(sweep, run, cores, device),
         Algorithm::Seads => {}
     }
     let mut training = crate::train::resume(
         run,
         Run::resume_with(run, |mut c| {
             c.use_cores(cores);
+            c.device = device;
             Trainer::new(c)
         }),
     )?;
@@ -76,7 +90,9 @@ fn train_and_evaluate(sweep: &Sweep, run: &Path, cores: usize) -> Result<()> {
         );
         return Ok(());
     }
-    seads_rl::set_threads(cores.max(1));
+    // The planner's parts and bookkeeping run on the task's rayon pool (`cores` threads), each
+    // part's network on one libtorch thread.
+    seads_rl::set_threads(1);
     if plan.every > 0 {
         let added = evaluate_checkpoints(
             run,
@@ -84,6 +100,7 @@ fn train_and_evaluate(sweep: &Sweep, run: &Path, cores: usize) -> Result<()> {
             &TaskSet::standard(plan.boards),
             plan.limits(),
             true,
+            device,
         )?;
         outln!(
             "{}: {added} checkpoint evaluation(s) over training",
@@ -91,7 +108,7 @@ fn train_and_evaluate(sweep: &Sweep, run: &Path, cores: usize) -> Result<()> {
         );
     }
     if plan.last {
-        let mut agent = load_agent(run, None)?;
+        let mut agent = load_agent(run, None, device)?;
         for replan in [true, false] {
             let protocol = Protocol {
                 kind: EvaluationKind::planning(replan),
@@ -118,12 +135,18 @@ fn train_and_evaluate(sweep: &Sweep, run: &Path, cores: usize) -> Result<()> {
 
 /// A baseline run: training on all of the task's cores (one training thread), then task success
 /// of the final policy on the study's boards per depth (`evaluation-policy.json`).
-fn train_and_evaluate_baseline<L: InWords>(sweep: &Sweep, run: &Path, cores: usize) -> Result<()> {
+fn train_and_evaluate_baseline<L: InWords>(
+    sweep: &Sweep,
+    run: &Path,
+    cores: usize,
+    device: ComputeDevice,
+) -> Result<()> {
     let mut training = crate::train::resume(
         run,
         Run::resume_with(run, |mut c| {
             c.threads = cores.max(1);
             c.sac_threads_alone = 0;
+            c.device = device;
             L::build(c)
         }),
     )?;

@@ -48,6 +48,27 @@ pub fn progress(run: &Path, done: bool) -> u64 {
         .min(budget)
 }
 
+/// Where the runs `chosen` of `sweep` in `dir` stand, for a progress bar: their environment steps
+/// so far (a done run counts its budget) and one word with a count per status ("done 3 running
+/// 2 …"; copied runs only if there are some).
+pub fn tally(dir: &Path, sweep: &Sweep, chosen: &[usize]) -> (u64, String) {
+    let mut steps = 0;
+    let mut counts = [0usize; Status::ALL.len()];
+    for &i in chosen {
+        let run = dir.join(&sweep.runs[i].dir);
+        let s = state::status(&run).map_or(Status::Pending, |s| s.0);
+        counts[Status::ALL.iter().position(|x| *x == s).unwrap_or(3)] += 1;
+        steps += progress(&run, s == Status::Done);
+    }
+    let words: Vec<String> = Status::ALL
+        .iter()
+        .zip(counts)
+        .filter(|&(s, n)| n > 0 || *s != Status::Copied)
+        .map(|(s, n)| format!("{} {n}", s.name()))
+        .collect();
+    (steps, words.join(" "))
+}
+
 /// Every run of a sweep and the counts per status (the JSON of `seads sweep status --json`).
 #[derive(Debug, Clone, Serialize)]
 pub struct Overview {

@@ -6,6 +6,8 @@
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
+use seads_rl::ComputeDevice;
+
 use crate::error::fail;
 use crate::{Context as _, Result};
 
@@ -27,6 +29,9 @@ pub struct SlurmOptions {
     pub max_parallel: Option<usize>,
     /// The `seads` binary the tasks run (it must be reachable from the compute nodes).
     pub seads: PathBuf,
+    /// Where the tasks' networks run. For a GPU each task asks for one (`--gres=gpu:1`), which
+    /// Slurm makes its `cuda:0`.
+    pub device: ComputeDevice,
 }
 
 /// A word for bash, single-quoted.
@@ -46,6 +51,13 @@ pub fn scripts(dir: &Path, sweep: &Sweep, options: &SlurmOptions) -> (String, St
         .partition
         .as_ref()
         .map_or(String::new(), |p| format!("#SBATCH --partition={p}\n"));
+    let (gres, device) = match options.device {
+        ComputeDevice::Cpu => (String::new(), String::new()),
+        ComputeDevice::Cuda(_) => (
+            "#SBATCH --gres=gpu:1\n".to_owned(),
+            " --device cuda:0".to_owned(),
+        ),
+    };
     let array = format!(
         "#!/bin/bash\n\
          # One task per run of sweep {name:?}; written by `seads sweep slurm`.\n\
@@ -55,9 +67,10 @@ pub fn scripts(dir: &Path, sweep: &Sweep, options: &SlurmOptions) -> (String, St
          #SBATCH --cpus-per-task={cpus}\n\
          #SBATCH --time={time}\n\
          {partition}\
+         {gres}\
          #SBATCH --output={logs}/task-%a.out\n\
          #SBATCH --requeue\n\
-         exec {seads} sweep task {dir} --index \"$SLURM_ARRAY_TASK_ID\" --cores \"${{SLURM_CPUS_PER_TASK:-{cpus}}}\"\n",
+         exec {seads} sweep task {dir} --index \"$SLURM_ARRAY_TASK_ID\" --cores \"${{SLURM_CPUS_PER_TASK:-{cpus}}}\"{device}\n",
         name = sweep.name,
         last = sweep.runs.len().saturating_sub(1),
         cpus = options.cpus_per_task,
