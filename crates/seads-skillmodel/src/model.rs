@@ -257,6 +257,7 @@ impl ForwardModel {
     pub fn screen_counts(&self) -> (u64, u64) {
         self.screen_counts
     }
+
     /// The successors of every state under every skill (state-major), computed where the model
     /// is: the mode's next bits in float32, packed 32 to an integer, so that only the new states
     /// leave the device. The planner's path on a GPU; on the CPU it gives the same states as the
@@ -271,10 +272,9 @@ impl ForwardModel {
             let z0 = states_tensor(states.iter().copied(), d, self.device);
             let logits = self.flip_logits_all_skills(&z0); // n × K × D
             let ones = z0.unsqueeze(1).gt(0.5);
-            let flip = logits
-                .gt(0.0)
-                .logical_or(&ones.logical_and(&logits.eq(0.0)));
-            let next = flip.logical_xor(&ones).to_kind(Kind::Int64); // n × K × D
+            let next = mode_flips(&logits, &z0)
+                .logical_xor(&ones)
+                .to_kind(Kind::Int64);
             let next = next.constant_pad_nd([0, (words * 32 - d) as i64]);
             let weights = Tensor::from_slice(&(0..32).map(|b| 1i64 << b).collect::<Vec<_>>())
                 .to_device(self.device);
@@ -315,6 +315,15 @@ impl ForwardModel {
             })
         }))
     }
+}
+
+/// Which bits flip in the mode of q (SPEC §4.1), from flip logits (n × K × D) and the states
+/// (n × D, 0/1): a 0 flips iff its logit is > 0, a 1 iff it is ≥ 0 (n × K × D, bool).
+fn mode_flips(logits: &Tensor, z0: &Tensor) -> Tensor {
+    let ones = z0.unsqueeze(1).gt(0.5);
+    logits
+        .gt(0.0)
+        .logical_or(&ones.logical_and(&logits.eq(0.0)))
 }
 
 /// States per part of a CPU successor call: the parts are computed on the rayon pool's threads,
@@ -373,11 +382,7 @@ impl Inference {
 
     /// The mode's flips (n × K × D, 1: the bit flips) in float32.
     fn exact_flips(&self, z0: &Tensor) -> Vec<u8> {
-        let logits = self.flip_logits_all_skills(z0); // n × K × D
-        let ones = z0.unsqueeze(1).gt(0.5);
-        let flip = logits
-            .gt(0.0)
-            .logical_or(&ones.logical_and(&logits.eq(0.0)));
+        let flip = mode_flips(&self.flip_logits_all_skills(z0), z0);
         Vec::<u8>::try_from(flip.to_kind(Kind::Uint8).view([-1]).to_device(Device::Cpu))
             .expect("flip table")
     }
@@ -689,7 +694,7 @@ impl seads_games::Successor for ForwardModel {
 
     fn preferred_batch(&self) -> usize {
         if self.device == Device::Cpu {
-            // A part for each of the pool's threads.
+            // Four parts for each of the pool's threads, so that uneven parts even out.
             4 * CPU_PART * rayon::current_num_threads()
         } else {
             DEVICE_BATCH
