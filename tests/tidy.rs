@@ -148,6 +148,7 @@ fn crate_dependencies_point_one_way_and_only_five_crates_link_libtorch() {
             &[
                 "seads-embodiment",
                 "seads-games",
+                "seads-nn",
                 "seads-planner",
                 "seads-rl",
                 "seads-skillmodel",

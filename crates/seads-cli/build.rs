@@ -3,7 +3,19 @@
 //! `cuda` feature, links libtorch's CUDA library into the binary.
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
-    // The full SHA; dirty counts tracked files only (as of the last build script run).
+    // The full SHA; dirty counts tracked files only. vergen reruns this script when HEAD moves;
+    // an edit to any source of the binary must rerun it too, or a rebuild would call itself clean.
+    // Each crate's sources and manifest only: generated files elsewhere under crates/ (the
+    // Python package's build outputs) must not rerun it.
+    for entry in std::fs::read_dir("../../crates")? {
+        let dir = entry?.path();
+        for part in ["src", "Cargo.toml"] {
+            println!("cargo:rerun-if-changed={}", dir.join(part).display());
+        }
+    }
+    for file in ["../../Cargo.toml", "../../Cargo.lock"] {
+        println!("cargo:rerun-if-changed={file}");
+    }
     let git = vergen_gitcl::GitclBuilder::default()
         .sha(false)
         .dirty(false)

@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # Builds the `seads` binary for the GPU test machine (PyTorch 2.11.0 with CUDA 13, no Rust, no
 # network; ../shared/gpu/README.md) and puts it, stripped, at gpu/seads in the repository root,
-# where the device check (scripts/gpu/check.sh) runs it.
+# where the device check (scripts/gpu/check.sh) runs it; and the same without CUDA at
+# gpu/seads-cpu, which runs here and there alike.
 #
 # The workspace uses tch 0.26 / libtorch 2.13; that machine has libtorch 2.11, whose tch release
 # is 0.24. So the same source (the working tree: HEAD plus uncommitted changes) is copied into a
@@ -40,4 +41,18 @@ LIBTORCH=$scratch/torch CARGO_TARGET_DIR=$scratch/target \
 mkdir -p "$root/gpu"
 cp "$scratch/target/release/seads" "$root/gpu/seads"
 strip "$root/gpu/seads"
+# The same source without CUDA: it runs here too, so a run it trains on this processor can be
+# compared with the same binary's run on the GPU machine's (data/golden/libtorch-2.11/).
+LIBTORCH=$scratch/torch CARGO_TARGET_DIR=$scratch/target \
+  RUSTFLAGS="-C link-arg=-Wl,--allow-shlib-undefined" \
+  cargo build --release -p seads-cli
+cp "$scratch/target/release/seads" "$root/gpu/seads-cpu"
+strip "$root/gpu/seads-cpu"
+# The fingerprint of the floating-point primitives a run uses (`cargo xtask golden`'s), to name
+# the primitives in which the GPU machine's processor parts from data/golden/fingerprint.json.
+LIBTORCH=$scratch/torch CARGO_TARGET_DIR=$scratch/target \
+  RUSTFLAGS="-C link-arg=-Wl,--allow-shlib-undefined" \
+  cargo build --release -p seads-rl --example numerics_fingerprint
+cp "$scratch/target/release/examples/numerics_fingerprint" "$root/gpu/numerics_fingerprint"
+strip "$root/gpu/numerics_fingerprint"
 echo "gpu build: $(du -h "$root/gpu/seads" | cut -f1) at gpu/seads ($(git -C "$root" rev-parse --short HEAD), tch 0.24, libtorch 2.11.0, cuda)" >&2

@@ -6,10 +6,13 @@
 # - training: one LightsOutCursor run of 10⁵ steps on the GPU beside the same run on one CPU
 #   core, their steps/s and skill coverage;
 # - devices: each run's checkpoint evaluated on the other device, and the errors a missing GPU
-#   gives.
+#   gives;
+# - a population of 16 runs trained as one on the GPU (SAC on stacked weights there, the rest on
+#   the CPU cores), its summed steps/s against the one-core run;
+# - the golden configuration on this processor against the EPYC's (issue 32, item 10).
 # What it measured goes to $OUT (default target/gpu-check): the JSON, the logs, the runs'
 # metrics, provenance and config, table.txt, and all of it again as all.tgz (the device tool
-# brings back only a few files per call); the runs themselves go to $RUNS. About 5 minutes on an
+# brings back only a few files per call); the runs themselves go to $RUNS. About 7 minutes on an
 # H100 with 16 cores; every step has a time limit, so a hang cannot take the machine's lease.
 set -uo pipefail
 root=$(cd "$(dirname "${BASH_SOURCE[0]}")/../.." && pwd)
@@ -102,6 +105,63 @@ for pair in "train-cuda cpu" "train-cpu cuda"; do
     --timeout 10 --json > "$out/evaluate-$1-on-$2.json" 2> "$out/evaluate-$1-on-$2.log"
   log "evaluate $1 on $2: exit $? $(head -c 300 "$out/evaluate-$1-on-$2.json")"
 done
+
+# A population of 16 LightsOutCursor runs (seeds 1-16, the preset's settings, POP_STEPS steps
+# each) trained as one on the GPU with the cores but two, against the one-core CPU run above (the
+# issue's target: at least 25 times its steps/s, summed over the members). Meanwhile, on the last
+# two cores, the golden configuration on this processor's CPU (data/golden/config.toml, portable
+# numerics) with gpu/seads-cpu, which repeats the golden on the development machine's AMD EPYC
+# (data/golden/libtorch-2.11/): whether a portable run is the same on this processor (issue 32,
+# item 10).
+pop_steps=${POP_STEPS:-10000}
+pop_cores=$((cores > 4 ? cores - 2 : cores))
+rm -rf "$runs/population" "$runs/golden"
+cat > "$out/population.toml" <<EOF
+name = "population-gpu"
+environments = ["lightsout-cursor"]
+seeds = [$(seq -s ', ' 1 16)]
+
+[overrides]
+env_steps = $pop_steps
+
+[evaluation]
+every = 0
+last = false
+
+[[variant]]
+name = "seads"
+EOF
+golden=""
+if [[ -x $root/gpu/seads-cpu ]] && ((cores > 4)); then
+  log "the golden configuration on this CPU (cores $((cores - 2))-$((cores - 1))), in the background"
+  pin "$((cores - 2))-$((cores - 1))" timeout 400 "$root/gpu/seads-cpu" train \
+    --config "$root/data/golden/config.toml" --out "$runs/golden" --quiet > "$out/golden.log" 2>&1 &
+  golden=$!
+fi
+"$seads" sweep plan "$out/population.toml" --out "$runs/population" > /dev/null
+log "a population of 16 runs of $pop_steps steps on the GPU with $pop_cores cores"
+start=$(date +%s%N)
+# A thread per member on the pinned cores: members wait for each other every epoch, so 16 members
+# on 14 threads would take two rounds per epoch where time-sharing the cores takes 16/14 of one.
+pin "0-$((pop_cores - 1))" timeout 300 "$seads" sweep task "$runs/population" --index 0-15 \
+  --cores 16 --device cuda > "$out/population.log" 2>&1
+log "population on the GPU: exit $?"
+echo "{\"wall_s\": $((($(date +%s%N) - start) / 1000000))e-3, \"runs\": 16, \"steps_each\": $pop_steps, \"cores\": $pop_cores, \"threads\": 16}" \
+  > "$out/population-wall.json"
+for seed in $(seq 1 16); do
+  cp "$runs/population/runs/lightsout-cursor/seads/seed-$seed/metrics.jsonl" \
+    "$out/population-seed-$seed-metrics.jsonl" 2>/dev/null
+done
+if [[ -n $golden ]]; then
+  wait "$golden"
+  log "golden: exit $?"
+  for f in metrics.jsonl provenance.jsonl; do cp "$runs/golden/$f" "$out/golden-$f" 2>/dev/null; done
+fi
+if [[ -x $root/gpu/numerics_fingerprint ]]; then
+  MKL_CBWR=COMPATIBLE ATEN_CPU_CAPABILITY=avx2 timeout 60 "$root/gpu/numerics_fingerprint" \
+    > "$out/golden-fingerprint.json" 2> "$out/golden-fingerprint.log"
+  log "fingerprint: exit $?"
+fi
 
 "$python" "$root/scripts/gpu/table.py" "$out" | tee "$out/table.txt"
 tar czf "$root/gpu-check.tgz" -C "$out" . && mv "$root/gpu-check.tgz" "$out/all.tgz"

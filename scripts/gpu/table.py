@@ -47,6 +47,66 @@ def committed_coverage(root, steps):
     return "n/a"
 
 
+def population(out, root):
+    """The population of 16 on the GPU against the one-core run: summed steps/s and the ratio."""
+    wall = load_json(out / "population-wall.json")
+    members = [load_lines(out / f"population-seed-{seed}-metrics.jsonl") for seed in range(1, 17)]
+    members = [m for m in members if m]
+    cpu = load_lines(out / "train-cpu-metrics.jsonl")
+    print("## a population of 16 LightsOutCursor runs (seeds 1-16, preset) on the GPU")
+    if not wall or not members:
+        print("(no population figures: see population.log)")
+        return
+    steps = sum(m[-1]["env_steps"] for m in members)
+    per_s = steps / max(wall["wall_s"], 1e-9)
+    line = f"{len(members)} members, {steps} steps in {wall['wall_s']:.1f} s: {per_s:.0f} steps/s summed"
+    if cpu:
+        one = cpu[-1]["env_steps"] / max(cpu[-1]["wall_s"], 1e-9)
+        line += f"; one run on one CPU core: {one:.0f} steps/s; ratio {per_s / one:.1f} (target 25)"
+    print(line)
+    coverage = sorted(m[-1]["skill_coverage"] for m in members)
+    near = round(members[0][-1]["env_steps"] / 50000) * 50000
+    print(f"members' coverage at the end: {', '.join(f'{c:.2f}' for c in coverage)}; "
+          f"committed CPU runs at {near} steps: {committed_coverage(root, near) if near else 'n/a'}")
+
+
+CLOCK = ("wall_s", "steps_per_s", "timings")
+
+
+def golden(out, root):
+    """This processor's golden run against the EPYC's (data/golden/: libtorch 2.13, which the same
+    binary as here, libtorch 2.11, repeats there: data/golden/libtorch-2.11/)."""
+    ours = load_lines(out / "golden-metrics.jsonl")
+    theirs = load_lines(root / "data/golden/metrics.jsonl")
+    print("## the golden configuration (portable numerics) on this CPU, gpu/seads-cpu (libtorch 2.11)")
+    if not ours or not theirs:
+        print("(no golden figures: see golden.log)")
+        return
+    cpu = (load_lines(out / "golden-provenance.jsonl") or [{}])[0].get("cpu_model", "?")
+    ours_fp = load_json(out / "golden-fingerprint.json")
+    theirs_fp = load_json(root / "data/golden/fingerprint.json")
+    if ours_fp and theirs_fp:
+        parted = sorted(k for k in set(ours_fp) | set(theirs_fp) if ours_fp.get(k) != theirs_fp.get(k))
+        print(f"primitives whose fingerprint differs from the golden's: {', '.join(parted) or 'none'}")
+        if "tch.sqrt" in parted:
+            print("(tch.sqrt is libtorch's root, from the processor's rsqrtps estimate; portable runs "
+                  "take seads_nn.sqrt instead: docs/RESULTS.md, 'Determinism across processors')")
+    ref = (load_lines(root / "data/golden/provenance.jsonl") or [{}])[0].get("cpu_model", "?")
+    strip = lambda line: {k: v for k, v in line.items() if k not in CLOCK}
+    ours = [strip(l) for l in ours if l["epoch"] <= 300]
+    theirs = [strip(l) for l in theirs if l["epoch"] <= 300]
+    for i, (a, b) in enumerate(zip(ours, theirs)):
+        if a != b:
+            field = next(k for k in sorted(set(a) | set(b)) if a.get(k) != b.get(k))
+            print(f"{cpu} parts from {ref} at line {i + 1} (epoch {a.get('epoch')}): "
+                  f"{field} {a.get(field)} against {b.get(field)}")
+            return
+    if len(ours) != len(theirs):
+        print(f"{cpu}: {len(ours)} lines to epoch 300, {ref}: {len(theirs)}")
+        return
+    print(f"{cpu} repeats {ref}: {len(ours)} metrics lines to epoch 300 equal, field for field")
+
+
 def main():
     out = pathlib.Path(sys.argv[1])
     root = pathlib.Path(__file__).resolve().parents[2]
@@ -84,6 +144,10 @@ def main():
     if steps:
         near = round(steps / 50000) * 50000
         print(f"| committed ten-seed study (CPU) at {near} steps | | | | {committed_coverage(root, near)} |")
+    print()
+    population(out, root)
+    print()
+    golden(out, root)
     print()
     for path in sorted(out.glob("evaluate-*.json")):
         report = load_json(path)

@@ -135,13 +135,18 @@ fn parted_primitives(ours: &Value, theirs: &Value) -> Vec<String> {
 
 /// The metrics lines of a run up to [`EPOCHS`], without their clock fields.
 fn lines(path: &Path) -> Result<Vec<Value>> {
+    metrics_without_clock(path, EPOCHS)
+}
+
+/// The metrics lines of `path` up to epoch `last`, without their clock fields.
+pub fn metrics_without_clock(path: &Path, last: u64) -> Result<Vec<Value>> {
     let text =
         std::fs::read_to_string(path).with_context(|| format!("reading {}", path.display()))?;
     let mut out = Vec::new();
     for line in text.lines() {
         let mut value: Value = serde_json::from_str(line)
             .with_context(|| format!("a metrics line of {}", path.display()))?;
-        if value["epoch"].as_u64().is_some_and(|e| e > EPOCHS) {
+        if value["epoch"].as_u64().is_some_and(|e| e > last) {
             break;
         }
         if let Some(object) = value.as_object_mut() {

@@ -4,6 +4,7 @@
 mod ci;
 mod gen_splits;
 mod golden;
+mod population_bench;
 
 use std::path::{Path, PathBuf};
 use std::process::{Command, ExitCode};
@@ -23,6 +24,9 @@ Commands:
   gen-splits   write data/depth_counts.csv and data/split_counts.csv from a fresh enumeration
   golden       train the golden run (data/golden/) and say whether this processor repeats it
                (`--record` makes this processor's run the golden); not part of ci
+  population-bench
+               populations of K LightsOutCursor runs against the same runs one by one, summed
+               steps/s (`population-bench --help`); not part of ci
 ";
 
 fn main() -> ExitCode {
@@ -50,6 +54,7 @@ fn main() -> ExitCode {
                 return ExitCode::from(2);
             }
         },
+        Some("population-bench") => population_bench::run(&root(), &args[1..]),
         Some("help" | "--help" | "-h") | None => {
             print!("{HELP}");
             Ok(())

@@ -22,9 +22,9 @@ pub struct RunArgs {
     #[arg(long, default_value = "lightsout-cursor")]
     env: String,
     /// Training budget in environment steps (the paper's Cursor budget is 500000). With the
-    /// default, seed 1 ends at epoch 1720 with skill coverage 24.95/25 on the Intel Xeon it was
-    /// recorded on (portable numerics; an AMD EPYC gave another run), and coverage wobbles by
-    /// about a skill between evaluations (docs/results/demo).
+    /// default, seed 1 ends at epoch 1706 with skill coverage 24.75/25 (25/25 at epoch 1700;
+    /// portable numerics, recorded on an AMD EPYC), and coverage wobbles by about a skill
+    /// between evaluations (docs/results/demo).
     #[arg(long, default_value_t = 157_252)]
     env_steps: u64,
     /// Seed of the run.
@@ -35,7 +35,7 @@ pub struct RunArgs {
     boards: usize,
     /// Time limit per search, seconds (a board that needs a move no skill makes is searched
     /// until then).
-    #[arg(long, default_value_t = 10.0, value_parser = crate::positive_finite)]
+    #[arg(long, default_value_t = 10.0, value_parser = seads_study::numbers::positive_finite)]
     timeout: f64,
 }
 

@@ -1,18 +1,17 @@
 //! `seads record` and `seads replay`: episodes as JSON Lines (`docs/EPISODES.md`).
 
-use std::io::{BufRead, BufReader, BufWriter, Write};
+use std::io::{BufRead, BufReader, Write};
 use std::path::PathBuf;
 
 use anyhow::{Context, Result, bail};
 use clap::Args;
-use rand::{RngExt, SeedableRng};
+use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
-use seads_embodiment::{
-    EnvConfig, EpisodeRecord, SkillPolicy, compare, record_episode, replay_episode,
-};
+use seads_embodiment::{EnvConfig, EpisodeRecord, compare, replay_episode};
 
 use crate::BadInput;
 use crate::envs::build_env;
+use seads_rl::store::AtomicFile;
 
 /// Arguments of `seads record`.
 #[derive(Debug, Args)]
@@ -74,69 +73,28 @@ pub fn record(args: RecordArgs) -> Result<()> {
     env.seed(args.seed);
     let mut rng = ChaCha8Rng::seed_from_u64(args.seed);
     // Written beside the output and renamed over it when complete: never a half-written file.
-    let mut file = atomic_file(&args.out)?;
-    write_episodes(&args, &mut file, env.as_mut(), agent.as_ref(), &mut rng)?;
-    commit(file, &args.out)?;
+    let mut file = AtomicFile::open(&args.out)?;
+    let policy = agent
+        .as_ref()
+        .map(|a| &a.policy as &dyn seads_embodiment::SkillPolicy);
+    let (episodes, steps) = (args.episodes, args.steps);
+    seads_study::recording::record_episodes(
+        env.as_mut(),
+        &args.env,
+        policy,
+        episodes,
+        steps,
+        &mut rng,
+        &mut file,
+    )
+    .with_context(|| format!("writing {}", args.out.display()))?;
+    file.commit()?;
     outln!(
         "recorded {} episodes of {} steps into {}",
         args.episodes,
         args.steps,
         args.out.display()
     );
-    Ok(())
-}
-
-/// A file written beside `path` and renamed over it, synced, only by [`commit`]: dropped
-/// without it (an error on the way), `path` stays as it was.
-fn atomic_file(path: &std::path::Path) -> Result<BufWriter<atomic_write_file::AtomicWriteFile>> {
-    let file = atomic_write_file::AtomicWriteFile::open(path)
-        .with_context(|| format!("creating {}", path.display()))?;
-    Ok(BufWriter::new(file))
-}
-
-/// Puts what [`atomic_file`] wrote in place of `path`.
-fn commit(
-    out: BufWriter<atomic_write_file::AtomicWriteFile>,
-    path: &std::path::Path,
-) -> Result<()> {
-    out.into_inner()
-        .map_err(|e| e.into_error())
-        .and_then(|file| file.commit())
-        .with_context(|| format!("writing {}", path.display()))
-}
-
-/// Records the episodes of `args` into `out`.
-fn write_episodes(
-    args: &RecordArgs,
-    out: &mut impl Write,
-    env: &mut dyn seads_embodiment::Environment,
-    agent: Option<&seads_rl::Agent>,
-    rng: &mut ChaCha8Rng,
-) -> Result<()> {
-    let (low, high) = (
-        env.spec().action_low.clone(),
-        env.spec().action_high.clone(),
-    );
-    for i in 0..args.episodes {
-        let mut episode = match &agent {
-            None => record_episode(env, args.steps, |_, action| {
-                for (a, (l, h)) in action.iter_mut().zip(low.iter().zip(&high)) {
-                    *a = rng.random_range(*l..=*h);
-                }
-            })?,
-            Some(agent) => {
-                let skill = i % agent.policy.num_skills();
-                let mut episode = record_episode(env, args.steps, |obs, action| {
-                    agent.policy.act(obs, &[skill], action)
-                })?;
-                episode.skill = Some(skill);
-                episode
-            }
-        };
-        episode.env = args.env.clone();
-        writeln!(out, "{}", serde_json::to_string(&episode)?)
-            .with_context(|| format!("writing {}", args.out.display()))?;
-    }
     Ok(())
 }
 
@@ -160,13 +118,14 @@ pub struct ReplayArgs {
 
 /// `seads replay`.
 pub fn replay(args: ReplayArgs) -> Result<()> {
-    crate::refuse_overwriting_input(&args.out, &[&args.input])?;
+    seads_study::paths::refuse_overwriting_input(&args.out, &[&args.input])
+        .map_err(crate::study_error)?;
     let mut env = build_env(&args.env, &EnvConfig::default())?;
     let m = env.spec().manipulator_dim;
     let input = std::fs::File::open(&args.input)
         .with_context(|| format!("opening {}", args.input.display()))?;
     // Written beside the output and renamed over it when every line is replayed.
-    let mut out = atomic_file(&args.out)?;
+    let mut out = AtomicFile::open(&args.out)?;
     let (mut episodes, mut differing) = (0, 0);
     for (number, line) in BufReader::new(input).lines().enumerate() {
         let line = line.with_context(|| format!("reading {}", args.input.display()))?;
@@ -193,7 +152,7 @@ pub fn replay(args: ReplayArgs) -> Result<()> {
         }
         episodes += 1;
     }
-    commit(out, &args.out)?;
+    out.commit()?;
     if differing > 0 {
         bail!("the board differs from the recording in {differing} of {episodes} episodes");
     }

@@ -145,44 +145,6 @@ pub fn lock_run(dir: &std::path::Path) -> anyhow::Result<seads_rl::store::RunLoc
     )
 }
 
-/// Refuses an output path that is one of the command's inputs (the same file or folder, through
-/// any path or link): an output never overwrites what the command reads. Exit 2.
-pub fn refuse_overwriting_input(
-    output: &std::path::Path,
-    inputs: &[&std::path::Path],
-) -> anyhow::Result<()> {
-    use std::os::unix::fs::MetadataExt as _;
-    let Ok(out) = std::fs::metadata(output) else {
-        return Ok(()); // a new file overwrites nothing
-    };
-    for input in inputs {
-        if let Ok(meta) = std::fs::metadata(input)
-            && (meta.dev(), meta.ino()) == (out.dev(), out.ino())
-        {
-            return Err(BadInput(anyhow::anyhow!(
-                "{} is also an input ({}): an output never overwrites its input",
-                output.display(),
-                input.display()
-            ))
-            .into());
-        }
-    }
-    Ok(())
-}
-
-/// A command-line number that must be finite and positive (seconds, millimetres, spacings):
-/// negative, zero, NaN and infinite values are usage errors (exit code 2), never a panic.
-fn positive_finite(text: &str) -> Result<f64, String> {
-    let value: f64 = text
-        .parse()
-        .map_err(|_| format!("{text:?} is not a number"))?;
-    if value.is_finite() && value > 0.0 {
-        Ok(value)
-    } else {
-        Err(format!("{text} must be a finite number above 0"))
-    }
-}
-
 /// Ends the process on a command line that clap refused: `--help` and `--version` print as
 /// usual; a usage error becomes one `error:` line naming `--help`, exit code 2, as every other
 /// bad input does.
@@ -206,21 +168,6 @@ fn usage_error(e: clap::Error) -> ! {
     std::process::exit(2)
 }
 
-/// Keeps freed memory in the process: libtorch allocates and frees multi-megabyte temporaries
-/// on every training step, and glibc's defaults return them to the OS (mmap / trim), so each
-/// step paid page faults that cost ~15 % of training time. Same effect as
-/// `GLIBC_TUNABLES=glibc.malloc.mmap_threshold=…:glibc.malloc.trim_threshold=…`.
-fn keep_freed_memory() {
-    #[cfg(all(target_os = "linux", target_env = "gnu"))]
-    #[allow(unsafe_code)]
-    // SAFETY: mallopt only changes allocator parameters; it is called once, before any other
-    // thread exists, with valid parameter constants and non-negative values.
-    unsafe {
-        libc::mallopt(libc::M_MMAP_THRESHOLD, 1 << 30);
-        libc::mallopt(libc::M_TRIM_THRESHOLD, i32::MAX);
-    }
-}
-
 /// Whether `command` trains or plans, where libtorch runs parallel regions on several threads
 /// (the planner's 8-bit products open one per batch).
 fn runs_libtorch_in_parallel(command: &Command) -> bool {
@@ -235,40 +182,6 @@ fn runs_libtorch_in_parallel(command: &Command) -> bool {
             | Command::Sweep(sweep::SweepCommand::Run(_) | sweep::SweepCommand::Task(_))
             | Command::Uarm(uarm::UarmCommand::Train(_) | uarm::UarmCommand::Evaluate(_))
     )
-}
-
-/// The variable that bounds how long libtorch's OpenMP threads (libgomp) spin before they sleep.
-const SPIN: &str = "GOMP_SPINCOUNT";
-
-/// Makes libgomp's idle threads spin 1000 iterations before they sleep instead of its default
-/// 300000, by running this program again with `GOMP_SPINCOUNT=1000` (libgomp reads it when it is
-/// loaded, before `main`). On a machine whose cores are busy with other work (a second run, the
-/// other worker of a sweep), a thread spinning at a barrier holds the core that the thread it
-/// waits for needs. A 10⁴-step LightsOutCursor run with two SAC threads beside two or three busy
-/// single-threaded processes did not reach step 4473 in 150 s with the default, and finished in
-/// 33–50 s at 1000 (3000: 58 s, 10000: 60–84 s); alone on the machine it takes 5 % longer at
-/// 1000 (15.4 → 16.2 s, docs/results/log-2026-11.md). The same numbers either way: only waiting changes. A
-/// user's own `GOMP_SPINCOUNT` or `OMP_WAIT_POLICY` is kept. If the program cannot be run again,
-/// it goes on as it is.
-fn spin_briefly_in_libgomp() {
-    #[cfg(unix)]
-    {
-        use std::os::unix::process::CommandExt;
-        if std::env::var_os(SPIN).is_some() || std::env::var_os("OMP_WAIT_POLICY").is_some() {
-            return;
-        }
-        let Ok(exe) = std::env::current_exe() else {
-            return;
-        };
-        let mut args = std::env::args_os();
-        let arg0 = args.next().unwrap_or_else(|| exe.clone().into_os_string());
-        // Returns only on failure; the process then runs with libgomp's defaults.
-        let _ = std::process::Command::new(exe)
-            .arg0(arg0)
-            .args(args)
-            .env(SPIN, "1000")
-            .exec();
-    }
 }
 
 /// Ends the process quietly when its output pipe closes (`seads sweep status | head`), as other
@@ -299,14 +212,14 @@ fn one_line(err: &anyhow::Error) -> String {
 }
 
 fn main() -> ExitCode {
-    keep_freed_memory();
+    seads_nn::process::keep_freed_memory();
     die_quietly_on_closed_pipes();
     let cli = match Cli::try_parse() {
         Ok(cli) => cli,
         Err(e) => usage_error(e),
     };
     if runs_libtorch_in_parallel(&cli.command) {
-        spin_briefly_in_libgomp();
+        seads_nn::process::spin_briefly_in_libgomp();
     }
     let result = match cli.command {
         Command::Games(cmd) => games::run(cmd),
@@ -333,12 +246,7 @@ fn main() -> ExitCode {
             eprintln!("error: {}", one_line(&err));
             if err.is::<BadInput>() {
                 ExitCode::from(2)
-            } else if err.chain().any(|c| {
-                matches!(
-                    c.downcast_ref::<seads_study::StudyError>(),
-                    Some(seads_study::StudyError::Taken(_))
-                )
-            }) {
+            } else if sweep::is_taken(&err) {
                 ExitCode::from(sweep::TAKEN_EXIT)
             } else {
                 ExitCode::FAILURE

@@ -33,7 +33,7 @@ pub struct PlotArgs {
     #[arg(long, default_value_t = 20)]
     boards: usize,
     /// Time limit per search in such an evaluation, seconds.
-    #[arg(long, default_value_t = 60.0, value_parser = crate::positive_finite)]
+    #[arg(long, default_value_t = 60.0, value_parser = seads_study::numbers::positive_finite)]
     timeout: f64,
 }
 

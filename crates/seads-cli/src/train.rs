@@ -181,7 +181,7 @@ pub fn resume<L: Learner>(
 pub const CRASH_POINT_VAR: &str = "SEADS_CRASH_POINT";
 
 /// The hook [`CRASH_POINT_VAR`] asks for, if it is set.
-fn crash_hook() -> Result<Option<Hook>> {
+pub fn crash_hook() -> Result<Option<Hook>> {
     let Ok(value) = std::env::var(CRASH_POINT_VAR) else {
         return Ok(None);
     };
@@ -213,18 +213,8 @@ pub fn drive<L: InWords>(run: &mut Run<L>, quiet: bool) -> Result<()> {
         run.set_hook(hook);
     }
     let budget = run.trainer().config().env_steps;
-    if !run.finished() {
-        let config = run.trainer().config();
-        seads_study::provenance::Provenance::here(
-            run.trainer().epoch(),
-            run.trainer().steps(),
-            config.portable_numerics,
-            config.device,
-            &crate::build(),
-        )
-        .append(run.dir())
+    seads_study::provenance::Provenance::record(run, &crate::build())
         .context("recording the run's provenance")?;
-    }
     let template = "{elapsed_precise} [{bar:30}] {pos}/{len} steps {msg}";
     let bar = crate::progress_bar(budget, quiet, template);
     bar.set_position(run.trainer().steps().min(budget));

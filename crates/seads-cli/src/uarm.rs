@@ -79,7 +79,7 @@ pub struct CalibrateArgs {
     #[arg(long, default_value = "uarm-calibration.toml")]
     out: PathBuf,
     /// Distance from the screen for z = 1, mm.
-    #[arg(long, default_value_t = 100.0, value_parser = crate::positive_finite)]
+    #[arg(long, default_value_t = 100.0, value_parser = seads_study::numbers::positive_finite)]
     d_max_mm: f64,
 }
 
@@ -161,7 +161,7 @@ pub struct UarmTrainArgs {
     #[arg(long, value_parser = clap::builder::RangedU64ValueParser::<usize>::new().range(1..=200_000), default_value_t = 20)]
     boards: usize,
     /// Time limit per search in the final evaluation, seconds.
-    #[arg(long, default_value_t = 60.0, value_parser = crate::positive_finite)]
+    #[arg(long, default_value_t = 60.0, value_parser = seads_study::numbers::positive_finite)]
     timeout: f64,
     /// Continue the run in --out from its last checkpoint.
     #[arg(long)]
@@ -338,7 +338,7 @@ pub struct UarmEvaluateArgs {
     #[arg(long, value_parser = clap::builder::RangedU64ValueParser::<usize>::new().range(1..=200_000), default_value_t = 20)]
     boards: usize,
     /// Time limit per search, seconds.
-    #[arg(long, default_value_t = 60.0, value_parser = crate::positive_finite)]
+    #[arg(long, default_value_t = 60.0, value_parser = seads_study::numbers::positive_finite)]
     timeout: f64,
     /// No progress bar.
     #[arg(long)]

@@ -14,7 +14,7 @@ use std::sync::OnceLock;
 use serde_json::Value;
 
 mod common;
-use common::{kill_at_moment, park_at_moment};
+use common::{kill_at_moment, metrics_without_clock, park_at_moment};
 
 const SEADS: &str = env!("CARGO_BIN_EXE_seads");
 
@@ -66,22 +66,6 @@ fn resume(out: &Path) -> std::process::Output {
     output
 }
 
-/// The metrics lines without what depends on the clock.
-fn metrics(run: &Path) -> Vec<Value> {
-    std::fs::read_to_string(run.join("metrics.jsonl"))
-        .unwrap()
-        .lines()
-        .map(|line| {
-            let mut v: Value = serde_json::from_str(line).unwrap();
-            let map = v.as_object_mut().unwrap();
-            for key in ["wall_s", "steps_per_s", "timings"] {
-                map.remove(key).unwrap();
-            }
-            v
-        })
-        .collect()
-}
-
 struct Baseline {
     _dir: tempfile::TempDir,
     config: PathBuf,
@@ -107,7 +91,7 @@ fn baseline() -> &'static Baseline {
             .filter_map(|l| l.strip_prefix("seads: moment "))
             .map(str::to_owned)
             .collect();
-        let metrics = metrics(&out);
+        let metrics = metrics_without_clock(&out);
         assert!(metrics.len() >= 10, "{} evaluations", metrics.len());
         Baseline {
             _dir: dir,
@@ -154,7 +138,7 @@ fn kill_and_resume(point: usize, tear: bool) -> String {
     }
     let output = resume(&out);
     assert_eq!(
-        metrics(&out),
+        metrics_without_clock(&out),
         base.metrics,
         "killed at moment {point} ({}), the resumed run differs",
         base.moments[point - 1]
@@ -242,7 +226,7 @@ fn a_torn_line_and_a_corrupt_latest_checkpoint_are_repaired() {
     assert!(stderr.contains("passed over checkpoint"), "{stderr}");
     assert!(stderr.contains("torn last line"), "{stderr}");
     assert!(stderr.contains(".epoch-000099.tmp"), "{stderr}");
-    assert_eq!(metrics(&out), base.metrics);
+    assert_eq!(metrics_without_clock(&out), base.metrics);
 }
 
 /// `--env-steps` with `--resume` raises a finished run's budget and records it; lowering it is
@@ -261,7 +245,7 @@ fn a_finished_run_can_be_extended() {
     assert!(output.status.success());
     let config = std::fs::read_to_string(out.join("config.toml")).unwrap();
     assert!(config.contains("env_steps = 2000"), "{config}");
-    let metrics = metrics(&out);
+    let metrics = metrics_without_clock(&out);
     assert!(metrics.last().unwrap()["env_steps"].as_u64().unwrap() >= 2000);
     // The rows up to the old end are the old run's.
     assert_eq!(metrics[..base.metrics.len()], base.metrics[..]);
@@ -356,7 +340,7 @@ fn damaged_runs_are_repaired_with_a_word_or_refused_never_retrained() {
             stderr.contains("ignored the latest pointer"),
             "{name}: {stderr}"
         );
-        assert_eq!(metrics(&run), base.metrics, "{name}");
+        assert_eq!(metrics_without_clock(&run), base.metrics, "{name}");
     }
     assert_eq!(std::fs::read_dir(&outside).unwrap().count(), 1);
     let refused: [(&str, Damage, &str); 2] = [

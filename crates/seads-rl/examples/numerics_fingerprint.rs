@@ -74,7 +74,13 @@ fn main() -> std::process::ExitCode {
     out.insert("tch.sigmoid", crc_tensor(&wide.sigmoid()));
     out.insert("tch.softplus", crc_tensor(&wide.softplus()));
     out.insert("tch.relu", crc_tensor(&wide.relu()));
+    // libtorch's root (MKL's, from the processor's rsqrtps estimate) and the one Adam takes
+    // with the portable kernels (correctly rounded): only the first may differ between processors.
     out.insert("tch.sqrt", crc_tensor(&positive.sqrt()));
+    out.insert(
+        "seads_nn.sqrt",
+        crc_tensor(&seads_nn::numerics::sqrt(&positive)),
+    );
     out.insert("tch.reciprocal", crc_tensor(&positive.reciprocal()));
     out.insert(
         "tch.log_softmax",

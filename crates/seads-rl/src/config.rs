@@ -155,11 +155,15 @@ pub struct TrainConfig {
     /// libtorch threads of the SAC thread once the other training thread has finished preparing
     /// the next epoch's updates and waits (0: keep `threads`). The presets use 2, for a run that
     /// has two cores to itself; set 0 when several runs share the cores, since libtorch's threads
-    /// busy-wait and slow down badly when the cores are oversubscribed.
+    /// busy-wait and slow down badly when the cores are oversubscribed. The moment SAC widens
+    /// depends on timing; at the presets' network sizes the bits do not, with portable numerics
+    /// and 32- or 64-wide networks they do (set 0 there for a run that repeats exactly;
+    /// `examples/thread_count_bits.rs`).
     pub sac_threads_alone: usize,
     /// Run libtorch with kernels that give the same numbers on every x86-64 machine (MKL's
-    /// `COMPATIBLE` branch), so that the seed alone fixes the run. About 1.8× slower per SAC
-    /// update; off in the presets, on for the demo and the tests (see `seads_rl::numerics`).
+    /// `COMPATIBLE` branch, and Adam's square root correctly rounded), so that the seed alone
+    /// fixes the run. About 1.8× slower per SAC update; off in the presets, on for the demo and
+    /// the tests (see `seads_nn::numerics`).
     pub portable_numerics: bool,
     /// Where the networks run: `cpu` (the default) or `cuda`, `cuda:N`. Only the CPU is
     /// bit-exact from the seed; a checkpoint from either loads on the other. Left out of the

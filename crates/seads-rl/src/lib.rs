@@ -44,11 +44,14 @@ mod in_words;
 mod learner;
 mod metrics;
 mod numerics;
+mod population;
 mod relaxed;
 mod replay;
 mod run;
 mod sac;
 mod seeds;
+mod stacked;
+mod stacked_population;
 pub mod store;
 mod task_episodes;
 mod task_policy;
@@ -69,11 +72,13 @@ pub use in_words::{BaselineInWords, InWords};
 pub use learner::{Hook, Learner, Moment};
 pub use metrics::{Metrics, read_metrics};
 pub use numerics::{PORTABLE_KERNELS, kernel_environment, portable_kernels_active};
+pub use population::{Members, Population, PopulationKey, check_population};
 pub use relaxed::RelaxedBernoulli;
 pub use run::{Run, RunEvent, load_config, raise_budget};
 pub use sac::{Sac, SacConfig, SacLosses, TransitionBatch, checkpoint_files};
 pub use seads_nn::{ComputeDevice, DeviceError};
 pub use seeds::{Purpose, derived_seed, stream};
+pub use stacked_population::StackedPopulation;
 pub use task_episodes::{TaskEpochStats, TaskTimings, updates_due};
 pub use task_policy::{TaskPolicy, task_success};
 pub use task_sac::{TaskMetrics, TaskSac};
@@ -157,6 +162,15 @@ pub enum RlError {
         dir: String,
         /// Who holds it, as its lock file names it.
         holder: String,
+    },
+    /// A member of a population failed.
+    #[error("{dir}")]
+    Member {
+        /// The member's run directory.
+        dir: String,
+        /// What went wrong.
+        #[source]
+        source: Box<RlError>,
     },
     /// A run that has written checkpoints has none that can be loaded.
     #[error("{dir}: none of its {tried} checkpoint(s) can be loaded; the newest")]

@@ -303,12 +303,28 @@ impl<L: Learner> Run<L> {
     pub fn step(&mut self) -> Result<RunEvent<L>, RlError> {
         let first = self.trainer.epoch() == 0;
         let stats = self.trainer.run_epoch_observed(&mut self.hook)?;
+        self.after_epoch(first, stats)
+    }
+
+    /// The learner and the hook, for a population that runs the parts of an epoch itself.
+    pub(crate) fn parts(&mut self) -> (&mut L, &mut Hook) {
+        (&mut self.trainer, &mut self.hook)
+    }
+
+    /// The evaluation and checkpoint due after an epoch that gave `stats` (`first`: it was the
+    /// run's first epoch).
+    pub(crate) fn after_epoch(
+        &mut self,
+        first: bool,
+        stats: L::Stats,
+    ) -> Result<RunEvent<L>, RlError> {
         (self.hook)(Moment::EpochDone);
-        let epoch = self.trainer.epoch();
-        let done = self.trainer.finished();
-        let config = self.trainer.config();
-        let eval_due = first || epoch.is_multiple_of(config.eval_every) || done;
-        let checkpoint_due = epoch.is_multiple_of(config.checkpoint_every) || done;
+        let (eval_due, checkpoint_due) = due(
+            self.trainer.config(),
+            first,
+            self.trainer.epoch(),
+            self.trainer.finished(),
+        );
         let metrics = if eval_due {
             Some(self.evaluate(&stats)?)
         } else {
@@ -325,6 +341,15 @@ impl<L: Learner> Run<L> {
             checkpoint,
         })
     }
+}
+
+/// Whether an evaluation and whether a checkpoint are due once `epoch` epochs are done (`first`:
+/// the run's first epoch was the last; `done`: the budget is spent).
+pub(crate) fn due(config: &TrainConfig, first: bool, epoch: u64, done: bool) -> (bool, bool) {
+    (
+        first || epoch.is_multiple_of(config.eval_every) || done,
+        epoch.is_multiple_of(config.checkpoint_every) || done,
+    )
 }
 
 /// Raises the budget of the run in `dir` to `env_steps` environment steps and records it in its

@@ -141,6 +141,38 @@ pub struct Sac {
     target_flat: Tensor,
 }
 
+/// A Gaussian-actor [`Sac`]'s settings, networks and optimisers, borrowed.
+pub(crate) struct SacParts<'a> {
+    pub config: &'a SacConfig,
+    pub actor_vs: &'a nn::VarStore,
+    pub critic_vs: &'a nn::VarStore,
+    pub scale: &'a Tensor,
+    pub bias: &'a Tensor,
+    pub actor_opt: &'a Adam,
+    pub critic_opt: &'a Adam,
+    pub target_flat: &'a Tensor,
+}
+
+/// A reparameterised sample a = tanh(mean + σ·ε)·scale + bias of the Gaussian of `mean` and
+/// (clamped) `log_std` for standard-normal `noise`, and its log-probability summed over the
+/// action's entries (the last dimension, kept); for one agent's rows or for stacked members'.
+pub(crate) fn squashed_gaussian(
+    mean: &Tensor,
+    log_std: &Tensor,
+    noise: &Tensor,
+    scale: &Tensor,
+    bias: &Tensor,
+) -> (Tensor, Tensor) {
+    let u = mean + log_std.exp() * noise;
+    let t = u.tanh();
+    let action = &t * scale + bias;
+    let log_normal = noise.square() * -0.5 - log_std - 0.5 * (2.0 * std::f64::consts::PI).ln();
+    let one_minus_t2: Tensor = 1.0 - t.square();
+    let squash = (scale * one_minus_t2 + 1e-6).log();
+    let log_prob = (log_normal - squash).sum_dim_intlist(-1, true, Kind::Float);
+    (action, log_prob)
+}
+
 /// The checkpoint file of the actor: all that executing skills needs.
 pub const ACTOR_FILE: &str = "sac_actor.safetensors";
 /// The other checkpoint files of SAC (critics, targets, optimiser states): what resuming needs.
@@ -158,8 +190,8 @@ pub fn checkpoint_files(prefix: &str) -> [String; 5] {
         .map(|part| format!("{prefix}_{part}.safetensors"))
 }
 
-const LOG_STD_MIN: f64 = -20.0;
-const LOG_STD_MAX: f64 = 2.0;
+pub(crate) const LOG_STD_MIN: f64 = -20.0;
+pub(crate) const LOG_STD_MAX: f64 = 2.0;
 /// The RelaxedBernoulli policy's logit bounds (the reference's `RelaxedBernoulliPolicy`).
 const LOGIT_BOUND: f64 = 5.0;
 
@@ -284,15 +316,19 @@ impl Sac {
 
     /// Standard-normal noise for a Gaussian actor, uniforms on [0, 1) for a RelaxedBernoulli one.
     fn noise<R: Rng + ?Sized>(&self, rows: usize, rng: &mut R) -> Tensor {
-        let noise: Vec<f32> = match self.actor {
+        self.tensor(&self.noise_values(rows, rng), self.action_dim)
+    }
+
+    /// [`Sac::noise`]'s values, rows × action_dim.
+    fn noise_values<R: Rng + ?Sized>(&self, rows: usize, rng: &mut R) -> Vec<f32> {
+        match self.actor {
             Actor::Gaussian { .. } => (0..rows * self.action_dim)
                 .map(|_| StandardNormal.sample(rng))
                 .collect(),
             Actor::Bernoulli { .. } => (0..rows * self.action_dim)
                 .map(|_| rng.random::<f32>())
                 .collect(),
-        };
-        self.tensor(&noise, self.action_dim)
+        }
     }
 
     /// Mean and log σ of the pre-squash Gaussian.
@@ -318,15 +354,7 @@ impl Sac {
         match &self.actor {
             Actor::Gaussian { mean, log_std } => {
                 let (mean, log_std) = Self::gaussian(mean, log_std, x);
-                let u = &mean + log_std.exp() * noise;
-                let t = u.tanh();
-                let action = &t * &self.scale + &self.bias;
-                let log_normal =
-                    noise.square() * -0.5 - &log_std - 0.5 * (2.0 * std::f64::consts::PI).ln();
-                let one_minus_t2: Tensor = 1.0 - t.square();
-                let squash = (&self.scale * one_minus_t2 + 1e-6).log();
-                let log_prob = (log_normal - squash).sum_dim_intlist(1, true, Kind::Float);
-                (action, log_prob)
+                squashed_gaussian(&mean, &log_std, noise, &self.scale, &self.bias)
             }
             Actor::Bernoulli {
                 logits,
@@ -427,6 +455,45 @@ impl Sac {
             actor: mean_f32(&actor_loss),
             q: mean_f32(&q),
         }
+    }
+
+    /// The noise [`Sac::update`] would draw from `rng` for each of `minibatches`, in the same
+    /// order (the next actions', then the actor's), as rows × action_dim values each.
+    pub(crate) fn draw_noise(
+        &self,
+        minibatches: &[TransitionBatch],
+        rng: &mut ChaCha8Rng,
+    ) -> Vec<[Vec<f32>; 2]> {
+        minibatches
+            .iter()
+            .map(|batch| {
+                let rows = batch.rewards.len();
+                [(); 2].map(|()| self.noise_values(rows, rng))
+            })
+            .collect()
+    }
+
+    /// What a stacked copy of the agent needs ([`crate::stacked::StackedSac`]); `None` for a
+    /// RelaxedBernoulli actor.
+    pub(crate) fn parts(&self) -> Option<SacParts<'_>> {
+        let Actor::Gaussian { .. } = self.actor else {
+            return None;
+        };
+        Some(SacParts {
+            config: &self.config,
+            actor_vs: &self.actor_vs,
+            critic_vs: &self.critic_vs,
+            scale: &self.scale,
+            bias: &self.bias,
+            actor_opt: &self.actor_opt,
+            critic_opt: &self.critic_opt,
+            target_flat: &self.target_flat,
+        })
+    }
+
+    /// The optimisers and the targets' flat buffer, to write a stacked copy's state back.
+    pub(crate) fn state_mut(&mut self) -> (&mut Adam, &mut Adam, &Tensor) {
+        (&mut self.actor_opt, &mut self.critic_opt, &self.target_flat)
     }
 
     /// Writes networks and optimiser states into `dir` (the actor file and the resume files).

@@ -132,6 +132,46 @@ pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<(), RlError> {
     file.commit().map_err(|e| RlError::io(path, e))
 }
 
+/// A file written as a stream and put in place of `path` only by [`AtomicFile::commit`]
+/// (temporary file beside it, fsynced, renamed): dropped without it (an error on the way),
+/// `path` stays as it was.
+pub struct AtomicFile {
+    out: std::io::BufWriter<atomic_write_file::AtomicWriteFile>,
+    path: std::path::PathBuf,
+}
+
+impl AtomicFile {
+    /// Starts the file that will replace `path`.
+    pub fn open(path: &Path) -> Result<Self, RlError> {
+        let file =
+            atomic_write_file::AtomicWriteFile::open(path).map_err(|e| RlError::io(path, e))?;
+        Ok(Self {
+            out: std::io::BufWriter::new(file),
+            path: path.to_path_buf(),
+        })
+    }
+
+    /// Puts what was written in place of the path.
+    pub fn commit(self) -> Result<(), RlError> {
+        let path = self.path;
+        self.out
+            .into_inner()
+            .map_err(|e| e.into_error())
+            .and_then(|file| file.commit())
+            .map_err(|e| RlError::io(&path, e))
+    }
+}
+
+impl std::io::Write for AtomicFile {
+    fn write(&mut self, buf: &[u8]) -> std::io::Result<usize> {
+        self.out.write(buf)
+    }
+
+    fn flush(&mut self) -> std::io::Result<()> {
+        self.out.flush()
+    }
+}
+
 /// fsyncs a folder, so that the names created or renamed in it survive a power loss.
 pub(crate) fn sync_dir(dir: &Path) -> Result<(), RlError> {
     fs::File::open(dir)

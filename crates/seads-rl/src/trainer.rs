@@ -17,6 +17,7 @@ use crate::buffers::{Buffers, RelabelObserver};
 use crate::checkpoint::{self, Prepared};
 use crate::episode::{run_episodes, skill_coverage};
 use crate::seeds::{Purpose, derived_seed, stream, train_env_seed};
+use crate::stacked::SacWork;
 use crate::{Episode, Moment, RlError, Sac, SacLosses, TrainConfig, TransitionBatch};
 
 /// First seed of the skill-coverage evaluation (the paper's 444555 … 444574).
@@ -251,11 +252,41 @@ impl Trainer {
         &mut self,
         hook: &mut dyn FnMut(Moment),
     ) -> Result<EpochStats, RlError> {
+        let mut epoch = self.collect(hook)?;
+        let Some(updates) = epoch.take_updates() else {
+            self.prepare_after(&mut epoch, hook);
+            return Ok(self.conclude(epoch, None));
+        };
+        let threads = SacThreads {
+            threads: self.config.threads,
+            alone: self.config.sac_threads_alone,
+            prepared: AtomicBool::new(false),
+        };
+        let (sac, sac_rng, mut prepare) = self.split();
+        let (sac, next) = std::thread::scope(|scope| {
+            let threads = &threads;
+            let updates = scope.spawn(move || {
+                let start = Instant::now();
+                let losses = sac_updates(sac, &updates.minibatches, sac_rng, threads);
+                (losses, start.elapsed().as_secs_f64())
+            });
+            let next = prepare.after(&mut epoch);
+            threads.prepared.store(true, Ordering::Release);
+            hook(Moment::Prepared);
+            (updates.join().expect("SAC thread"), next)
+        });
+        self.prepared = next;
+        Ok(self.conclude(epoch, Some(sac)))
+    }
+
+    /// The first part of an epoch: its episodes collected with the current policy, and its
+    /// updates (those prepared by the previous epoch, or prepared now by the first epoch with a
+    /// full buffer). Calls `hook` with [`Moment::Collected`].
+    pub(crate) fn collect(&mut self, hook: &mut dyn FnMut(Moment)) -> Result<Collected, RlError> {
         let mut stats = EpochStats {
             epoch: self.progress.epoch,
             ..EpochStats::default()
         };
-
         let start = Instant::now();
         let skills: Vec<usize> = (0..self.envs.len())
             .map(|_| self.progress.streams.labels.random_range(0..self.k))
@@ -282,8 +313,28 @@ impl Trainer {
         stats.changed = new.iter().filter(|e| e.changed()).count() as f32 / new.len().max(1) as f32;
         let new_steps: u64 = new.iter().map(|e| e.len(self.spec.action_dim) as u64).sum();
         let finished = self.progress.env_steps + new_steps >= self.config.env_steps;
+        // The first epoch with a full buffer prepares its own updates (as does the first after
+        // resuming from a checkpoint written before checkpoints kept them).
+        let updates = match self.prepared.take() {
+            Some(prepared) => Some(prepared),
+            None => {
+                let (_, _, mut prepare) = self.split();
+                prepare.buffers.ready().then(|| prepare.updates())
+            }
+        };
+        Ok(Collected {
+            stats,
+            new,
+            new_steps,
+            finished,
+            updates,
+        })
+    }
 
-        let mut prepare = Prepare {
+    /// The agent and its noise stream, and what preparing the next epoch's updates works on
+    /// meanwhile: everything else.
+    fn split(&mut self) -> (&mut Sac, &mut ChaCha8Rng, Prepare<'_>) {
+        let prepare = Prepare {
             buffers: Buffers {
                 config: &self.config,
                 k: self.k,
@@ -295,46 +346,51 @@ impl Trainer {
             spec: &self.spec,
             timings: &mut self.progress.timings,
         };
-        // The first epoch with a full buffer prepares its own updates (as does the first after
-        // resuming from a checkpoint written before checkpoints kept them).
-        let prepared = match self.prepared.take() {
-            Some(prepared) => Some(prepared),
-            None => prepare.buffers.ready().then(|| prepare.updates()),
-        };
-        if let Some(prepared) = prepared {
-            stats.updated = true;
-            stats.mean_reward = prepared.mean_reward;
-            stats.skill_model_loss = prepared.skill_model_loss;
-            let (sac, sac_rng) = (&mut self.sac, &mut self.progress.streams.sac);
-            let threads = SacThreads {
-                threads: self.config.threads,
-                alone: self.config.sac_threads_alone,
-                prepared: AtomicBool::new(false),
-            };
-            let ((losses, sac_s), next) = std::thread::scope(|scope| {
-                let threads = &threads;
-                let updates = scope.spawn(move || {
-                    let start = Instant::now();
-                    let losses = sac_updates(sac, &prepared.minibatches, sac_rng, threads);
-                    (losses, start.elapsed().as_secs_f64())
-                });
-                prepare.buffers.push(new);
-                // No next epoch once the budget is spent: the final skill model is epoch n's.
-                let next = (!finished && prepare.buffers.ready()).then(|| prepare.updates());
-                threads.prepared.store(true, Ordering::Release);
-                hook(Moment::Prepared);
-                (updates.join().expect("SAC thread"), next)
-            });
-            stats.sac = losses;
-            self.prepared = next;
-            self.progress.timings.sac += sac_s;
-        } else {
-            prepare.buffers.push(new);
+        (&mut self.sac, &mut self.progress.streams.sac, prepare)
+    }
+
+    /// The part of an epoch that may run beside its SAC steps: its episodes join the buffers and
+    /// the next epoch's updates are prepared. Calls `hook` with [`Moment::Prepared`].
+    pub(crate) fn prepare_after(&mut self, epoch: &mut Collected, hook: &mut dyn FnMut(Moment)) {
+        let next = self.split().2.after(epoch);
+        if epoch.stats.updated {
+            hook(Moment::Prepared);
         }
-        self.progress.env_steps += new_steps;
+        self.prepared = next;
+    }
+
+    /// The SAC work of an epoch's updates, with the noise [`Sac::update`] would draw from the
+    /// run's SAC stream: for a stacked update ([`crate::stacked::StackedSac`]).
+    pub(crate) fn sac_work(&mut self, updates: Prepared) -> SacWork {
+        let noise = self
+            .sac
+            .draw_noise(&updates.minibatches, &mut self.progress.streams.sac);
+        SacWork {
+            minibatches: updates.minibatches,
+            noise,
+        }
+    }
+
+    /// The agent, for a stacked update to write back into.
+    pub(crate) fn sac_mut(&mut self) -> &mut Sac {
+        &mut self.sac
+    }
+
+    /// The end of an epoch whose SAC steps gave `sac` (mean losses, seconds), if it updated.
+    pub(crate) fn conclude(
+        &mut self,
+        epoch: Collected,
+        sac: Option<(SacLosses, f64)>,
+    ) -> EpochStats {
+        let mut stats = epoch.stats;
+        if let Some((losses, seconds)) = sac {
+            stats.sac = losses;
+            self.progress.timings.sac += seconds;
+        }
+        self.progress.env_steps += epoch.new_steps;
         self.progress.epoch += 1;
         stats.env_steps = self.progress.env_steps;
-        Ok(stats)
+        stats
     }
 
     /// Skill coverage (SPEC §4.5): distinct game moves made by the K skills from identical
@@ -409,9 +465,13 @@ struct SacThreads {
     prepared: AtomicBool,
 }
 
-/// SAC steps on the given minibatches; returns their mean losses. The thread count changes only
-/// how fast they run: libtorch's results are the same with one or two threads (checked by a
-/// test), so the moment SAC takes more threads does not change the run.
+/// SAC steps on the given minibatches; returns their mean losses. At the presets' sizes the thread
+/// count changes only how fast they run: libtorch's results are the same with one or two threads
+/// (`sac_updates_do_not_depend_on_the_thread_count`), so the moment SAC takes more threads does
+/// not change the run. With portable kernels and narrow networks it may: MKL then splits a narrow
+/// layer's products over its inputs, and the columns at the seam round differently
+/// (`examples/thread_count_bits.rs`), so such a configuration repeats exactly only with
+/// `sac_threads_alone = 0`.
 fn sac_updates(
     sac: &mut Sac,
     minibatches: &[TransitionBatch],
@@ -443,6 +503,28 @@ fn sac_updates(
     }
 }
 
+/// An epoch between its collection and its updates ([`Trainer::collect`]).
+pub(crate) struct Collected {
+    stats: EpochStats,
+    /// The new episodes, until they join the buffers.
+    new: Vec<Episode>,
+    new_steps: u64,
+    /// Whether the budget is spent with this epoch.
+    finished: bool,
+    updates: Option<Prepared>,
+}
+
+impl Collected {
+    /// The epoch's updates, if it has any, recorded in its statistics.
+    pub(crate) fn take_updates(&mut self) -> Option<Prepared> {
+        let updates = self.updates.take()?;
+        self.stats.updated = true;
+        self.stats.mean_reward = updates.mean_reward;
+        self.stats.skill_model_loss = updates.skill_model_loss;
+        Some(updates)
+    }
+}
+
 /// What preparing an epoch's updates works on: everything but SAC, which updates meanwhile.
 struct Prepare<'a> {
     buffers: Buffers<'a>,
@@ -452,6 +534,13 @@ struct Prepare<'a> {
 }
 
 impl Prepare<'_> {
+    /// The epoch's new episodes join the buffers; then the next epoch's updates, unless the
+    /// budget is spent (the final skill model is this epoch's) or the buffer is not yet full.
+    fn after(&mut self, epoch: &mut Collected) -> Option<Prepared> {
+        self.buffers.push(std::mem::take(&mut epoch.new));
+        (epoch.stats.updated && !epoch.finished && self.buffers.ready()).then(|| self.updates())
+    }
+
     /// Steps 3a and 3b of an epoch up to SAC: the skill-model update on a batch relabelled with
     /// p = 1, then an independent batch scored and relabelled with the updated model and cut
     /// into SAC minibatches.

@@ -45,7 +45,7 @@ fn sac_learns_to_track_a_target() {
     }
 }
 
-/// SAC updates give the same bits with one libtorch thread as with two, at the presets' network
+/// SAC updates give the same bits with one libtorch thread as with two or eight, at the presets' network
 /// and batch sizes (the trainer widens SAC to two threads part-way through an epoch, at a moment
 /// that depends on timing, so this keeps runs reproducible).
 #[test]
@@ -80,28 +80,16 @@ fn sac_updates_do_not_depend_on_the_thread_count() {
                 .expect("SAC thread")
         })
     };
-    let (one, two) = (run(1), run(2));
-    assert_eq!(one.0, two.0, "losses");
-    assert_eq!(one.1, two.1, "deterministic actions after the updates");
-}
-
-/// A small, fast configuration of LightsOutCursor.
-fn small(seed: u64, steps: u64) -> TrainConfig {
-    let mut config = TrainConfig::preset("lightsout-cursor").unwrap();
-    config.seed = seed;
-    config.env_steps = steps;
-    config.sac.hidden = vec![64, 64];
-    config.skill_model.hidden = vec![64, 64];
-    config.sampled_episodes = 64;
-    config.recent_episodes = 32;
-    config.eval_every = 10;
-    config.checkpoint_every = 10;
-    config.eval_seeds = 2;
-    // Tests run side by side: SAC taking a second thread would oversubscribe the cores.
-    config.sac_threads_alone = 0;
-    // Portable kernels, as the demo uses (cargo sets them: .cargo/config.toml).
-    config.portable_numerics = true;
-    config
+    // Two: the trainer's switch; eight: a task given 8 cores or more (`TrainConfig::use_cores`).
+    let one = run(1);
+    for threads in [2, 8] {
+        let other = run(threads);
+        assert_eq!(one.0, other.0, "losses with {threads} threads");
+        assert_eq!(
+            one.1, other.1,
+            "deterministic actions after the updates, {threads} threads"
+        );
+    }
 }
 
 /// A few epochs of LightsOutCursor (small networks, CI-sized): updates start once the buffer
@@ -110,7 +98,7 @@ fn small(seed: u64, steps: u64) -> TrainConfig {
 /// takes ~10⁴–10⁵ steps: see `seads train` and the README's results.)
 #[test]
 fn lightsout_cursor_smoke() {
-    let mut trainer = Trainer::new(small(7, 4000)).unwrap();
+    let mut trainer = Trainer::new(common::small(7, 4000)).unwrap();
     let first = trainer.skill_coverage().unwrap();
     let mut updated = false;
     let mut losses = Vec::new();
@@ -132,14 +120,17 @@ fn lightsout_cursor_smoke() {
 }
 
 /// The same seed gives the same run (metrics bit for bit), whether or not SAC takes a second
-/// libtorch thread part-way through its epochs; another seed gives another run.
+/// libtorch thread part-way through its epochs; another seed gives another run. SAC is 128 wide:
+/// with the portable kernels a 64-wide one's bits depend on the thread count
+/// (`examples/thread_count_bits.rs`), so whether it widened, which timing decides, would show.
 #[test]
 fn same_seed_same_run() {
     let run = |seed, sac_threads_alone| {
-        let config = TrainConfig {
+        let mut config = TrainConfig {
             sac_threads_alone,
-            ..small(seed, 1200)
+            ..common::small(seed, 1200)
         };
+        config.sac.hidden = vec![128, 128];
         let mut trainer = Trainer::new(config).unwrap();
         let mut trace = Vec::new();
         while !trainer.finished() {
@@ -168,7 +159,7 @@ fn same_seed_same_run() {
 fn resume_refuses_a_config_edited_since_its_checkpoint() {
     let dir = tempfile::tempdir().unwrap();
     let path = dir.path().join("run");
-    let mut run = Run::<Trainer>::create(&path, small(12, 2500)).unwrap();
+    let mut run = Run::<Trainer>::create(&path, common::small(12, 2500)).unwrap();
     while run.trainer().epoch() < 10 {
         run.step().unwrap();
     }
@@ -202,7 +193,7 @@ fn resume_refuses_a_config_edited_since_its_checkpoint() {
 fn resume_continues_from_the_last_checkpoint() {
     let dir = tempfile::tempdir().unwrap();
     let path = dir.path().join("run");
-    let mut run = Run::<Trainer>::create(&path, small(11, 2500)).unwrap();
+    let mut run = Run::<Trainer>::create(&path, common::small(11, 2500)).unwrap();
     let mut at_checkpoint = None;
     for _ in 0..25 {
         let event = run.step().unwrap();
@@ -220,7 +211,7 @@ fn resume_continues_from_the_last_checkpoint() {
     drop(run);
     // Creating again in the same directory is refused.
     assert!(matches!(
-        Run::<Trainer>::create(&path, small(11, 2500)),
+        Run::<Trainer>::create(&path, common::small(11, 2500)),
         Err(RlError::Config(m)) if m.contains("already holds a run")
     ));
     let mut resumed = Run::<Trainer>::resume(&path).unwrap();
@@ -253,13 +244,13 @@ fn resume_continues_from_the_last_checkpoint() {
 #[test]
 fn a_checkpoint_keeps_the_prepared_updates() {
     let dir = tempfile::tempdir().unwrap();
-    let mut trainer = Trainer::new(small(5, 100_000)).unwrap();
+    let mut trainer = Trainer::new(common::small(5, 100_000)).unwrap();
     for _ in 0..4 {
         trainer.run_epoch().unwrap();
     }
     trainer.save(dir.path()).unwrap();
     assert!(dir.path().join("prepared.safetensors").exists());
-    let mut restored = Trainer::new(small(5, 100_000)).unwrap();
+    let mut restored = Trainer::new(common::small(5, 100_000)).unwrap();
     restored.load(dir.path()).unwrap();
     let (a, b) = (trainer.run_epoch().unwrap(), restored.run_epoch().unwrap());
     assert!(a.updated && b.updated);
@@ -286,7 +277,7 @@ fn chain(err: impl std::error::Error + Send + Sync + 'static) -> String {
 fn corrupt_checkpoints_are_errors_not_panics() {
     let dir = tempfile::tempdir().unwrap();
     let path = dir.path().join("run");
-    let mut run = Run::<Trainer>::create(&path, small(2, 4000)).unwrap();
+    let mut run = Run::<Trainer>::create(&path, common::small(2, 4000)).unwrap();
     while !run.finished() {
         run.step().unwrap();
     }
@@ -367,7 +358,7 @@ fn a_resumed_run_equals_the_uninterrupted_run() {
     let config = TrainConfig {
         eval_every: 5,
         checkpoint_every: 5,
-        ..small(5, 2500)
+        ..common::small(5, 2500)
     };
     let strip = |path: &std::path::Path| -> Vec<(u64, u64, u64, u32, u32, u32)> {
         read_metrics(path)

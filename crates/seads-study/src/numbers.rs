@@ -50,6 +50,31 @@ pub fn depths(text: &str) -> Result<Vec<usize>, String> {
         .collect()
 }
 
+/// A command-line number that must be finite and positive (seconds, millimetres, spacings):
+/// negative, zero, NaN and infinite values are usage errors (exit code 2), never a panic.
+pub fn positive_finite(text: &str) -> Result<f64, String> {
+    let value: f64 = text
+        .parse()
+        .map_err(|_| format!("{text:?} is not a number"))?;
+    if value.is_finite() && value > 0.0 {
+        Ok(value)
+    } else {
+        Err(format!("{text} must be a finite number above 0"))
+    }
+}
+
+/// A command-line number that must be finite and not negative (a standard deviation).
+pub fn non_negative_finite(text: &str) -> Result<f64, String> {
+    let value: f64 = text
+        .parse()
+        .map_err(|_| format!("{text:?} is not a number"))?;
+    if value.is_finite() && value >= 0.0 {
+        Ok(value)
+    } else {
+        Err(format!("{text} must be a finite number of at least 0"))
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -3,9 +3,9 @@
 //! run's `provenance.jsonl` before its first epoch.
 //!
 //! Runs with `portable_numerics = false` (the presets) repeat exactly only on the same kind of
-//! processor, and even portable runs were seen to differ between an AMD EPYC and an Intel Xeon
-//! (docs/RESULTS.md, "Determinism across processors"), so a committed result names its
-//! processor and commit here.
+//! processor, and portable runs differed between an AMD EPYC and an Intel Xeon until Adam took
+//! its square root correctly rounded (docs/RESULTS.md, "Determinism across processors"), so a
+//! committed result names its processor and commit here.
 
 use std::path::Path;
 
@@ -107,6 +107,26 @@ impl Provenance {
             }
         }
         Ok(seen)
+    }
+
+    /// Appends this process of `build` to the provenance of `run`, about to train it on from
+    /// where it stands; nothing for a run that has finished.
+    pub fn record<L: seads_rl::InWords>(
+        run: &seads_rl::Run<L>,
+        build: &Build,
+    ) -> Result<(), seads_rl::RlError> {
+        if run.finished() {
+            return Ok(());
+        }
+        let (trainer, config) = (run.trainer(), run.trainer().config());
+        let here = Self::here(
+            trainer.epoch(),
+            trainer.steps(),
+            config.portable_numerics,
+            config.device,
+            build,
+        );
+        here.append(run.dir())
     }
 
     /// Appends this line to `run_dir`'s provenance file (a torn last line is repaired first).

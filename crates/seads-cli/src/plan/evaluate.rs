@@ -13,18 +13,6 @@ use super::{load_agent, run_evaluation};
 use crate::BadInput;
 use seads_study::evaluation::{self, run_policy_evaluation};
 
-/// A command-line number that must be finite and not negative (a standard deviation).
-fn non_negative_finite(text: &str) -> Result<f64, String> {
-    let value: f64 = text
-        .parse()
-        .map_err(|_| format!("{text:?} is not a number"))?;
-    if value.is_finite() && value >= 0.0 {
-        Ok(value)
-    } else {
-        Err(format!("{text} must be a finite number of at least 0"))
-    }
-}
-
 /// Arguments of `seads evaluate`.
 #[derive(Debug, Args)]
 pub struct EvaluateArgs {
@@ -56,7 +44,7 @@ pub struct EvaluateArgs {
     #[arg(long, conflicts_with_all = ["checkpoint", "replan", "seed"])]
     checkpoints: Option<seads_study::over_training::Selection>,
     /// Time limit per search, seconds (the authors' evaluation used 60).
-    #[arg(long, default_value_t = 60.0, value_parser = crate::positive_finite)]
+    #[arg(long, default_value_t = 60.0, value_parser = seads_study::numbers::positive_finite)]
     timeout: f64,
     /// Also stop each search after expanding this many states: a limit that, unlike the clock,
     /// gives the same results on every machine.
@@ -65,7 +53,7 @@ pub struct EvaluateArgs {
     /// Execute skills with Gaussian noise of this standard deviation on every low-level action
     /// (the authors' evaluation under noise used 0.05 for the cursor), drawn from each task's
     /// seed; the files are named `evaluation-replan-noise-STD…`.
-    #[arg(long, value_parser = non_negative_finite, conflicts_with = "checkpoints")]
+    #[arg(long, value_parser = seads_study::numbers::non_negative_finite, conflicts_with = "checkpoints")]
     action_noise: Option<f64>,
     /// Where the networks run: cpu, cuda (the first GPU) or cuda:N, whichever device the run
     /// trained on. The plans are the same on either.

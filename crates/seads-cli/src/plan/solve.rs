@@ -30,7 +30,7 @@ pub struct SolveArgs {
     #[arg(long, default_value_t = 0)]
     seed: u64,
     /// Time limit per search, seconds.
-    #[arg(long, default_value_t = 300.0, value_parser = crate::positive_finite)]
+    #[arg(long, default_value_t = 300.0, value_parser = seads_study::numbers::positive_finite)]
     timeout: f64,
     /// Draw the board and the executed skills' paths into this image (.png or .svg).
     #[arg(long)]

@@ -81,6 +81,12 @@ pub struct RunArgs {
     /// workers share the device.
     #[arg(long, default_value = "cpu")]
     device: ComputeDevice,
+    /// Train up to K compatible runs (same environment and network shapes) as one population in
+    /// one process per worker: their epochs side by side on the worker's cores, each run
+    /// written, resumed and evaluated as if trained alone, with the same metrics on the CPU. With
+    /// a GPU device, SEADS members' SAC steps run there on stacked weights, all at once.
+    #[arg(long, value_name = "K")]
+    population: Option<u64>,
     /// No progress bar.
     #[arg(long)]
     quiet: bool,
@@ -91,17 +97,23 @@ pub struct RunArgs {
 pub struct TaskArgs {
     /// The sweep directory.
     dir: PathBuf,
-    /// Index of the run in the sweep (0-based; a Slurm array task passes $SLURM_ARRAY_TASK_ID).
-    #[arg(long)]
-    index: usize,
+    /// Index of the run in the sweep (0-based; a Slurm array task passes $SLURM_ARRAY_TASK_ID),
+    /// or a list of runs (0,5,10) to train as one population.
+    #[arg(long, value_parser = seads_study::numbers::NumberList::parse)]
+    index: seads_study::numbers::NumberList,
     /// Cores of this task; its libtorch threads follow them (Slurm: $SLURM_CPUS_PER_TASK).
     #[arg(long, default_value_t = 2)]
     cores: u64,
     /// Where the run's networks train and evaluate: cpu, cuda or cuda:N.
     #[arg(long, default_value = "cpu")]
     device: ComputeDevice,
+    /// How long to wait for another task that holds one of the runs (a re-queued Slurm task
+    /// waits for the one it replaces to let go) before giving up: exit 3 for one run, exit 2
+    /// for a population.
+    #[arg(long, value_name = "SECONDS", default_value_t = state::PATIENCE.as_secs())]
+    wait: u64,
     /// Started by `seads sweep run`: die with the parent, and if another task holds the run,
-    /// exit with status 3 (taken elsewhere) after two seconds instead of a minute.
+    /// exit with status 3 (taken elsewhere) after two seconds.
     #[arg(long, hide = true)]
     child: bool,
 }
@@ -130,6 +142,10 @@ pub struct SlurmArgs {
     /// The seads binary the tasks run (default: this one; it must be reachable from the nodes).
     #[arg(long)]
     seads: Option<PathBuf>,
+    /// One array task per population of up to K compatible runs (see `seads sweep run
+    /// --population`) instead of one per run.
+    #[arg(long, value_name = "K")]
+    population: Option<u64>,
     /// Submit the array and the report job with sbatch, and print their job ids.
     #[arg(long)]
     submit: bool,
@@ -158,11 +174,18 @@ pub fn run(command: SweepCommand) -> Result<()> {
                 Some(w) => at_least_one("--workers", w)?,
                 None => (cores / 2).max(1),
             };
+            let population = args
+                .population
+                .map(|k| at_least_one("--population", k))
+                .transpose()?;
             pool::run_sweep(
                 &args.dir,
                 args.seeds.as_ref().map(|s| s.0.as_slice()),
-                workers,
-                cores,
+                pool::Workers {
+                    workers,
+                    cores,
+                    population,
+                },
                 crate::usable_device(args.device)?,
                 args.quiet,
             )
@@ -174,7 +197,7 @@ pub fn run(command: SweepCommand) -> Result<()> {
                 die_with_parent();
                 Duration::from_secs(2)
             } else {
-                state::PATIENCE
+                Duration::from_secs(args.wait)
             };
             let cores = at_least_one("--cores", args.cores)?;
             let device = crate::usable_device(args.device)?;
@@ -183,7 +206,15 @@ pub fn run(command: SweepCommand) -> Result<()> {
                 .num_threads(cores)
                 .build_global()
                 .context("starting the task's threads")?;
-            task::run_task(&args.dir, args.index, cores, device, patience)
+            let indices: Vec<usize> = args.index.0.iter().map(|&i| i as usize).collect();
+            let result = task::run_task(&args.dir, &indices, cores, device, patience);
+            // Run by hand, a population whose member another task holds is the user's to fix.
+            match result {
+                Err(e) if !args.child && indices.len() > 1 && is_taken(&e) => {
+                    Err(BadInput(e.context("a member belongs to another population's task")).into())
+                }
+                other => other,
+            }
         }
         SweepCommand::Slurm(args) => slurm(args),
         SweepCommand::Status(args) => status(args),
@@ -228,6 +259,15 @@ fn slurm(args: SlurmArgs) -> Result<()> {
         ))
     })?;
     let sweep = Sweep::load(&dir).map_err(crate::bad_input)?;
+    let populations = match args.population {
+        Some(k) => {
+            let all: Vec<usize> = (0..sweep.runs.len()).collect();
+            let k = at_least_one("--population", k)?;
+            Some(seads_study::sweep::populations(&dir, &sweep, &all, k)?)
+        }
+        None => None,
+    };
+    let tasks = populations.as_ref().map_or(sweep.runs.len(), Vec::len);
     let seads = match args.seads {
         Some(path) => std::fs::canonicalize(&path)
             .map_err(|_| BadInput(anyhow!("--seads {} does not exist", path.display())))?,
@@ -243,15 +283,13 @@ fn slurm(args: SlurmArgs) -> Result<()> {
             .transpose()?,
         seads,
         device: args.device,
+        populations,
     };
     let (array, report) = slurm::write_scripts(&dir, &sweep, &options)?;
     outln!("wrote {} and {}", array.display(), report.display());
     if args.submit {
         let (array_id, report_id) = slurm::submit(&array, &report)?;
-        outln!(
-            "submitted job array {array_id} ({} tasks) and report job {report_id}",
-            sweep.runs.len()
-        );
+        outln!("submitted job array {array_id} ({tasks} tasks) and report job {report_id}");
         outln!("follow with: seads sweep status {}", dir.display());
     } else {
         outln!(
@@ -272,6 +310,16 @@ fn status(args: StatusArgs) -> Result<()> {
         outln!("{}", overview.table());
     }
     Ok(())
+}
+
+/// Whether `e` says that another task holds a run.
+pub fn is_taken(e: &anyhow::Error) -> bool {
+    e.chain().any(|c| {
+        matches!(
+            c.downcast_ref::<seads_study::StudyError>(),
+            Some(seads_study::StudyError::Taken(_))
+        )
+    })
 }
 
 /// A task started by `seads sweep run` is killed when that process dies, however it dies, so

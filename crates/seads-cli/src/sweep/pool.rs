@@ -12,7 +12,7 @@ use anyhow::{Context, Result, bail};
 use seads_rl::ComputeDevice;
 
 use super::index::Sweep;
-use super::state::{LOG, Status, TAKEN_EXIT, status};
+use super::state::{LOG, Status, TAKEN_EXIT, note_population_log, status};
 use seads_study::sweep::overview::tally;
 
 /// What a worker reports for a run: whether its task succeeded, or `None` when another task
@@ -22,13 +22,26 @@ struct Finished {
     ok: Option<bool>,
 }
 
-/// Runs the sweep in `dir` (only the runs of `seeds`, if given) with `workers` parallel tasks
-/// sharing `cores` cores, their networks on `device`.
+/// How a sweep's runs are spread over this machine.
+pub struct Workers {
+    /// Tasks at once.
+    pub workers: usize,
+    /// Cores they share.
+    pub cores: usize,
+    /// Runs trained together in one task, at most (`None`: one run per task).
+    pub population: Option<usize>,
+}
+
+/// Runs the sweep in `dir` (only the runs of `seeds`, if given) with parallel tasks sharing the
+/// cores, their networks on `device`.
 pub fn run_sweep(
     dir: &Path,
     seeds: Option<&[u64]>,
-    workers: usize,
-    cores: usize,
+    Workers {
+        workers,
+        cores,
+        population,
+    }: Workers,
     device: ComputeDevice,
     quiet: bool,
 ) -> Result<()> {
@@ -58,6 +71,11 @@ pub fn run_sweep(
             }
         }
     }
+    let listed = todo.len();
+    let todo: Vec<Vec<usize>> = match population {
+        Some(k) => seads_study::sweep::populations(dir, &sweep, &todo, k)?,
+        None => todo.into_iter().map(|i| vec![i]).collect(),
+    };
     let workers = workers.max(1);
     let per_task = (cores / workers).max(1);
     let of_seeds = seeds.map_or(String::new(), |_| {
@@ -69,10 +87,13 @@ pub fn run_sweep(
         String::new()
     };
     outln!(
-        "sweep {:?}: {} runs{of_seeds}, {} to train or resume, {skipped_running} running elsewhere{of_copied}; {workers} worker(s) × {per_task} core(s)",
+        "sweep {:?}: {} runs{of_seeds}, {listed} to train or resume{}, {skipped_running} running elsewhere{of_copied}; {workers} worker(s) × {per_task} core(s)",
         sweep.name,
         sweep.runs.len(),
-        todo.len()
+        population.map_or(String::new(), |_| format!(
+            " in {} population(s)",
+            todo.len()
+        )),
     );
     let total: u64 = chosen
         .iter()
@@ -93,18 +114,33 @@ pub fn run_sweep(
             handles.push(scope.spawn(|| -> Result<()> {
                 loop {
                     let next = queue.lock().expect("queue lock").next();
-                    let Some(index) = next else { return Ok(()) };
-                    let run = dir.join(&sweep.runs[index].dir);
-                    // Another `sweep run` (or a Slurm task) may have taken or finished the run
+                    let Some(mut members) = next else {
+                        return Ok(());
+                    };
+                    // Another `sweep run` (or a Slurm task) may have taken or finished a run
                     // since this one listed it: leave it to that one.
-                    if matches!(
-                        status(&run)?.0,
-                        Status::Running | Status::Done | Status::Copied | Status::Damaged
-                    ) {
-                        let mut finished = finished.lock().expect("finished lock");
-                        finished.push(Finished { index, ok: None });
-                        continue;
+                    let mut free = Vec::new();
+                    for index in members.drain(..) {
+                        let run = dir.join(&sweep.runs[index].dir);
+                        if matches!(
+                            status(&run)?.0,
+                            Status::Running | Status::Done | Status::Copied | Status::Damaged
+                        ) {
+                            let mut finished = finished.lock().expect("finished lock");
+                            finished.push(Finished { index, ok: None });
+                        } else {
+                            free.push(index);
+                        }
                     }
+                    let Some(&index) = free.first() else { continue };
+                    let run = dir.join(&sweep.runs[index].dir);
+                    let list: Vec<String> = free.iter().map(usize::to_string).collect();
+                    // A population's output goes to its first member's log.
+                    let others: Vec<_> = free[1..]
+                        .iter()
+                        .map(|&o| dir.join(&sweep.runs[o].dir))
+                        .collect();
+                    note_population_log(&others, &list.join(","), &run.join(LOG))?;
                     let log = std::fs::OpenOptions::new()
                         .create(true)
                         .append(true)
@@ -113,7 +149,7 @@ pub fn run_sweep(
                     let exit = Command::new(&exe)
                         .args(["sweep", "task"])
                         .arg(dir)
-                        .args(["--index", &index.to_string()])
+                        .args(["--index", &list.join(",")])
                         .args(["--cores", &per_task.to_string(), "--child"])
                         .args(["--device", &device.to_string()])
                         .stdin(Stdio::null())
@@ -125,10 +161,18 @@ pub fn run_sweep(
                         Some(code) if code == i32::from(TAKEN_EXIT) => None,
                         _ => Some(exit.success()),
                     };
-                    finished
-                        .lock()
-                        .expect("finished lock")
-                        .push(Finished { index, ok });
+                    let mut finished = finished.lock().expect("finished lock");
+                    for &index in &free {
+                        // A failed population: each member's task.json says how it ended.
+                        let ok = match ok {
+                            Some(false) if free.len() > 1 => Some(matches!(
+                                status(&dir.join(&sweep.runs[index].dir))?.0,
+                                Status::Done
+                            )),
+                            other => other,
+                        };
+                        finished.push(Finished { index, ok });
+                    }
                 }
             }));
         }

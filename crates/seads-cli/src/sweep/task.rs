@@ -6,82 +6,184 @@ use std::path::Path;
 use std::time::Duration;
 
 use anyhow::{Context, Result};
-use seads_rl::{Algorithm, ComputeDevice, Hac, Run, TaskSac, Trainer};
+use seads_rl::store::MetricsLine as _;
+use seads_rl::{
+    Algorithm, ComputeDevice, Hac, Learner, Members, Population, Run, TaskSac, TrainConfig, Trainer,
+};
 
 use seads_rl::InWords;
 use seads_skillmodel::SkillModelKind;
 
 use super::index::Sweep;
+use crate::BadInput;
 use crate::plan::evaluate_checkpoints;
 use crate::plan::{load_agent, run_evaluation};
 use seads_planner::{EvaluationKind, Protocol, TaskSet};
 use seads_study::evaluation::run_policy_evaluation;
 use seads_study::over_training::Selection;
+use seads_study::sweep::train::member_config;
 use seads_study::sweep::{Task, Work};
 
-/// Runs task `index` of the sweep in `dir` with `cores` cores and its networks on `device`, waiting up to `patience` for
-/// another task that holds the run. A run already done is left as it is. Errors are recorded in
-/// the run's `task.json` before they are returned.
+/// Runs the task of the runs `indices` of the sweep in `dir` with `cores` cores and the networks
+/// on `device`: one run trains alone, several train as one population (see
+/// [`seads_rl::Population`]), then each is evaluated. Waits up to `patience` for another task
+/// that holds a run. Runs already done are left as they are. Errors are recorded in the runs'
+/// `task.json` before they are returned.
 pub fn run_task(
     dir: &Path,
-    index: usize,
+    indices: &[usize],
     cores: usize,
     device: ComputeDevice,
     patience: Duration,
 ) -> Result<()> {
-    let task = Task::claim(dir, index, patience).map_err(crate::study_error)?;
-    let run = task.run.display();
-    if task.replanned {
-        outln!("{run}: was deleted; planned again from the manifest");
-    }
-    match &task.work {
-        Work::Nothing => {
-            outln!("{run}: already done");
-            return Ok(());
+    // Every run is claimed and checked before anything is written.
+    let tasks = Task::claim_population(dir, indices, patience).map_err(crate::study_error)?;
+    let mut work = Vec::new();
+    for task in tasks {
+        let run = task.run.display();
+        if task.replanned {
+            outln!("{run}: was deleted; planned again from the manifest");
         }
-        Work::Redo(name) => outln!("{run}: {name} is gone; finishing the run again"),
-        Work::Run => {}
+        match &task.work {
+            Work::Nothing => outln!("{run}: already done"),
+            Work::Redo(name) => {
+                outln!("{run}: {name} is gone; finishing the run again");
+                work.push(task);
+            }
+            Work::Run => work.push(task),
+        }
     }
-    task.start()?;
-    let result = train_and_evaluate(&task.sweep, &task.run, cores, device);
-    task.finish(&result)?;
-    result
+    for task in &work {
+        task.start()?;
+    }
+    let runs: Vec<&Path> = work.iter().map(|t| t.run.as_path()).collect();
+    let trained = match runs.len() {
+        0 => return Ok(()),
+        1 => train(runs[0], cores, device),
+        _ => train_population(&runs, cores, device),
+    };
+    let mut first_error = None;
+    for task in work {
+        let result = match &trained {
+            Ok(()) => evaluate(&task.sweep, &task.run, device),
+            Err(e) => Err(anyhow::anyhow!("{e:#}")),
+        };
+        task.finish(&result)?;
+        if let Err(e) = result {
+            first_error.get_or_insert(e);
+        }
+    }
+    match (trained, first_error) {
+        (Err(e), _) | (Ok(()), Some(e)) => Err(e),
+        (Ok(()), None) => Ok(()),
+    }
 }
 
-fn train_and_evaluate(
-    sweep: &Sweep,
-    run: &Path,
-    cores: usize,
-    device: ComputeDevice,
-) -> Result<()> {
+/// Trains (or resumes) one run to its budget with `cores` cores: SEADS on two training threads
+/// (see [`seads_rl::TrainConfig::use_cores`]), a baseline on one.
+fn train(run: &Path, cores: usize, device: ComputeDevice) -> Result<()> {
     let config =
         seads_rl::load_config(run).with_context(|| format!("loading {}", run.display()))?;
     crate::kernels::use_kernels(config.portable_numerics)?;
     match config.algorithm {
-        Algorithm::Sac => {
-            return train_and_evaluate_baseline::<TaskSac>(sweep, run, cores, device);
-        }
-        Algorithm::Hac => return train_and_evaluate_baseline::<Hac>(sweep, run, cores, device),
-        Algorithm::Seads => {}
+        Algorithm::Seads => train_one::<Trainer>(run, |c| c.use_cores(cores), device),
+        Algorithm::Sac => train_one::<TaskSac>(run, |c| c.threads = cores, device),
+        Algorithm::Hac => train_one::<Hac>(run, |c| c.threads = cores, device),
     }
+}
+
+fn train_one<L: InWords>(
+    run: &Path,
+    threads: impl Fn(&mut TrainConfig),
+    device: ComputeDevice,
+) -> Result<()> {
     let mut training = crate::train::resume(
         run,
         Run::resume_with(run, |mut c| {
-            c.use_cores(cores);
+            c.sac_threads_alone = 0;
+            threads(&mut c);
             c.device = device;
-            Trainer::new(c)
+            L::build(c)
         }),
     )?;
     if !training.finished() {
+        let config = training.trainer().config();
         outln!(
-            "{}: training from epoch {} with {} libtorch thread(s) per training thread",
+            "{}: training from epoch {} with {} libtorch thread(s) per training thread ({})",
             run.display(),
             training.trainer().epoch(),
-            training.trainer().config().threads
+            config.threads,
+            config.algorithm.name()
         );
         crate::train::drive(&mut training, true)?;
     }
-    drop(training);
+    Ok(())
+}
+
+/// Trains the runs `runs` (checked to fit one population) together to their budgets: their
+/// epochs side by side on `cores` threads, each member's networks on one libtorch thread. On a
+/// GPU, SEADS members' SAC agents are stacked there ([`seads_rl::StackedPopulation`]) and the
+/// rest of their work stays on the CPU.
+fn train_population(runs: &[&Path], cores: usize, device: ComputeDevice) -> Result<()> {
+    let config = seads_rl::load_config(runs[0])?;
+    crate::kernels::use_kernels(config.portable_numerics)?;
+    let cpu = ComputeDevice::Cpu;
+    match config.algorithm {
+        Algorithm::Seads if device != cpu => train_members(runs, cpu, |members| {
+            seads_rl::StackedPopulation::new(members, cores, device)
+        }),
+        Algorithm::Seads => train_members(runs, device, |m| Population::<Trainer>::new(m, cores)),
+        Algorithm::Sac => train_members(runs, device, |m| Population::<TaskSac>::new(m, cores)),
+        Algorithm::Hac => train_members(runs, device, |m| Population::<Hac>::new(m, cores)),
+    }
+}
+
+fn train_members<P: Members>(
+    runs: &[&Path],
+    device: ComputeDevice,
+    population: impl FnOnce(Vec<Run<P::Learner>>) -> Result<P, seads_rl::RlError>,
+) -> Result<()>
+where
+    P::Learner: InWords,
+{
+    let members = runs
+        .iter()
+        .map(|run| {
+            let build = |c| P::Learner::build(member_config(c, device));
+            crate::train::resume(run, Run::resume_with(run, build))
+        })
+        .collect::<Result<Vec<_>>>()?;
+    let mut population = population(members).map_err(|e| BadInput(e.into()))?;
+    let names: Vec<String> = runs.iter().map(|r| r.display().to_string()).collect();
+    outln!(
+        "training {} runs as one population: {}",
+        runs.len(),
+        names.join(", ")
+    );
+    let hook = crate::train::crash_hook()?;
+    let show = |run: &Run<P::Learner>, m: &<P::Learner as Learner>::Metrics| -> Result<()> {
+        let (epoch, steps) = (m.epoch(), m.env_steps());
+        let headline = run.trainer().headline(m);
+        outln!(
+            "{}: epoch {epoch:>6}  steps {steps:>9}  {headline}",
+            run.dir().display()
+        );
+        Ok(())
+    };
+    let build = crate::build();
+    seads_study::sweep::train::train_population(&mut population, &build, hook, |run, m| {
+        show(run, m).map_err(Into::into)
+    })
+    .context("training the population")
+}
+
+/// Evaluates a trained run as its sweep asks.
+fn evaluate(sweep: &Sweep, run: &Path, device: ComputeDevice) -> Result<()> {
+    let config =
+        seads_rl::load_config(run).with_context(|| format!("loading {}", run.display()))?;
+    if config.algorithm != Algorithm::Seads {
+        return evaluate_baseline(sweep, run, &config);
+    }
     let plan = &sweep.evaluation;
     if config.skill_model.kind == SkillModelKind::Vic {
         outln!(
@@ -133,41 +235,15 @@ fn train_and_evaluate(
     Ok(())
 }
 
-/// A baseline run: training on all of the task's cores (one training thread), then task success
-/// of the final policy on the study's boards per depth (`evaluation-policy.json`).
-fn train_and_evaluate_baseline<L: InWords>(
-    sweep: &Sweep,
-    run: &Path,
-    cores: usize,
-    device: ComputeDevice,
-) -> Result<()> {
-    let mut training = crate::train::resume(
-        run,
-        Run::resume_with(run, |mut c| {
-            c.threads = cores.max(1);
-            c.sac_threads_alone = 0;
-            c.device = device;
-            L::build(c)
-        }),
-    )?;
-    let config = training.trainer().config().clone();
-    if !training.finished() {
-        outln!(
-            "{}: training the {} baseline from epoch {} with {} libtorch thread(s)",
-            run.display(),
-            config.algorithm.name().to_uppercase(),
-            training.trainer().epoch(),
-            cores.max(1)
-        );
-        crate::train::drive(&mut training, true)?;
-    }
-    drop(training);
+/// Task success of a baseline's final policy on the study's boards per depth
+/// (`evaluation-policy.json`).
+fn evaluate_baseline(sweep: &Sweep, run: &Path, config: &seads_rl::TrainConfig) -> Result<()> {
     if sweep.evaluation.last {
         // The final checkpoint holds the trained policy.
         let checkpoint = seads_rl::store::latest_checkpoint(run)?
             .with_context(|| format!("{} has no checkpoint", run.display()))?;
         let results = run_policy_evaluation(
-            &config,
+            config,
             run,
             &checkpoint,
             TaskSet::standard(sweep.evaluation.boards),

@@ -72,3 +72,19 @@ pub fn park_at_moment(mut command: Command, point: usize) -> std::process::Child
     assert!(stopped, "the run never reached moment {point}");
     child
 }
+
+/// The metrics lines of the run in `run`, without what depends on the clock.
+pub fn metrics_without_clock(run: &Path) -> Vec<serde_json::Value> {
+    std::fs::read_to_string(run.join("metrics.jsonl"))
+        .expect("metrics.jsonl")
+        .lines()
+        .map(|line| {
+            let mut v: serde_json::Value = serde_json::from_str(line).expect("a metrics line");
+            let map = v.as_object_mut().expect("an object");
+            for key in ["wall_s", "steps_per_s", "timings"] {
+                map.remove(key).expect("a clock field");
+            }
+            v
+        })
+        .collect()
+}

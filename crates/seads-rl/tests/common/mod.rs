@@ -1,8 +1,9 @@
 //! Helpers shared by the tests and the benches of seads-rl (benches include this file by path).
+#![allow(dead_code)] // each test crate or bench uses some of them
 
 use rand::{RngExt, SeedableRng};
 use rand_chacha::ChaCha8Rng;
-use seads_rl::TransitionBatch;
+use seads_rl::{TrainConfig, TransitionBatch};
 
 /// `rows` transitions with values uniform in [−1, 1), policy inputs of `input` values, 2-D
 /// actions, no episode ends, drawn from `seed`.
@@ -17,4 +18,23 @@ pub fn random_transitions(rows: usize, input: usize, seed: u64) -> TransitionBat
         next_obs: random(rows * input),
         dones: vec![0.0; rows],
     }
+}
+
+/// A small, fast configuration of LightsOutCursor.
+pub fn small(seed: u64, steps: u64) -> TrainConfig {
+    let mut config = TrainConfig::preset("lightsout-cursor").unwrap();
+    config.seed = seed;
+    config.env_steps = steps;
+    config.sac.hidden = vec![64, 64];
+    config.skill_model.hidden = vec![64, 64];
+    config.sampled_episodes = 64;
+    config.recent_episodes = 32;
+    config.eval_every = 10;
+    config.checkpoint_every = 10;
+    config.eval_seeds = 2;
+    // Tests run side by side: SAC taking a second thread would oversubscribe the cores.
+    config.sac_threads_alone = 0;
+    // Portable kernels, as the demo uses (cargo sets them: .cargo/config.toml).
+    config.portable_numerics = true;
+    config
 }

@@ -7,14 +7,17 @@
 pub mod index;
 pub mod manifest;
 pub mod overview;
+pub mod population;
 pub mod slurm;
 pub mod state;
 pub mod task;
+pub mod train;
 
 pub use crate::error::Taken;
 pub use index::{INDEX, MANIFEST, Planned, Sweep, SweepRun};
 pub use manifest::{EvaluationPlan, Manifest, PlannedRun};
 pub use overview::{Overview, RunStatus};
+pub use population::populations;
 pub use state::{
     Claim, LOG, Missing, Outcome, PATIENCE, RECORD, Record, Status, TAKEN_EXIT, check_outputs,
     damage, is_claimed, status,

@@ -32,6 +32,8 @@ pub struct SlurmOptions {
     /// Where the tasks' networks run. For a GPU each task asks for one (`--gres=gpu:1`), which
     /// Slurm makes its `cuda:0`.
     pub device: ComputeDevice,
+    /// The runs as populations (`--population K`), one array task each; `None`: a task per run.
+    pub populations: Option<Vec<Vec<usize>>>,
 }
 
 /// A word for bash, single-quoted.
@@ -58,9 +60,28 @@ pub fn scripts(dir: &Path, sweep: &Sweep, options: &SlurmOptions) -> (String, St
             " --device cuda:0".to_owned(),
         ),
     };
+    // With populations, array task i trains the runs listed in the script's i-th word.
+    let (last, members, index) = match &options.populations {
+        None => (
+            sweep.runs.len().saturating_sub(1),
+            String::new(),
+            "\"$SLURM_ARRAY_TASK_ID\"".to_owned(),
+        ),
+        Some(groups) => {
+            let words: Vec<String> = groups
+                .iter()
+                .map(|g| g.iter().map(usize::to_string).collect::<Vec<_>>().join(","))
+                .collect();
+            (
+                groups.len().saturating_sub(1),
+                format!("POPULATIONS=({})\n", words.join(" ")),
+                "\"${POPULATIONS[$SLURM_ARRAY_TASK_ID]}\"".to_owned(),
+            )
+        }
+    };
     let array = format!(
         "#!/bin/bash\n\
-         # One task per run of sweep {name:?}; written by `seads sweep slurm`.\n\
+         # One task per {unit} of sweep {name:?}; written by `seads sweep slurm`.\n\
          # A task resumes its run when it is re-queued or submitted again.\n\
          #SBATCH --job-name=seads-{name}\n\
          #SBATCH --array=0-{last}{throttle}\n\
@@ -70,9 +91,14 @@ pub fn scripts(dir: &Path, sweep: &Sweep, options: &SlurmOptions) -> (String, St
          {gres}\
          #SBATCH --output={logs}/task-%a.out\n\
          #SBATCH --requeue\n\
-         exec {seads} sweep task {dir} --index \"$SLURM_ARRAY_TASK_ID\" --cores \"${{SLURM_CPUS_PER_TASK:-{cpus}}}\"{device}\n",
+         {members}\
+         exec {seads} sweep task {dir} --index {index} --cores \"${{SLURM_CPUS_PER_TASK:-{cpus}}}\"{device}\n",
         name = sweep.name,
-        last = sweep.runs.len().saturating_sub(1),
+        unit = if options.populations.is_some() {
+            "population of runs"
+        } else {
+            "run"
+        },
         cpus = options.cpus_per_task,
         time = options.time,
         dir = quote(&d),

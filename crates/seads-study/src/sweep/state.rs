@@ -4,7 +4,7 @@
 //!   other writer works on the run: a killed one releases it, so "running" can never be stale;
 //! - `task.json` records the last task's outcome: running, done or failed (with the error).
 
-use std::path::Path;
+use std::path::{Path, PathBuf};
 use std::time::Duration;
 
 use crate::error::Taken;
@@ -158,6 +158,26 @@ fn hostname() -> String {
     std::fs::read_to_string("/proc/sys/kernel/hostname")
         .map(|s| s.trim().to_owned())
         .unwrap_or_default()
+}
+
+/// Notes in the `task.log` of each run in `others` that it trains in a population whose output
+/// goes to `log` (the first member's).
+pub fn note_population_log(others: &[PathBuf], members: &str, log: &Path) -> Result<()> {
+    for run in others {
+        let path = run.join(LOG);
+        let note = format!(
+            "trained in a population with runs {members}; see {}\n",
+            log.display()
+        );
+        let mut file = std::fs::OpenOptions::new()
+            .create(true)
+            .append(true)
+            .open(&path)
+            .doing(|| format!("opening {}", path.display()))?;
+        std::io::Write::write_all(&mut file, note.as_bytes())
+            .doing(|| format!("writing {}", path.display()))?;
+    }
+    Ok(())
 }
 
 /// The exclusive claim of a task on a run (its [`seads_rl::store::RunLock`]), held until dropped (or

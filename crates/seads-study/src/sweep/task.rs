@@ -76,6 +76,36 @@ impl Task {
         })
     }
 
+    /// Claims the runs `indices` of the sweep in `dir` for one task that trains them as a
+    /// population ([`Task::claim`] each, before anything is written), and checks that they can
+    /// share one ([`seads_rl::check_population`]; not for a single run): a run of other shapes is
+    /// [`StudyError::is_invalid`]; a run that another task (another population) holds past
+    /// `patience` is [`StudyError::Taken`], and no run is claimed then.
+    pub fn claim_population(
+        dir: &Path,
+        indices: &[usize],
+        patience: Duration,
+    ) -> Result<Vec<Self>> {
+        let tasks = indices
+            .iter()
+            .map(|&index| Self::claim(dir, index, patience))
+            .collect::<Result<Vec<_>>>()?;
+        // A run alone is no population: its config is read (and a failure recorded) as it trains.
+        if tasks.len() < 2 {
+            return Ok(tasks);
+        }
+        let configs = tasks
+            .iter()
+            .map(|t| {
+                let config = seads_rl::load_config(&t.run)
+                    .map_err(|e| StudyError::Invalid(e.to_string()))?;
+                Ok((t.run.display().to_string(), config))
+            })
+            .collect::<Result<Vec<_>>>()?;
+        seads_rl::check_population(&configs).map_err(|e| StudyError::Invalid(e.to_string()))?;
+        Ok(tasks)
+    }
+
     /// Records that the task works on the run now.
     pub fn start(&self) -> Result<()> {
         Record::write(&self.run, Outcome::Running, self.attempts, None)
