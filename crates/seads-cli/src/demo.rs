@@ -23,8 +23,8 @@ pub struct RunArgs {
     env: String,
     /// Training budget in environment steps (the paper's Cursor budget is 500000). With the
     /// default, seed 1 ends at epoch 1706 with skill coverage 24.75/25 (25/25 at epoch 1700;
-    /// portable numerics, recorded on an AMD EPYC), and coverage wobbles by about a skill
-    /// between evaluations (docs/results/demo).
+    /// portable numerics; an AMD EPYC and an Intel Xeon give the same run), and coverage
+    /// wobbles by about a skill between evaluations (docs/results/demo).
     #[arg(long, default_value_t = 157_252)]
     env_steps: u64,
     /// Seed of the run.
