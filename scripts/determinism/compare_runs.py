@@ -5,7 +5,7 @@ Usage: compare_runs.py --last-epoch N NAME=METRICS.jsonl ... > summary.json
 Prints, as JSON, each run's lines at the epochs they all share (environment steps, skill coverage,
 losses), the commit and processor of its first training process where a provenance.jsonl lies
 beside the metrics, and, for each pair of runs, whether every shared line is equal in every field.
-Used by rsqrt_emulation.sh.
+Used by rsqrt_emulation.sh; scripts/gpu/table.py takes its line comparison from here.
 """
 
 import argparse
@@ -16,15 +16,27 @@ import sys
 CLOCK = {"wall_s", "steps_per_s", "timings"}
 
 
+def without_clock(rows, last_epoch):
+    """The metrics rows up to `last_epoch`, clock fields left out."""
+    return [{k: v for k, v in r.items() if k not in CLOCK} for r in rows if r["epoch"] <= last_epoch]
+
+
+def first_difference(ours, theirs):
+    """Where two runs' rows (from `without_clock`) first part: (line from 1, field, ours, theirs),
+    with field None where one run has fewer lines; None where they are equal."""
+    for i, (a, b) in enumerate(zip(ours, theirs)):
+        if a != b:
+            field = next(k for k in sorted(set(a) | set(b)) if a.get(k) != b.get(k))
+            return i + 1, field, a.get(field), b.get(field)
+    if len(ours) != len(theirs):
+        return min(len(ours), len(theirs)) + 1, None, len(ours), len(theirs)
+    return None
+
+
 def lines(path, last_epoch):
-    out = {}
     with open(path, encoding="utf-8") as f:
-        for text in f:
-            row = json.loads(text)
-            if row["epoch"] > last_epoch:
-                break
-            out[row["epoch"]] = {k: v for k, v in row.items() if k not in CLOCK}
-    return out
+        rows = [json.loads(text) for text in f if text.strip()]
+    return {row["epoch"]: row for row in without_clock(rows, last_epoch)}
 
 
 def provenance(path):

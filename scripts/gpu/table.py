@@ -7,6 +7,9 @@ import json
 import pathlib
 import sys
 
+sys.path.insert(0, str(pathlib.Path(__file__).resolve().parents[1] / "determinism"))
+from compare_runs import first_difference, without_clock  # noqa: E402
+
 
 def load_json(path):
     try:
@@ -70,9 +73,6 @@ def population(out, root):
           f"committed CPU runs at {near} steps: {committed_coverage(root, near) if near else 'n/a'}")
 
 
-CLOCK = ("wall_s", "steps_per_s", "timings")
-
-
 def golden(out, root):
     """This processor's golden run against the EPYC's (data/golden/: libtorch 2.13, which the same
     binary as here, libtorch 2.11, repeats there: data/golden/libtorch-2.11/)."""
@@ -92,19 +92,16 @@ def golden(out, root):
             print("(tch.sqrt is libtorch's root, from the processor's rsqrtps estimate; portable runs "
                   "take seads_nn.sqrt instead: docs/RESULTS.md, 'Determinism across processors')")
     ref = (load_lines(root / "data/golden/provenance.jsonl") or [{}])[0].get("cpu_model", "?")
-    strip = lambda line: {k: v for k, v in line.items() if k not in CLOCK}
-    ours = [strip(l) for l in ours if l["epoch"] <= 300]
-    theirs = [strip(l) for l in theirs if l["epoch"] <= 300]
-    for i, (a, b) in enumerate(zip(ours, theirs)):
-        if a != b:
-            field = next(k for k in sorted(set(a) | set(b)) if a.get(k) != b.get(k))
-            print(f"{cpu} parts from {ref} at line {i + 1} (epoch {a.get('epoch')}): "
-                  f"{field} {a.get(field)} against {b.get(field)}")
-            return
-    if len(ours) != len(theirs):
-        print(f"{cpu}: {len(ours)} lines to epoch 300, {ref}: {len(theirs)}")
-        return
-    print(f"{cpu} repeats {ref}: {len(ours)} metrics lines to epoch 300 equal, field for field")
+    ours, theirs = without_clock(ours, 300), without_clock(theirs, 300)
+    parted = first_difference(ours, theirs)
+    if parted is None:
+        print(f"{cpu} repeats {ref}: {len(ours)} metrics lines to epoch 300 equal, field for field")
+    elif parted[1] is None:
+        print(f"{cpu}: {parted[2]} lines to epoch 300, {ref}: {parted[3]}")
+    else:
+        line, field, a, b = parted
+        print(f"{cpu} parts from {ref} at line {line} (epoch {ours[line - 1]['epoch']}): "
+              f"{field} {a} against {b}")
 
 
 def main():
