@@ -29,9 +29,20 @@ use std::process::ExitCode;
 
 use clap::{Parser, Subcommand};
 
+/// `seads --version`: the version, the commit the binary was built from and whether its working
+/// tree had uncommitted changes (what a run's provenance records).
+const VERSION: &str = concat!(
+    env!("CARGO_PKG_VERSION"),
+    " (commit ",
+    env!("VERGEN_GIT_SHA"),
+    ", uncommitted changes: ",
+    env!("VERGEN_GIT_DIRTY"),
+    ")"
+);
+
 /// SEADS: learn reward-free manipulation skills that play board games, and solve boards with them.
 #[derive(Debug, Parser)]
-#[command(name = "seads", version, about, long_about = None, propagate_version = true)]
+#[command(name = "seads", version = VERSION, about, long_about = None, propagate_version = true)]
 struct Cli {
     #[command(subcommand)]
     command: Command,

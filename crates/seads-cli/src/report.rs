@@ -26,6 +26,10 @@ pub struct ReportArgs {
     /// itself.
     #[arg(long)]
     copy_runs: bool,
+    /// The git repository whose commits count as known: the report's code-version table marks
+    /// runs that trained on a commit it lacks (default: the current directory's repository).
+    #[arg(long, value_name = "DIR")]
+    repository: Option<PathBuf>,
 }
 
 /// Runs `seads report`.
@@ -36,6 +40,11 @@ pub fn report(args: ReportArgs) -> Result<()> {
         inputs: args.inputs.clone(),
         reference: args.reference.clone(),
         copy_runs: args.copy_runs,
+        repository: Some(
+            args.repository
+                .clone()
+                .unwrap_or_else(|| PathBuf::from(".")),
+        ),
     };
     let summary = write_report(&options, &args.out).map_err(crate::study_error)?;
     if summary.damaged > 0 {

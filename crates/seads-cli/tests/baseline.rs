@@ -3,7 +3,6 @@
 //! protocol and reported beside SEADS's modes; the planning commands refuse them in one line.
 
 use std::path::{Path, PathBuf};
-use std::process::Command;
 
 mod common;
 use common::*;
@@ -264,7 +263,7 @@ fn killed_run_resumes_to_the_same_run(algorithm: &str, points: &[usize]) {
     ]);
     for &point in points {
         let out = dir.path().join(format!("killed-{point}"));
-        let mut command = Command::new(env!("CARGO_BIN_EXE_seads"));
+        let mut command = seads_command();
         command.args(["train", "--config", s(&config), "--out", s(&out), "--quiet"]);
         kill_at_moment(command, point);
         seads_ok(&["train", "--resume", s(&out), "--quiet"]);

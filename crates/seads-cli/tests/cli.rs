@@ -552,9 +552,11 @@ fn planning_commands_reject_bad_input() {
 /// GPU or not.
 #[test]
 fn devices_that_are_not_there_are_refused_before_anything_is_written() {
-    let run = tiny_run().join("run");
-    let run = run.to_str().unwrap();
+    // Its own copy of the shared run, which other tests write evaluations into meanwhile.
     let dir = tempfile::tempdir().unwrap();
+    let run = dir.path().join("run");
+    copy_dir(&tiny_run().join("run"), &run);
+    let run = run.to_str().unwrap();
     let out = dir.path().join("new");
     let out = out.to_str().unwrap();
     let before = std::fs::read_dir(run).unwrap().count();
@@ -1135,7 +1137,7 @@ fn the_run_decides_the_kernels() {
     let losses = |config: &std::path::Path, mkl: &str, name: &str| -> Vec<String> {
         let out = dir.path().join(name);
         // Long enough (~60 epochs) for the kernels' last-bit differences to show.
-        let status = std::process::Command::new(env!("CARGO_BIN_EXE_seads"))
+        let status = seads_command()
             .args(["train", "--quiet", "--env-steps", "3000", "--config"])
             .arg(config)
             .arg("--out")
@@ -1231,7 +1233,7 @@ fn a_closed_output_pipe_is_not_a_panic() {
     use std::os::unix::process::ExitStatusExt;
     let (reader, writer) = std::io::pipe().unwrap();
     drop(reader);
-    let out = std::process::Command::new(env!("CARGO_BIN_EXE_seads"))
+    let out = seads_command()
         .args(["games", "depths", "--game", "tileswap"])
         .stdout(writer)
         .output()
@@ -1253,7 +1255,7 @@ fn a_closed_output_pipe_is_not_a_panic() {
 fn training_runs_with_a_short_openmp_spin() {
     let dir = tempfile::tempdir().unwrap();
     let spin_of = |user: Option<(&str, &str)>, out: &str| -> Option<String> {
-        let mut command = std::process::Command::new(env!("CARGO_BIN_EXE_seads"));
+        let mut command = seads_command();
         command
             .args(["train", "--env", "lightsout-cursor", "--quiet", "--out"])
             .arg(dir.path().join(out))
@@ -1297,11 +1299,7 @@ fn a_full_stdout_is_an_error_message_not_a_panic() {
         .write(true)
         .open("/dev/full")
         .unwrap();
-    let output = std::process::Command::new(env!("CARGO_BIN_EXE_seads"))
-        .arg("envs")
-        .stdout(full)
-        .output()
-        .unwrap();
+    let output = seads_command().arg("envs").stdout(full).output().unwrap();
     let stderr = String::from_utf8_lossy(&output.stderr);
     assert_eq!(output.status.code(), Some(1), "{stderr}");
     assert!(stderr.contains("writing to standard output"), "{stderr}");
@@ -1407,7 +1405,7 @@ fn a_checkpoint_of_other_shapes_is_one_line_of_bad_input() {
 fn run_for(args: &[String], patience: std::time::Duration) -> (Option<i32>, String) {
     use std::io::Read as _;
     use std::os::unix::process::ExitStatusExt;
-    let mut child = std::process::Command::new(env!("CARGO_BIN_EXE_seads"))
+    let mut child = seads_command()
         .args(args)
         .stdout(std::process::Stdio::null())
         .stderr(std::process::Stdio::piped())

@@ -81,7 +81,7 @@ fn solo(dir: &Path, runs: &[PathBuf]) -> Vec<Vec<Value>> {
 }
 
 fn task(sweep: &Path, indices: &str) -> Command {
-    let mut command = Command::new(env!("CARGO_BIN_EXE_seads"));
+    let mut command = seads_command();
     command.args([
         "sweep",
         "task",

@@ -3,7 +3,7 @@
 //! points, which must lose nothing (the resumed sweep equals the uninterrupted one).
 
 use std::path::{Path, PathBuf};
-use std::process::{Command, Stdio};
+use std::process::Stdio;
 use std::time::{Duration, Instant};
 
 mod common;
@@ -542,7 +542,7 @@ fn a_run_taken_by_another_sweep_meanwhile_is_left_to_it() {
     let first = sweep.join("runs/lightsout-cursor/seads/seed-1");
     let second = sweep.join("runs/lightsout-cursor/seads/seed-2");
     let started = Instant::now();
-    let child = Command::new(env!("CARGO_BIN_EXE_seads"))
+    let child = seads_command()
         .args(["sweep", "run", s(&sweep), "--workers", "1", "--quiet"])
         .stdout(Stdio::piped())
         .stderr(Stdio::piped())
@@ -659,7 +659,7 @@ fn killing_sweep_run_at_any_point_loses_nothing() {
     for (i, moment) in [2, 9, 17].into_iter().enumerate() {
         let sweep = tmp.path().join(format!("killed-{i}"));
         seads_ok(&["sweep", "plan", s(&manifest), "--out", s(&sweep)]);
-        let mut parent = Command::new(env!("CARGO_BIN_EXE_seads"))
+        let mut parent = seads_command()
             .args(["sweep", "run", s(&sweep), "--workers", "2", "--quiet"])
             .env("SEADS_CRASH_POINT", moment.to_string())
             .stdout(Stdio::null())
@@ -867,4 +867,59 @@ fn a_copy_of_a_sweep_in_progress_holds_its_finished_runs_and_reports_again() {
         "{md}"
     );
     assert!(md.contains("- not here: 1 run(s)"), "{md}");
+}
+
+/// `sweep run` and `sweep task` refuse a binary built from a working tree with uncommitted changes
+/// (exit 2, one line, nothing trained) unless `--allow-dirty` or `SEADS_ALLOW_DIRTY`; a clean
+/// build passes the check and meets the ordinary input errors behind it. Which of the two this
+/// test binary is, `seads --version` says.
+#[test]
+fn a_study_refuses_a_dirty_binary() {
+    let tmp = tempfile::tempdir().unwrap();
+    let manifest = write_manifest(tmp.path(), MANIFEST);
+    let out = tmp.path().join("sweep");
+    seads_ok(&["sweep", "plan", s(&manifest), "--out", s(&out)]);
+    let planned = snapshot(&out);
+    let version = String::from_utf8(seads_ok(&["--version"]).stdout).unwrap();
+    let dirty = if version.contains("uncommitted changes: true") {
+        true
+    } else {
+        assert!(version.contains("uncommitted changes: false"), "{version}");
+        false
+    };
+    let strict = |args: &[&str]| {
+        let mut command = seads_command();
+        command.env_remove("SEADS_ALLOW_DIRTY").args(args);
+        command.output().unwrap()
+    };
+    for (args, ordinary) in [
+        (
+            vec!["sweep", "run", s(&out), "--seeds", "7"],
+            "has no seed 7",
+        ),
+        (
+            vec!["sweep", "task", s(&out), "--index", "4"],
+            "out of range",
+        ),
+    ] {
+        let refused = strict(&args);
+        let stderr = String::from_utf8_lossy(&refused.stderr);
+        assert_eq!(refused.status.code(), Some(2), "{args:?}: {stderr}");
+        assert_eq!(stderr.lines().count(), 1, "one line: {stderr}");
+        let expected = if dirty {
+            "uncommitted changes"
+        } else {
+            ordinary
+        };
+        assert!(stderr.contains(expected), "{args:?}: {stderr}");
+        // With the option, the same call meets only the ordinary error.
+        let allowed = strict(&[&args[..], &["--allow-dirty"]].concat());
+        let stderr = String::from_utf8_lossy(&allowed.stderr);
+        assert_eq!(allowed.status.code(), Some(2), "{stderr}");
+        assert!(
+            stderr.contains(ordinary),
+            "{args:?} --allow-dirty: {stderr}"
+        );
+    }
+    assert_eq!(snapshot(&out), planned, "nothing trained or written");
 }

@@ -1,5 +1,5 @@
-//! The network blocks of SEADS's learners, on tch: MLPs with the reference's (Xavier)
-//! initialisation drawn from a seeded stream, a flat view of a variable store's parameters, and an
+//! The network blocks of SEADS's learners, on tch: MLPs with the reference's initialisations
+//! ([`Init`]: Xavier for SAC, PyTorch's default for the skill models) drawn from a seeded stream, a flat view of a variable store's parameters, and an
 //! Adam whose state can be checkpointed. The skill model (`seads-skillmodel`) and SAC (`seads-rl`)
 //! are built from them.
 
@@ -15,22 +15,35 @@ use rand::{Rng, RngExt};
 use tch::nn::{self, Module};
 use tch::{Kind, Tensor};
 
-/// A fully connected network: Linear → ReLU → … → Linear, Xavier-uniform weights (gain 1) and
-/// zero biases in every layer, as the reference initialises its networks. The weights are drawn
-/// from the caller's seeded RNG, never from libtorch's global generator, so that a seed fixes
-/// them whatever else runs in the process.
+/// How a linear layer's weights and biases start, as the reference starts its networks.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Init {
+    /// Xavier-uniform weights (gain 1), U(±√(6 / (fan_in + fan_out))), and zero biases: the
+    /// reference's SAC networks (`weights_init_` in its `sac/model.py`).
+    Xavier,
+    /// PyTorch's own `nn.Linear` initialisation: weights and biases both U(±1/√fan_in) (Kaiming
+    /// uniform with a = √5 for the weights). The reference's forward model and VIC discriminator
+    /// are plain `nn.Sequential`s, so they start this way.
+    TorchDefault,
+}
+
+/// A fully connected network: Linear → ReLU → … → Linear, every layer initialised by one
+/// [`Init`]. The weights are drawn from the caller's seeded RNG, never from libtorch's global
+/// generator, so that a seed fixes them whatever else runs in the process.
 #[derive(Debug)]
 pub struct Mlp {
     layers: Vec<nn::Linear>,
 }
 
 impl Mlp {
-    /// An MLP `input → hidden[0] → … → output` with ReLU between layers, under `path`.
+    /// An MLP `input → hidden[0] → … → output` with ReLU between layers, under `path`, each
+    /// layer initialised by `init` from `rng` (layer by layer, weights before bias).
     pub fn new<R: Rng + ?Sized>(
         path: &nn::Path,
         input: i64,
         hidden: &[i64],
         output: i64,
+        init: Init,
         rng: &mut R,
     ) -> Self {
         let sizes: Vec<i64> = std::iter::once(input)
@@ -40,7 +53,7 @@ impl Mlp {
         let layers = sizes
             .windows(2)
             .enumerate()
-            .map(|(i, w)| xavier_linear(&(path / format!("layer{i}")), w[0], w[1], rng))
+            .map(|(i, w)| linear(&(path / format!("layer{i}")), w[0], w[1], init, rng))
             .collect();
         Self { layers }
     }
@@ -64,11 +77,12 @@ impl Mlp {
     }
 }
 
-/// A linear layer with Xavier-uniform weights (gain 1) drawn from `rng` and zero bias.
-pub fn xavier_linear<R: Rng + ?Sized>(
+/// A linear layer `input → output` under `path`, initialised by `init` from `rng`.
+pub fn linear<R: Rng + ?Sized>(
     path: &nn::Path,
     input: i64,
     output: i64,
+    init: Init,
     rng: &mut R,
 ) -> nn::Linear {
     let config = nn::LinearConfig {
@@ -77,18 +91,42 @@ pub fn xavier_linear<R: Rng + ?Sized>(
         bias: true,
     };
     let mut layer = nn::linear(path, input, output, config);
-    let bound = (6.0 / (input + output) as f64).sqrt() as f32;
-    let values: Vec<f32> = (0..input * output)
-        .map(|_| rng.random_range(-bound..bound))
-        .collect();
+    let mut uniform = |bound: f32, n: i64| -> Vec<f32> {
+        (0..n).map(|_| rng.random_range(-bound..bound)).collect()
+    };
+    let (weights, bias) = match init {
+        Init::Xavier => {
+            let bound = (6.0 / (input + output) as f64).sqrt() as f32;
+            (uniform(bound, input * output), None)
+        }
+        Init::TorchDefault => {
+            let bound = (1.0 / input as f64).sqrt() as f32;
+            let weights = uniform(bound, input * output);
+            (weights, Some(uniform(bound, output)))
+        }
+    };
     tch::no_grad(|| {
+        let device = layer.ws.device();
         layer.ws.copy_(
-            &Tensor::from_slice(&values)
+            &Tensor::from_slice(&weights)
                 .view([output, input])
-                .to_device(layer.ws.device()),
-        )
+                .to_device(device),
+        );
+        if let (Some(bias), Some(bs)) = (bias, layer.bs.as_mut()) {
+            bs.copy_(&Tensor::from_slice(&bias).to_device(device));
+        }
     });
     layer
+}
+
+/// A linear layer with Xavier-uniform weights (gain 1) drawn from `rng` and zero bias.
+pub fn xavier_linear<R: Rng + ?Sized>(
+    path: &nn::Path,
+    input: i64,
+    output: i64,
+    rng: &mut R,
+) -> nn::Linear {
+    linear(path, input, output, Init::Xavier, rng)
 }
 
 impl Module for Mlp {
@@ -332,7 +370,14 @@ mod tests {
     #[test]
     fn adam_matches_libtorch() {
         let init = nn::VarStore::new(Device::Cpu);
-        let _ = Mlp::new(&init.root(), 3, &[8], 2, &mut ChaCha8Rng::seed_from_u64(1));
+        let _ = Mlp::new(
+            &init.root(),
+            3,
+            &[8],
+            2,
+            Init::Xavier,
+            &mut ChaCha8Rng::seed_from_u64(1),
+        );
         let x = Tensor::from_slice(
             &(0..48)
                 .map(|i| ((i * 7 % 13) as f32 - 6.0) / 4.0)
@@ -347,7 +392,14 @@ mod tests {
         .view([16, 2]);
         let run = |ours: bool| {
             let mut vs = nn::VarStore::new(Device::Cpu);
-            let net = Mlp::new(&vs.root(), 3, &[8], 2, &mut ChaCha8Rng::seed_from_u64(2));
+            let net = Mlp::new(
+                &vs.root(),
+                3,
+                &[8],
+                2,
+                Init::Xavier,
+                &mut ChaCha8Rng::seed_from_u64(2),
+            );
             vs.copy(&init).unwrap();
             let mut mine = Adam::new(&vs, 1e-2);
             let mut theirs = nn::Adam::default().build(&vs, 1e-2).unwrap();
@@ -373,6 +425,7 @@ mod tests {
             53,
             &[256, 256],
             3,
+            Init::Xavier,
             &mut ChaCha8Rng::seed_from_u64(0),
         );
         let bound = (6.0f64 / (53.0 + 256.0)).sqrt();
@@ -393,6 +446,7 @@ mod tests {
             53,
             &[256, 256],
             3,
+            Init::Xavier,
             &mut ChaCha8Rng::seed_from_u64(0),
         );
         assert!(

@@ -252,7 +252,7 @@ pub fn upload(values: &[f32], shape: &[i64], device: Device) -> Tensor {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::{Mlp, parameter_layout};
+    use crate::{Init, Mlp, parameter_layout};
     use rand::SeedableRng;
     use rand_chacha::ChaCha8Rng;
     use tch::Kind;
@@ -270,6 +270,7 @@ mod tests {
                 3,
                 &[8, 8],
                 2,
+                Init::TorchDefault,
                 &mut ChaCha8Rng::seed_from_u64(k as u64),
             );
             let adam = Adam::new(&vs, lrs[k]);

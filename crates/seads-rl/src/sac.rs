@@ -9,7 +9,7 @@ use std::path::Path;
 use rand::{Rng, RngExt, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use rand_distr::{Distribution, StandardNormal};
-use seads_nn::{Adam, Mlp, flatten_parameters, mean_f32, xavier_linear};
+use seads_nn::{Adam, Init, Mlp, flatten_parameters, mean_f32, xavier_linear};
 use serde::{Deserialize, Serialize};
 use tch::nn::{self, Module};
 use tch::{Device, Kind, Tensor};
@@ -245,7 +245,15 @@ impl Sac {
         let action_dim = low.len();
         let (i, a) = (input_dim as i64, action_dim as i64);
         let actor_vs = nn::VarStore::new(device);
-        let mean = Mlp::new(&(actor_vs.root() / "actor"), i, &config.hidden, a, &mut rng);
+        // The reference's SAC networks start Xavier (its `weights_init_`).
+        let mean = Mlp::new(
+            &(actor_vs.root() / "actor"),
+            i,
+            &config.hidden,
+            a,
+            Init::Xavier,
+            &mut rng,
+        );
         let actor = match temperature {
             None => {
                 let last = *config.hidden.last().expect("validated");
@@ -260,7 +268,16 @@ impl Sac {
         };
         // Twin critics (their targets are initialised the same way, then overwritten by a copy).
         let twin_critics = |vs: &nn::VarStore, rng: &mut ChaCha8Rng| {
-            ["q1", "q2"].map(|name| Mlp::new(&(vs.root() / name), i + a, &config.hidden, 1, rng))
+            ["q1", "q2"].map(|name| {
+                Mlp::new(
+                    &(vs.root() / name),
+                    i + a,
+                    &config.hidden,
+                    1,
+                    Init::Xavier,
+                    rng,
+                )
+            })
         };
         let critic_vs = nn::VarStore::new(device);
         let q = twin_critics(&critic_vs, &mut rng);

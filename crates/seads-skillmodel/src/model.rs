@@ -13,7 +13,7 @@ use tch::{Device, Kind, Tensor};
 
 use crate::SkillModelError;
 use crate::screen::{Int8Screen, MAX_WIDTH, MIN_ROWS};
-use seads_nn::{Adam, Mlp, mean_f32};
+use seads_nn::{Adam, Init, Mlp, mean_f32};
 
 /// States per successor call on a GPU (25 skills: 8·10⁵ network rows, about 2 GiB of
 /// activations for 256-unit layers): enough rows that a call's launches and copies are a small
@@ -615,6 +615,7 @@ impl Trainable {
             input as i64,
             &config.hidden,
             output as i64,
+            Init::TorchDefault,
             &mut rng,
         );
         let opt = Adam::new(&vs, config.lr);

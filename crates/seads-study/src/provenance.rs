@@ -27,6 +27,24 @@ pub struct Build<'a> {
     pub dirty: bool,
 }
 
+impl Build<'_> {
+    /// Whether a study may train with this binary: one built from a working tree with uncommitted
+    /// changes is refused ([`StudyError::Invalid`], one line) unless `allow_dirty`, so that a
+    /// study's runs come from code that is committed. A run it trains anyway says `dirty: true`
+    /// in its provenance.
+    pub fn allows_study(&self, allow_dirty: bool) -> crate::Result<()> {
+        if self.dirty && !allow_dirty {
+            return Err(crate::StudyError::invalid(format!(
+                "this seads binary was built from a working tree with uncommitted changes (on {}), \
+                 so a study's runs could not be traced to committed code: commit and rebuild, or \
+                 pass --allow-dirty",
+                self.commit
+            )));
+        }
+        Ok(())
+    }
+}
+
 /// One training process of a run.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct Provenance {
@@ -153,4 +171,25 @@ fn cpu() -> (Option<String>, Option<String>, bool) {
 #[cfg(not(any(target_arch = "x86", target_arch = "x86_64")))]
 fn cpu() -> (Option<String>, Option<String>, bool) {
     (None, None, false)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::Build;
+
+    #[test]
+    fn a_study_refuses_a_dirty_binary_unless_allowed() {
+        let build = |dirty| Build {
+            version: "0.1.0",
+            commit: "abc123",
+            dirty,
+        };
+        let refused = build(true).allows_study(false).unwrap_err();
+        assert!(refused.is_invalid());
+        let message = refused.to_string();
+        assert!(message.contains("uncommitted changes") && message.contains("--allow-dirty"));
+        assert!(!message.contains('\n'), "one line: {message}");
+        assert!(build(true).allows_study(true).is_ok());
+        assert!(build(false).allows_study(false).is_ok());
+    }
 }

@@ -87,6 +87,11 @@ pub struct RunArgs {
     /// a GPU device, SEADS members' SAC steps run there on stacked weights, all at once.
     #[arg(long, value_name = "K")]
     population: Option<u64>,
+    /// Train even though this binary was built from a working tree with uncommitted changes
+    /// (refused by default, so that a study's runs come from committed code; such runs say
+    /// `dirty: true` in their provenance and the report marks them).
+    #[arg(long, env = "SEADS_ALLOW_DIRTY")]
+    allow_dirty: bool,
     /// No progress bar.
     #[arg(long)]
     quiet: bool,
@@ -112,6 +117,10 @@ pub struct TaskArgs {
     /// for a population.
     #[arg(long, value_name = "SECONDS", default_value_t = state::PATIENCE.as_secs())]
     wait: u64,
+    /// Train even though this binary was built from a working tree with uncommitted changes
+    /// (refused by default; see `seads sweep run --allow-dirty`).
+    #[arg(long, env = "SEADS_ALLOW_DIRTY")]
+    allow_dirty: bool,
     /// Started by `seads sweep run`: die with the parent, and if another task holds the run,
     /// exit with status 3 (taken elsewhere) after two seconds.
     #[arg(long, hide = true)]
@@ -149,6 +158,10 @@ pub struct SlurmArgs {
     /// Submit the array and the report job with sbatch, and print their job ids.
     #[arg(long)]
     submit: bool,
+    /// Let the tasks train with a binary built from a working tree with uncommitted changes
+    /// (refused by default; see `seads sweep run --allow-dirty`).
+    #[arg(long, env = "SEADS_ALLOW_DIRTY")]
+    allow_dirty: bool,
 }
 
 /// Arguments of `seads sweep status`.
@@ -166,6 +179,9 @@ pub fn run(command: SweepCommand) -> Result<()> {
     match command {
         SweepCommand::Plan(args) => plan(args),
         SweepCommand::Run(args) => {
+            crate::build()
+                .allows_study(args.allow_dirty)
+                .map_err(crate::study_error)?;
             let cores = match args.cores {
                 Some(c) => at_least_one("--cores", c)?,
                 None => cores(),
@@ -191,6 +207,9 @@ pub fn run(command: SweepCommand) -> Result<()> {
             )
         }
         SweepCommand::Task(args) => {
+            crate::build()
+                .allows_study(args.allow_dirty)
+                .map_err(crate::study_error)?;
             // `seads sweep run` looked at the run an instant ago and found it free: if another
             // task holds it now, it took it meanwhile, and the child leaves it to that one.
             let patience = if args.child {
@@ -284,6 +303,7 @@ fn slurm(args: SlurmArgs) -> Result<()> {
         seads,
         device: args.device,
         populations,
+        allow_dirty: args.allow_dirty,
     };
     let (array, report) = slurm::write_scripts(&dir, &sweep, &options)?;
     outln!("wrote {} and {}", array.display(), report.display());

@@ -152,6 +152,8 @@ pub fn run_sweep(
                         .args(["--index", &list.join(",")])
                         .args(["--cores", &per_task.to_string(), "--child"])
                         .args(["--device", &device.to_string()])
+                        // The same binary, whose build `sweep run` has already checked.
+                        .arg("--allow-dirty")
                         .stdin(Stdio::null())
                         .stdout(log.try_clone()?)
                         .stderr(log)

@@ -6,12 +6,18 @@ use std::io::{BufRead, BufReader};
 use std::path::Path;
 use std::process::{Command, Output, Stdio};
 
+/// The `seads` binary of this build, as a command. Studies may train with it even when it was
+/// built from a working tree with uncommitted changes (`SEADS_ALLOW_DIRTY`), as a developer's
+/// test build usually is; `a_study_refuses_a_dirty_binary` runs without that.
+pub fn seads_command() -> Command {
+    let mut command = Command::new(env!("CARGO_BIN_EXE_seads"));
+    command.env("SEADS_ALLOW_DIRTY", "true");
+    command
+}
+
 /// Runs the `seads` binary of this build.
 pub fn seads(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_seads"))
-        .args(args)
-        .output()
-        .expect("run seads")
+    seads_command().args(args).output().expect("run seads")
 }
 
 /// Runs seads and asserts that it succeeded.
@@ -87,4 +93,19 @@ pub fn metrics_without_clock(run: &Path) -> Vec<serde_json::Value> {
             v
         })
         .collect()
+}
+
+/// Copies the directory `from` into `to` (created), files and folders alike: a test's own copy
+/// of a run that other tests use at the same time.
+pub fn copy_dir(from: &Path, to: &Path) {
+    std::fs::create_dir_all(to).expect("create the copy");
+    for entry in std::fs::read_dir(from).expect("read the directory") {
+        let entry = entry.expect("a directory entry");
+        let target = to.join(entry.file_name());
+        if entry.file_type().expect("a file type").is_dir() {
+            copy_dir(&entry.path(), &target);
+        } else {
+            std::fs::copy(entry.path(), &target).expect("copy a file");
+        }
+    }
 }

@@ -12,6 +12,7 @@ mod figures;
 mod runs;
 pub mod stats;
 mod tables;
+mod versions;
 mod walltime;
 
 use std::fmt::Write as _;
@@ -42,6 +43,9 @@ pub struct ReportOptions {
     /// config, metrics and evaluation files (never checkpoints), with each sweep's index and
     /// manifest; a report of the copy names the runs it lacks.
     pub copy_runs: bool,
+    /// The git repository whose commits count as known: the code-version table marks runs that
+    /// trained on a commit it lacks (`None`: not checked).
+    pub repository: Option<PathBuf>,
 }
 
 /// What a report holds, for the front end to tell.
@@ -99,6 +103,15 @@ pub fn write_report(options: &ReportOptions, out: &Path) -> Result<ReportSummary
     write("lengths.csv", &length_csv)?;
     let (walltime_md, walltime_csv) = walltime::walltime_tables(&groups);
     write("walltime.csv", &walltime_csv)?;
+    let known = |commit: &str| {
+        options
+            .repository
+            .as_deref()
+            .and_then(|repo| versions::has_commit(repo, commit))
+    };
+    let reported: Vec<&runs::RunData> = collection.runs.iter().collect();
+    let (versions_md, versions_csv) = versions::version_tables(&reported, &known);
+    write("versions.csv", &versions_csv)?;
     let failures = failures::failure_tables(&groups)?;
     if let Some((_, failures_csv, deviations_csv)) = &failures {
         write("failures.csv", failures_csv)?;
@@ -220,6 +233,9 @@ pub fn write_report(options: &ReportOptions, out: &Path) -> Result<ReportSummary
         md += failed_md;
         let _ = writeln!(md, "\nAs CSV: `failed-tasks.csv`.\n");
     }
+    let _ = writeln!(md, "## Code versions the runs trained on\n");
+    md += &versions_md;
+    let _ = writeln!(md, "\nAs CSV, per run: `versions.csv`.\n");
     let _ = writeln!(md, "## Where the training time went\n");
     md += &walltime_md;
     let _ = writeln!(md, "\nAs CSV, per run: `walltime.csv`.\n");

@@ -34,6 +34,9 @@ pub struct SlurmOptions {
     pub device: ComputeDevice,
     /// The runs as populations (`--population K`), one array task each; `None`: a task per run.
     pub populations: Option<Vec<Vec<usize>>>,
+    /// Whether the tasks may train with a binary built from a working tree with uncommitted
+    /// changes (`sweep task --allow-dirty`).
+    pub allow_dirty: bool,
 }
 
 /// A word for bash, single-quoted.
@@ -92,8 +95,13 @@ pub fn scripts(dir: &Path, sweep: &Sweep, options: &SlurmOptions) -> (String, St
          #SBATCH --output={logs}/task-%a.out\n\
          #SBATCH --requeue\n\
          {members}\
-         exec {seads} sweep task {dir} --index {index} --cores \"${{SLURM_CPUS_PER_TASK:-{cpus}}}\"{device}\n",
+         exec {seads} sweep task {dir} --index {index} --cores \"${{SLURM_CPUS_PER_TASK:-{cpus}}}\"{device}{dirty}\n",
         name = sweep.name,
+        dirty = if options.allow_dirty {
+            " --allow-dirty"
+        } else {
+            ""
+        },
         unit = if options.populations.is_some() {
             "population of runs"
         } else {
