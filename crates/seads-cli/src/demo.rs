@@ -33,14 +33,14 @@ pub struct RunArgs {
     /// Boards per solution depth (1–5) in the evaluation.
     #[arg(long, default_value_t = 20)]
     boards: usize,
-    /// Time limit per search, seconds (a board that needs a move no skill makes is searched
-    /// until then).
-    #[arg(long, default_value_t = 10.0, value_parser = seads_study::numbers::positive_finite)]
-    timeout: f64,
+    /// The search limits of the evaluation.
+    #[command(flatten)]
+    search: crate::plan::SearchArgs,
 }
 
 /// `seads run`.
 pub fn run(args: RunArgs) -> Result<()> {
+    crate::plan::check_boards(args.boards)?;
     let (mut run, _lock) = if args.out.join("config.toml").exists() {
         outln!("resuming the run in {}", args.out.display());
         let lock = crate::lock_run(&args.out)?;
@@ -61,8 +61,12 @@ pub fn run(args: RunArgs) -> Result<()> {
             config.env_steps,
             args.out.display()
         );
-        let run = Run::create(&args.out, config)?;
-        (run, crate::lock_run(&args.out)?)
+        let lock = crate::lock_new_run(&args.out)?;
+        let run = Run::create(&args.out, config).map_err(|e| match e {
+            seads_rl::RlError::Config(_) => anyhow::Error::from(BadInput(e.into())),
+            other => anyhow::Error::from(other),
+        })?;
+        (run, lock)
     };
     crate::train::drive(&mut run, false)?;
     drop(run);
@@ -73,7 +77,7 @@ pub fn run(args: RunArgs) -> Result<()> {
         args.boards
     );
     outln!(" depth   with re-planning   plan once   median steps (re-planning)");
-    let protocol = |replan| Protocol::planning(replan, args.boards, args.timeout);
+    let protocol = |replan| Protocol::planning(replan, args.boards, args.search.limits());
     let replan = run_evaluation(&mut agent, &args.out, &protocol(true), false)?.results;
     let once = run_evaluation(&mut agent, &args.out, &protocol(false), false)?.results;
     let (a, b) = (summarise(&replan), summarise(&once));
@@ -89,8 +93,14 @@ pub fn run(args: RunArgs) -> Result<()> {
         );
     }
     let figures = args.out.join("figures");
-    let written =
-        crate::plot::write_figures(&args.out, &figures, None, args.boards, args.timeout, true)?;
+    let written = crate::plot::write_figures(
+        &args.out,
+        &figures,
+        None,
+        args.boards,
+        args.search.limits(),
+        true,
+    )?;
     outln!("\nfigures ({}): {}", written.len(), figures.display());
     outln!(
         "next: seads solve --run {} --board \"…\" --replan   (see seads --help)",

@@ -70,6 +70,13 @@ pub fn record(args: RecordArgs) -> Result<()> {
             memory as f64 / f64::from(1u32 << 30)
         )));
     }
+    let policy_dir = std::path::Path::new(&args.policy);
+    let inputs: Vec<&std::path::Path> = if agent.is_some() {
+        vec![policy_dir]
+    } else {
+        Vec::new()
+    };
+    seads_study::paths::refuse_unsafe_output(&args.out, &inputs).map_err(crate::study_error)?;
     env.seed(args.seed);
     let mut rng = ChaCha8Rng::seed_from_u64(args.seed);
     // Written beside the output and renamed over it when complete: never a half-written file.
@@ -118,7 +125,7 @@ pub struct ReplayArgs {
 
 /// `seads replay`.
 pub fn replay(args: ReplayArgs) -> Result<()> {
-    seads_study::paths::refuse_overwriting_input(&args.out, &[&args.input])
+    seads_study::paths::refuse_unsafe_output(&args.out, &[&args.input])
         .map_err(crate::study_error)?;
     let mut env = build_env(&args.env, &EnvConfig::default())?;
     let m = env.spec().manipulator_dim;

@@ -106,6 +106,25 @@ pub fn build() -> seads_study::provenance::Build<'static> {
     }
 }
 
+/// The most threads or processes an option may ask of this machine: four per core. More would
+/// only time-share the cores, and a few hundred thousand exhaust the machine.
+pub fn max_threads() -> usize {
+    4 * std::thread::available_parallelism().map_or(1, |n| n.get())
+}
+
+/// `value` of `option` (threads, workers, cores), as bad input where it exceeds
+/// [`max_threads`].
+pub fn check_threads(option: &str, value: usize) -> anyhow::Result<()> {
+    let most = max_threads();
+    if value > most {
+        return Err(BadInput(anyhow::anyhow!(
+            "{option} {value} is more than this machine can run: at most {most} (four per core)"
+        ))
+        .into());
+    }
+    Ok(())
+}
+
 /// A progress bar of `len` steps drawn with `template` (indicatif's), hidden when `quiet`.
 pub fn progress_bar(len: u64, quiet: bool, template: &str) -> indicatif::ProgressBar {
     if quiet {
@@ -143,17 +162,38 @@ pub fn lock_run(dir: &std::path::Path) -> anyhow::Result<seads_rl::store::RunLoc
     use anyhow::Context as _;
     // Only a run directory is locked: anything else is said as such.
     seads_rl::load_config(dir).with_context(|| format!("loading run {}", dir.display()))?;
-    let mut command: String = std::env::args()
-        .map(|a| a.rsplit('/').next().unwrap_or_default().to_owned())
+    acquire(dir, std::time::Duration::from_secs(2))
+}
+
+/// Takes the directory of a new run for this command (creating it) before anything is written
+/// into it: of two commands that start the same new run, one trains and the other is told, in one
+/// line, that the directory is in use.
+pub fn lock_new_run(dir: &std::path::Path) -> anyhow::Result<seads_rl::store::RunLock> {
+    use anyhow::Context as _;
+    std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
+    acquire(dir, std::time::Duration::ZERO)
+}
+
+/// The lock of `dir`, naming this command as its holder; another holder is bad input.
+fn acquire(
+    dir: &std::path::Path,
+    patience: std::time::Duration,
+) -> anyhow::Result<seads_rl::store::RunLock> {
+    // Any argument, UTF-8 or not, as the lock's note of who holds it: at most 200 characters.
+    let command: String = std::env::args_os()
+        .map(|a| {
+            let a = a.to_string_lossy();
+            a.rsplit('/').next().unwrap_or_default().to_owned()
+        })
         .collect::<Vec<_>>()
-        .join(" ");
-    command.truncate(200);
-    seads_rl::store::RunLock::acquire(dir, &command, std::time::Duration::from_secs(2)).map_err(
-        |e| match e {
-            seads_rl::RlError::Busy { .. } => BadInput(e.into()).into(),
-            other => anyhow::Error::from(other),
-        },
-    )
+        .join(" ")
+        .chars()
+        .take(200)
+        .collect();
+    seads_rl::store::RunLock::acquire(dir, &command, patience).map_err(|e| match e {
+        seads_rl::RlError::Busy { .. } => BadInput(e.into()).into(),
+        other => anyhow::Error::from(other),
+    })
 }
 
 /// Ends the process on a command line that clap refused: `--help` and `--version` print as

@@ -32,13 +32,14 @@ pub struct PlotArgs {
     /// Boards per depth when an evaluation must be run first (saved evaluations are reused).
     #[arg(long, default_value_t = 20)]
     boards: usize,
-    /// Time limit per search in such an evaluation, seconds.
-    #[arg(long, default_value_t = 60.0, value_parser = seads_study::numbers::positive_finite)]
-    timeout: f64,
+    /// The search limits of such an evaluation.
+    #[command(flatten)]
+    search: crate::plan::SearchArgs,
 }
 
 /// `seads plot`: writes every figure of the run into `out`; returns the files written.
 pub fn plot(args: PlotArgs) -> Result<()> {
+    crate::plan::check_boards(args.boards)?;
     // Plotting may evaluate the run and save that evaluation into it.
     seads_rl::load_config(&args.run)
         .with_context(|| format!("loading run {}", args.run.display()))?;
@@ -48,7 +49,7 @@ pub fn plot(args: PlotArgs) -> Result<()> {
         &args.out,
         args.checkpoint,
         args.boards,
-        args.timeout,
+        args.search.limits(),
         false,
     )?;
     for path in written {
@@ -63,7 +64,7 @@ pub fn write_figures(
     out: &Path,
     checkpoint: Option<u64>,
     boards: usize,
-    timeout: f64,
+    limits: seads_planner::SearchLimits,
     quiet: bool,
 ) -> Result<Vec<PathBuf>> {
     std::fs::create_dir_all(out).with_context(|| format!("creating {}", out.display()))?;
@@ -113,7 +114,7 @@ pub fn write_figures(
     let k = seads_embodiment::SkillPolicy::num_skills(&agent.policy);
     both("coverage", &|p| coverage_figure(p, &metrics, k, &title))?;
     if agent.model.is_some() {
-        let evaluations = evaluations(&mut agent, run, boards, timeout, quiet)?;
+        let evaluations = evaluations(&mut agent, run, boards, limits, quiet)?;
         both("success", &|p| success_figure(p, &evaluations, &title))?;
     } else if !quiet {
         eprintln!(
@@ -140,7 +141,7 @@ fn evaluations(
     agent: &mut Agent,
     run: &Path,
     boards: usize,
-    timeout: f64,
+    limits: seads_planner::SearchLimits,
     quiet: bool,
 ) -> Result<[(bool, Vec<DepthResult>); 2]> {
     let mut load = |replan: bool| -> Result<Vec<DepthResult>> {
@@ -152,7 +153,7 @@ fn evaluations(
         {
             return Ok(record.results);
         }
-        let protocol = Protocol::planning(replan, boards, timeout);
+        let protocol = Protocol::planning(replan, boards, limits);
         Ok(run_evaluation(agent, run, &protocol, quiet)?.results)
     };
     Ok([(true, load(true)?), (false, load(false)?)])

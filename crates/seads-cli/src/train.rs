@@ -137,11 +137,12 @@ fn create<L: Learner>(
     out: &std::path::Path,
     config: TrainConfig,
 ) -> Result<(Run<L>, seads_rl::store::RunLock)> {
+    // The lock first: nothing is written into a directory another command holds.
+    let lock = crate::lock_new_run(out)?;
     let run = Run::create(out, config).map_err(|e| match e {
         seads_rl::RlError::Config(_) => anyhow::Error::from(BadInput(e.into())),
         other => anyhow::Error::from(other),
     })?;
-    let lock = crate::lock_run(out)?;
     Ok((run, lock))
 }
 

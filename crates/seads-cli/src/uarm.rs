@@ -160,9 +160,9 @@ pub struct UarmTrainArgs {
     /// Test boards per solution depth 1–5 in the final evaluation (1 to 200000).
     #[arg(long, value_parser = clap::builder::RangedU64ValueParser::<usize>::new().range(1..=200_000), default_value_t = 20)]
     boards: usize,
-    /// Time limit per search in the final evaluation, seconds.
-    #[arg(long, default_value_t = 60.0, value_parser = seads_study::numbers::positive_finite)]
-    timeout: f64,
+    /// The search limits of the evaluation.
+    #[command(flatten)]
+    search: crate::plan::SearchArgs,
     /// Continue the run in --out from its last checkpoint.
     #[arg(long)]
     resume: bool,
@@ -283,9 +283,10 @@ pub fn train(mut args: UarmTrainArgs) -> Result<()> {
         let run = crate::train::resume(&args.out, Run::resume_with(&args.out, trainer))?;
         (run, lock)
     } else {
-        let run = Run::with_trainer(&args.out, trainer(robot_config(&env, &args)?)?)
-            .map_err(|e| BadInput(e.into()))?;
-        let lock = crate::lock_run(&args.out)?;
+        let config = robot_config(&env, &args)?;
+        // The lock first: nothing is written into a directory another command holds.
+        let lock = crate::lock_new_run(&args.out)?;
+        let run = Run::with_trainer(&args.out, trainer(config)?).map_err(|e| BadInput(e.into()))?;
         RobotSettings {
             action_space: args.action_space,
             reset_board: args.reset_board,
@@ -301,7 +302,7 @@ pub fn train(mut args: UarmTrainArgs) -> Result<()> {
         env,
         twin.is_some(),
         args.boards,
-        args.timeout,
+        args.search.limits(),
         args.quiet,
     )
 }
@@ -337,9 +338,9 @@ pub struct UarmEvaluateArgs {
     /// Test boards per solution depth 1–5 (1 to 200000).
     #[arg(long, value_parser = clap::builder::RangedU64ValueParser::<usize>::new().range(1..=200_000), default_value_t = 20)]
     boards: usize,
-    /// Time limit per search, seconds.
-    #[arg(long, default_value_t = 60.0, value_parser = seads_study::numbers::positive_finite)]
-    timeout: f64,
+    /// The search limits of the evaluation.
+    #[command(flatten)]
+    search: crate::plan::SearchArgs,
     /// No progress bar.
     #[arg(long)]
     quiet: bool,
@@ -373,7 +374,7 @@ pub fn evaluate_run(args: UarmEvaluateArgs) -> Result<()> {
         env,
         twin.is_some(),
         args.boards,
-        args.timeout,
+        args.search.limits(),
         args.quiet,
     )
 }
@@ -389,21 +390,16 @@ fn evaluate(
     env: UarmEnv,
     settable: bool,
     boards: usize,
-    timeout: f64,
+    limits: seads_planner::SearchLimits,
     quiet: bool,
 ) -> Result<()> {
     let checkpoint = find_checkpoint(run, epoch).map_err(|e| BadInput(e.into()))?;
     let bar = crate::progress_bar(5 * boards as u64, quiet, "{wide_bar} {pos}/{len}");
-    let record = seads_study::robot::evaluate_robot(
-        run,
-        &checkpoint,
-        env,
-        settable,
-        boards,
-        timeout,
-        || bar.inc(1),
-    )
-    .map_err(crate::study_error)?;
+    let record =
+        seads_study::robot::evaluate_robot(run, &checkpoint, env, settable, boards, limits, || {
+            bar.inc(1)
+        })
+        .map_err(crate::study_error)?;
     bar.finish_and_clear();
     let results = record.results;
     let (solved, tasks) = results

@@ -1538,3 +1538,255 @@ fn an_evaluation_under_action_noise_has_files_of_its_own_and_repeats() {
         assert_eq!(out.status.code(), Some(2), "{bad}");
     }
 }
+
+/// Outputs are written only as regular files: `record --out` refuses a FIFO, a symbolic link and a
+/// file inside the run it records, leaving each as it was (exit 2, one line); a run directory
+/// named with 100 `é` or with bytes that are not UTF-8 is evaluated like any other.
+#[test]
+fn outputs_replace_only_regular_files_and_any_run_name_works() {
+    let dir = tempfile::tempdir().unwrap();
+    let run = dir.path().join("run");
+    copy_dir(&tiny_run().join("run"), &run);
+    let fifo = dir.path().join("fifo");
+    let made = std::process::Command::new("mkfifo")
+        .arg(&fifo)
+        .status()
+        .unwrap();
+    assert!(made.success());
+    let target = dir.path().join("target.jsonl");
+    let link = dir.path().join("link.jsonl");
+    std::os::unix::fs::symlink(&target, &link).unwrap();
+    let record = |out: &std::path::Path, policy: &str, why: &str| {
+        check_bad_input(
+            &[
+                "record",
+                "--env",
+                "lightsout-cursor",
+                "--policy",
+                policy,
+                "--episodes",
+                "1",
+                "--steps",
+                "2",
+                "--out",
+                s(out),
+            ],
+            why,
+        );
+    };
+    record(&fifo, "random", "a special file");
+    record(&link, "random", "a symbolic link");
+    let config = run.join("config.toml");
+    let before = std::fs::read(&config).unwrap();
+    record(&config, s(&run), "inside");
+    use std::os::unix::fs::FileTypeExt as _;
+    assert!(
+        std::fs::symlink_metadata(&fifo)
+            .unwrap()
+            .file_type()
+            .is_fifo()
+    );
+    assert!(
+        std::fs::symlink_metadata(&link)
+            .unwrap()
+            .file_type()
+            .is_symlink()
+    );
+    assert!(!target.exists(), "nothing written through the link");
+    assert_eq!(std::fs::read(&config).unwrap(), before);
+    let accented = dir.path().join("é".repeat(100));
+    let raw = dir
+        .path()
+        .join(<std::ffi::OsStr as std::os::unix::ffi::OsStrExt>::from_bytes(b"run-\xff\xfe"));
+    for name in [accented, raw] {
+        copy_dir(&run, &name);
+        let out = seads_command()
+            .args([
+                "evaluate", "--depths", "1", "--boards", "1", "--quiet", "--run",
+            ])
+            .arg(&name)
+            .output()
+            .unwrap();
+        assert!(
+            out.status.success(),
+            "{}: {}",
+            name.display(),
+            String::from_utf8_lossy(&out.stderr)
+        );
+    }
+}
+
+/// A budget or seed beyond a TOML integer (2⁶³ and up) is refused before anything is written: a
+/// finished run keeps its readable config (and still evaluates), a new run is not created.
+#[test]
+fn budgets_and_seeds_beyond_a_toml_integer_are_refused_before_writing() {
+    let dir = tempfile::tempdir().unwrap();
+    let run = dir.path().join("run");
+    copy_dir(&tiny_run().join("run"), &run);
+    let config = std::fs::read(run.join("config.toml")).unwrap();
+    let huge = "9223372036854775808";
+    check_bad_input(
+        &["train", "--resume", s(&run), "--env-steps", huge],
+        "a TOML integer",
+    );
+    assert_eq!(std::fs::read(run.join("config.toml")).unwrap(), config);
+    seads_ok(&[
+        "evaluate",
+        "--run",
+        s(&run),
+        "--depths",
+        "1",
+        "--boards",
+        "1",
+        "--quiet",
+    ]);
+    let out = dir.path().join("new");
+    for option in ["--seed", "--env-steps"] {
+        check_bad_input(
+            &[
+                "train",
+                "--env",
+                "lightsout-cursor",
+                "--out",
+                s(&out),
+                option,
+                huge,
+            ],
+            "a TOML integer",
+        );
+        assert!(!out.exists(), "{option}: nothing written");
+    }
+}
+
+/// An evaluation with no board, or with more tasks than one evaluation may have, is refused
+/// before anything is trained or written, by `run` and `plot` as by `evaluate`.
+#[test]
+fn evaluations_of_no_board_or_too_many_are_refused_up_front() {
+    let dir = tempfile::tempdir().unwrap();
+    let run = dir.path().join("run");
+    copy_dir(&tiny_run().join("run"), &run);
+    let before: Vec<_> = std::fs::read_dir(&run).unwrap().collect();
+    let figures = dir.path().join("figures");
+    check_bad_input(
+        &[
+            "plot",
+            "--run",
+            s(&run),
+            "--out",
+            s(&figures),
+            "--boards",
+            "0",
+        ],
+        "at least 1 board",
+    );
+    assert!(!figures.exists());
+    assert_eq!(std::fs::read_dir(&run).unwrap().count(), before.len());
+    let demo = dir.path().join("demo");
+    for (boards, why) in [("0", "at least 1 board"), ("2000000", "more than the")] {
+        check_bad_input(
+            &[
+                "run",
+                "--out",
+                s(&demo),
+                "--boards",
+                boards,
+                "--env-steps",
+                "100",
+            ],
+            why,
+        );
+        assert!(!demo.exists(), "--boards {boards}: nothing written");
+    }
+}
+
+/// Two `train` processes started together on one new directory, with seeds 1 and 2: exactly one
+/// trains and the other exits 2 in one line without writing, so the run's config is the winner's
+/// (three tries). A directory that holds a run's metrics and checkpoints but no config.toml is
+/// never trained over.
+#[test]
+fn one_writer_wins_a_new_run_and_a_damaged_run_is_not_trained_over() {
+    let dir = tempfile::tempdir().unwrap();
+    let config = tiny_config(dir.path());
+    for attempt in 0..3 {
+        let out = dir.path().join(format!("race-{attempt}"));
+        let children: Vec<_> = ["1", "2"]
+            .map(|seed| {
+                let child = seads_command()
+                    .args([
+                        "train",
+                        "--config",
+                        s(&config),
+                        "--out",
+                        s(&out),
+                        "--seed",
+                        seed,
+                    ])
+                    .arg("--quiet")
+                    .stdout(std::process::Stdio::null())
+                    .stderr(std::process::Stdio::piped())
+                    .spawn()
+                    .unwrap();
+                (seed, child)
+            })
+            .into_iter()
+            .collect();
+        let ended: Vec<_> = children
+            .into_iter()
+            .map(|(seed, child)| (seed, child.wait_with_output().unwrap()))
+            .collect();
+        let winners: Vec<&str> = ended
+            .iter()
+            .filter(|(_, o)| o.status.success())
+            .map(|(seed, _)| *seed)
+            .collect();
+        assert_eq!(winners.len(), 1, "attempt {attempt}: {ended:?}");
+        let (_, loser) = ended.iter().find(|(_, o)| !o.status.success()).unwrap();
+        let stderr = String::from_utf8_lossy(&loser.stderr);
+        assert_eq!(loser.status.code(), Some(2), "{stderr}");
+        assert_eq!(stderr.lines().count(), 1, "{stderr}");
+        assert!(
+            stderr.contains("in use") || stderr.contains("already holds a run"),
+            "{stderr}"
+        );
+        let written = std::fs::read_to_string(out.join("config.toml")).unwrap();
+        assert!(
+            written.contains(&format!("\nseed = {}\n", winners[0])),
+            "attempt {attempt}: the config is the winner's (seed {})",
+            winners[0]
+        );
+        let provenance = std::fs::read_to_string(out.join("provenance.jsonl")).unwrap();
+        assert_eq!(provenance.lines().count(), 1, "one process trained it");
+    }
+    let damaged = dir.path().join("damaged");
+    copy_dir(&tiny_run().join("run"), &damaged);
+    std::fs::remove_file(damaged.join("config.toml")).unwrap();
+    let metrics = std::fs::read(damaged.join("metrics.jsonl")).unwrap();
+    check_bad_input(
+        &["train", "--config", s(&config), "--out", s(&damaged)],
+        "no config.toml",
+    );
+    assert_eq!(
+        std::fs::read(damaged.join("metrics.jsonl")).unwrap(),
+        metrics
+    );
+    assert!(!damaged.join("config.toml").exists());
+}
+
+/// A run named three times (twice, and through `./`) is one run of the report; a file given as a
+/// run is said to be a file.
+#[test]
+fn a_run_given_twice_is_reported_once() {
+    let dir = tempfile::tempdir().unwrap();
+    let base = dir.path().join("base");
+    copy_dir(&tiny_run().join("run"), &base);
+    let again = dir.path().join(".").join("base");
+    let report = dir.path().join("report");
+    seads_ok(&["report", s(&base), s(&base), s(&again), "--out", s(&report)]);
+    let md = std::fs::read_to_string(report.join("report.md")).unwrap();
+    assert!(md.contains("from 1 run(s): 1 finished"), "{md}");
+    let file = base.join("config.toml");
+    check_bad_input(
+        &["report", s(&file), "--out", s(&dir.path().join("r2"))],
+        "is a file",
+    );
+}

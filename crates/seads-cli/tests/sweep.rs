@@ -319,10 +319,16 @@ fn a_sweep_is_planned_once_run_to_the_end_and_reported() {
         md.contains("2 task(s) ended at the search time limit"),
         "{md}"
     );
-    // A run outside a sweep can join the report as its own variant.
-    seads_ok(&["report", s(&sweep), s(&run), "--out", s(&report)]);
+    // A run outside a sweep can join the report as its own variant (a copy: the sweep's own run,
+    // named again, is the same run and counted once).
+    let outside = tmp.path().join("outside/seed-1");
+    copy_dir(&run, &outside);
+    seads_ok(&["report", s(&sweep), s(&outside), "--out", s(&report)]);
     let md = std::fs::read_to_string(report.join("report.md")).unwrap();
     assert!(md.contains("| seed-1 |"), "{md}");
+    seads_ok(&["report", s(&sweep), s(&run), "--out", s(&report)]);
+    let md = std::fs::read_to_string(report.join("report.md")).unwrap();
+    assert!(!md.contains("| seed-1 |") && md.contains("from 4 run(s)"), "{md}");
 
     // Runs of one row must be one environment: the same variant name on two board sizes is an error.
     let other = tmp.path().join("other/seed-1");
@@ -922,4 +928,69 @@ fn a_study_refuses_a_dirty_binary() {
         );
     }
     assert_eq!(snapshot(&out), planned, "nothing trained or written");
+}
+
+/// Threads and workers beyond what the machine can run (four per core) are one line of bad input,
+/// before a thread is spawned or anything written: never a panic or a machine that hangs.
+#[test]
+fn thread_counts_beyond_the_machine_are_refused() {
+    let tmp = tempfile::tempdir().unwrap();
+    let manifest = write_manifest(tmp.path(), MANIFEST);
+    let out = tmp.path().join("sweep");
+    seads_ok(&["sweep", "plan", s(&manifest), "--out", s(&out)]);
+    let planned = snapshot(&out);
+    let huge = ["100000", "18446744073709551615"];
+    for n in huge {
+        check_bad_input(
+            &["sweep", "run", s(&out), "--workers", n],
+            "more than this machine can run",
+        );
+        check_bad_input(
+            &["sweep", "run", s(&out), "--cores", n],
+            "more than this machine can run",
+        );
+        check_bad_input(
+            &["sweep", "task", s(&out), "--index", "0", "--cores", n],
+            "more than this machine can run",
+        );
+    }
+    check_bad_input(
+        &["plan-bench", "--depths", "1", "--threads", "1000000"],
+        "more than this machine can run",
+    );
+    assert_eq!(snapshot(&out), planned, "nothing trained or written");
+}
+
+/// A Slurm script cannot be made to run another command: a `--time` or `--partition` with a
+/// newline, a quote or `%`, or a sweep directory whose path holds `%` (Slurm expands it in
+/// `--output`), is one line of bad input and no script is written.
+#[test]
+fn slurm_scripts_refuse_values_that_would_change_them() {
+    let tmp = tempfile::tempdir().unwrap();
+    let manifest = write_manifest(tmp.path(), MANIFEST);
+    let out = tmp.path().join("sweep");
+    seads_ok(&["sweep", "plan", s(&manifest), "--out", s(&out)]);
+    for (option, value) in [
+        ("--time", "01:00:00\necho INJECTED"),
+        ("--time", "1%a"),
+        ("--partition", "p\n#SBATCH --wrap=x"),
+        ("--partition", "a b"),
+    ] {
+        check_bad_input(&["sweep", "slurm", s(&out), option, value], option);
+        assert!(
+            !out.join("slurm").join("array.sbatch").exists(),
+            "{value:?}"
+        );
+    }
+    let odd = tmp.path().join("space%a");
+    seads_ok(&["sweep", "plan", s(&manifest), "--out", s(&odd)]);
+    check_bad_input(
+        &["sweep", "slurm", s(&odd)],
+        "holds a newline, a quote or %",
+    );
+    // An ordinary call writes both scripts, the log path quoted.
+    seads_ok(&["sweep", "slurm", s(&out), "--time", "01:00:00"]);
+    let array = std::fs::read_to_string(out.join("slurm").join("array.sbatch")).unwrap();
+    assert!(array.contains("#SBATCH --time=01:00:00\n"), "{array}");
+    assert!(array.contains("--output=\""), "{array}");
 }

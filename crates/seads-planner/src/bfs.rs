@@ -8,8 +8,30 @@ use rustc_hash::FxHashSet;
 use seads_games::{Successor, SymbolicState};
 use serde::{Deserialize, Serialize};
 
+/// Which of the shortest plans a search returns.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum PlanChoice {
+    /// The plan the forward model is surest of: among the plans that reach the goal in the batch
+    /// where the goal was first generated, each step's skill the likeliest of those the model
+    /// predicts to make that step, and of these plans the one with the highest product of the
+    /// steps' probabilities. During re-planning, a skill that left another board than predicted
+    /// is not chosen again from that board in the same task while another plan is left.
+    #[default]
+    MostLikely,
+    /// The first plan found, in fringe-then-skill order (the reference's search).
+    FirstFound,
+}
+
+impl PlanChoice {
+    /// The choice that evaluation records without one were made with.
+    pub fn paper() -> Self {
+        Self::FirstFound
+    }
+}
+
 /// Limits of one search. `Default` = the reference's 20 layers, a 4 GiB memory bound, no time
-/// limit (the authors' evaluation used 60 s per search).
+/// limit (the authors' evaluation used 60 s per search), the most likely plan.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields, default)]
 pub struct PlannerConfig {
@@ -25,6 +47,8 @@ pub struct PlannerConfig {
     pub max_expanded: Option<usize>,
     /// States expanded per call of the successor function.
     pub batch_size: usize,
+    /// Which plan to return.
+    pub plan: PlanChoice,
 }
 
 impl Default for PlannerConfig {
@@ -35,6 +59,7 @@ impl Default for PlannerConfig {
             timeout_s: None,
             max_expanded: None,
             batch_size: 1024,
+            plan: PlanChoice::MostLikely,
         }
     }
 }
@@ -50,6 +75,10 @@ pub struct Plan {
     pub expanded: usize,
     /// Distinct states discovered.
     pub discovered: usize,
+    /// The model's log-probability of the plan's predicted states (the sum of its steps'
+    /// log q(z_{t+1} | z_t, k_t)), where the plan was chosen by it ([`PlanChoice::MostLikely`]
+    /// and a model with probabilities).
+    pub log_likelihood: Option<f32>,
 }
 
 /// Why a search found no plan.
@@ -309,7 +338,19 @@ fn search<K: Key>(
                     let row = (parent - group.start) * k;
                     for skill in 0..k {
                         if found == Some(row + skill) {
-                            return Ok(trace(&nodes, parent, skill, goal, expanded, nodes.len()));
+                            let first = trace(&nodes, parent, skill, goal, expanded, nodes.len());
+                            if config.plan == PlanChoice::FirstFound {
+                                return Ok(first);
+                            }
+                            // Every way to the goal from this chunk, in search order.
+                            let hits = chunk.clone().flat_map(|p| (0..k).map(move |s| (p, s)));
+                            let candidates: Vec<Plan> = hits
+                                .filter(|&(p, s)| out[(p - group.start) * k + s] == goal)
+                                .take(MAX_CANDIDATES)
+                                .map(|(p, s)| trace(&nodes, p, s, goal, expanded, nodes.len()))
+                                .collect();
+                            let start = nodes[0].state;
+                            return Ok(most_likely(successor, start, candidates).unwrap_or(first));
                         }
                         if new[row + skill] {
                             nodes.push(Node {
@@ -369,5 +410,63 @@ fn trace(
         predicted,
         expanded,
         discovered,
+        log_likelihood: None,
     }
+}
+
+/// Plans weighed against each other per goal: at most this many of a chunk's.
+const MAX_CANDIDATES: usize = 64;
+
+/// Of `candidates` (plans from `start`, in search order), the one the model is surest of, each
+/// step's skill the likeliest of the skills whose predicted successor is that step's state; the
+/// earliest of equals. `None` where the model has no probabilities or there is no candidate.
+fn most_likely(
+    successor: &mut dyn Successor,
+    start: SymbolicState,
+    candidates: Vec<Plan>,
+) -> Option<Plan> {
+    let k = successor.num_skills();
+    // Each step as (from, to), every candidate's in turn.
+    let steps: Vec<(SymbolicState, SymbolicState)> = candidates
+        .iter()
+        .flat_map(|plan| {
+            std::iter::once(start)
+                .chain(plan.predicted.iter().copied())
+                .zip(plan.predicted.iter().copied())
+        })
+        .collect();
+    let log_q = successor.log_likelihoods(&steps)?;
+    let from: Vec<SymbolicState> = steps.iter().map(|&(z, _)| z).collect();
+    let mut next = Vec::with_capacity(from.len() * k);
+    successor.successors(&from, &mut next);
+    let mut best: Option<Plan> = None;
+    let mut offset = 0;
+    for mut plan in candidates {
+        let mut total = 0.0f32;
+        for (t, skill) in plan.skills.iter_mut().enumerate() {
+            let (i, to) = (offset + t, steps[offset + t].1);
+            // The likeliest skill that the model predicts to make this step (the planned one
+            // does, so there is one); the lowest of equals.
+            let (chosen, ll) = (0..k)
+                .filter(|&s| next[i * k + s] == to)
+                .map(|s| (s, log_q[i * k + s]))
+                // A NaN (a broken model) never wins.
+                .map(|(s, ll)| (s, if ll.is_nan() { f32::NEG_INFINITY } else { ll }))
+                .fold(None, |acc: Option<(usize, f32)>, (s, ll)| match acc {
+                    Some((_, b)) if b >= ll => acc,
+                    _ => Some((s, ll)),
+                })?;
+            *skill = chosen;
+            total += ll;
+        }
+        offset += plan.skills.len();
+        plan.log_likelihood = Some(total);
+        if best
+            .as_ref()
+            .is_none_or(|b| b.log_likelihood.is_some_and(|b| total > b))
+        {
+            best = Some(plan);
+        }
+    }
+    best
 }

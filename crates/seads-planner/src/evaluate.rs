@@ -303,8 +303,9 @@ mod tests {
                 kind: EvaluationKind::Replan,
                 tasks: TaskSet::standard(20),
                 limits: Some(SearchLimits {
-                    timeout_s: 10.0,
+                    timeout_s: Some(10.0),
                     max_expanded: None,
+                    plan: crate::PlanChoice::FirstFound,
                 }),
                 action_noise: None,
             }),

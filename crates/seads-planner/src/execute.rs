@@ -7,7 +7,7 @@ use seads_embodiment::{EnvError, Environment, SkillPolicy, SkillRun, execute_ski
 use seads_games::{Successor, SymbolicState};
 use serde::{Deserialize, Serialize};
 
-use crate::{PlanError, PlannerConfig, bfs_plan};
+use crate::{PlanChoice, PlanError, PlannerConfig, bfs_plan};
 
 /// How a task is solved. `Default` = with re-planning, at most 10 plans (the reference).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -159,6 +159,9 @@ pub fn solve(
     }
 }
 
+/// Plans from `start`. With [`PlanChoice::MostLikely`], the skills that deviated in this task
+/// (`outcome.deviations`) are not taken again from the board they deviated from, unless no plan
+/// is left without them.
 fn search(
     start: SymbolicState,
     successor: &mut dyn Successor,
@@ -168,10 +171,68 @@ fn search(
 ) -> Result<crate::Plan, PlanError> {
     let began = Instant::now();
     outcome.plans += 1;
-    let plan = bfs_plan(successor, start, goal, &config.planner);
+    let failed: Vec<(SymbolicState, usize)> = match config.planner.plan {
+        PlanChoice::MostLikely => outcome
+            .deviations
+            .iter()
+            .map(|d| (d.before, d.skill))
+            .collect(),
+        PlanChoice::FirstFound => Vec::new(),
+    };
+    let mut plan = if failed.is_empty() {
+        bfs_plan(successor, start, goal, &config.planner)
+    } else {
+        let mut avoiding = Avoiding {
+            inner: successor,
+            failed: &failed,
+        };
+        bfs_plan(&mut avoiding, start, goal, &config.planner)
+    };
+    if plan.is_err() && !failed.is_empty() {
+        outcome.timed_out |= matches!(plan, Err(PlanError::Timeout { .. }));
+        plan = bfs_plan(successor, start, goal, &config.planner);
+    }
     outcome.planning_s += began.elapsed().as_secs_f64();
     outcome.timed_out |= matches!(plan, Err(PlanError::Timeout { .. }));
     plan
+}
+
+/// A successor function in which the skills that failed from a board lead nowhere from it (back
+/// to the board itself, which the search has seen), so that a search takes them only from other
+/// boards.
+struct Avoiding<'a> {
+    inner: &'a mut dyn Successor,
+    failed: &'a [(SymbolicState, usize)],
+}
+
+impl Successor for Avoiding<'_> {
+    fn num_skills(&self) -> usize {
+        self.inner.num_skills()
+    }
+
+    fn symbolic_len(&self) -> usize {
+        self.inner.symbolic_len()
+    }
+
+    fn successors(&mut self, states: &[SymbolicState], out: &mut Vec<SymbolicState>) {
+        let (base, k) = (out.len(), self.inner.num_skills());
+        self.inner.successors(states, out);
+        for (i, &z) in states.iter().enumerate() {
+            for &(board, skill) in self.failed {
+                if board == z && skill < k {
+                    out[base + i * k + skill] = z;
+                }
+            }
+        }
+    }
+
+    fn preferred_batch(&self) -> usize {
+        self.inner.preferred_batch()
+    }
+
+    fn log_likelihoods(&mut self, pairs: &[(SymbolicState, SymbolicState)]) -> Option<Vec<f32>> {
+        self.inner.log_likelihoods(pairs)
+    }
 }
 
 /// Executes `skill`, recording a deviation when the board it leaves is not `predicted`.

@@ -32,13 +32,13 @@ mod evaluate;
 mod execute;
 mod protocol;
 
-pub use bfs::{Plan, PlanError, PlannerConfig, bfs_plan};
+pub use bfs::{Plan, PlanChoice, PlanError, PlannerConfig, bfs_plan};
 pub use evaluate::{
     CheckpointId, DepthResult, Evaluation, EvaluationRecord, EvaluationSummary, TaskRecord,
     evaluate, summarise,
 };
 pub use execute::{Deviation, SolveConfig, SolveOutcome, solve};
 pub use protocol::{
-    EVALUATION_SEEDS, EvaluationKind, Protocol, STANDARD_DEPTHS, SearchLimits, TASK_STREAM_SEED,
-    TaskSet,
+    DEFAULT_MAX_EXPANDED, EVALUATION_SEEDS, EvaluationKind, Protocol, STANDARD_DEPTHS,
+    SearchLimits, TASK_STREAM_SEED, TaskSet,
 };

@@ -24,6 +24,8 @@ use rand::{RngExt, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use seads_embodiment::{BoardState, EnvConfig, EnvError};
 use seads_games::{GameKind, Split, SymbolicState};
+
+use crate::PlanChoice;
 use serde::{Deserialize, Serialize};
 
 /// The 20 environment seeds of the authors' evaluation jobs (the first 20 draws of
@@ -135,15 +137,59 @@ impl TaskSet {
     }
 }
 
-/// The limits of each search of an evaluation.
+/// States a search may expand by default: 2²² = 4,194,304. A learned model as good as the true
+/// rules finds every 5×5 LightsOut board of depth ≤ 10 within it (3,850,756 boards lie at depth
+/// ≤ 9), and a search stopped by it stops at the same state on every machine, loaded or not.
+pub const DEFAULT_MAX_EXPANDED: usize = 1 << 22;
+
+/// The limits of each search of an evaluation, and which plan it returns. By default a search is bounded by expanded
+/// states only ([`DEFAULT_MAX_EXPANDED`]), so that an evaluation's outcome never depends on the
+/// machine's speed or load; a wall-clock limit is an option.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct SearchLimits {
-    /// Seconds per search.
-    pub timeout_s: f64,
+    /// Seconds per search (`None`: no clock). A clock makes results depend on the machine.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub timeout_s: Option<f64>,
     /// States expanded per search (`None`: no bound).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub max_expanded: Option<usize>,
+    /// Which plan a search returns (records from before the choice: the first found).
+    #[serde(default = "PlanChoice::paper")]
+    pub plan: PlanChoice,
+}
+
+impl Default for SearchLimits {
+    fn default() -> Self {
+        Self {
+            timeout_s: None,
+            max_expanded: Some(DEFAULT_MAX_EXPANDED),
+            plan: PlanChoice::MostLikely,
+        }
+    }
+}
+
+impl SearchLimits {
+    /// The planner's configuration for one search under these limits (the planner's other
+    /// settings at their defaults).
+    pub fn planner(&self) -> crate::PlannerConfig {
+        crate::PlannerConfig {
+            timeout_s: self.timeout_s,
+            max_expanded: self.max_expanded,
+            plan: self.plan,
+            ..crate::PlannerConfig::default()
+        }
+    }
+
+    /// The limits in words: "4194304 expanded states", "60 s", "60 s or 20000 expanded states".
+    pub fn describe(&self) -> String {
+        match (self.timeout_s, self.max_expanded) {
+            (Some(t), Some(m)) => format!("{t} s or {m} expanded states"),
+            (Some(t), None) => format!("{t} s"),
+            (None, Some(m)) => format!("{m} expanded states"),
+            (None, None) => "no limit".to_owned(),
+        }
+    }
 }
 
 /// How an evaluation acts, as its files name it.
@@ -224,15 +270,12 @@ pub struct Protocol {
 
 impl Protocol {
     /// A planning evaluation, with or without re-planning, on the standard tasks of depths 1–5
-    /// with `boards` boards per depth, `timeout_s` per search and no action noise.
-    pub fn planning(replan: bool, boards: usize, timeout_s: f64) -> Self {
+    /// with `boards` boards per depth, searches bounded by `limits` and no action noise.
+    pub fn planning(replan: bool, boards: usize, limits: SearchLimits) -> Self {
         Self {
             kind: EvaluationKind::planning(replan),
             tasks: TaskSet::standard(boards),
-            limits: Some(SearchLimits {
-                timeout_s,
-                max_expanded: None,
-            }),
+            limits: Some(limits),
             action_noise: None,
         }
     }

@@ -9,8 +9,8 @@ use seads_games::{
     TileSwap,
 };
 use seads_planner::{
-    DepthResult, Evaluation, PlanError, PlannerConfig, SolveConfig, TaskSet, bfs_plan, evaluate,
-    solve, summarise,
+    DepthResult, Evaluation, PlanChoice, PlanError, PlannerConfig, SolveConfig, TaskSet, bfs_plan,
+    evaluate, solve, summarise,
 };
 use std::sync::LazyLock;
 
@@ -172,12 +172,21 @@ struct CursorPolicy {
 
 impl CursorPolicy {
     fn lightsout(slip: Option<usize>) -> Self {
-        let targets = (0..25)
-            .map(|m| [(m % 5) as f32 * 0.2 + 0.1, (m / 5) as f32 * 0.2 + 0.1])
+        Self {
+            slip,
+            ..Self::pressing(&(0..25).collect::<Vec<_>>())
+        }
+    }
+
+    /// Skill k presses field `fields[k]`, every time.
+    fn pressing(fields: &[usize]) -> Self {
+        let targets = fields
+            .iter()
+            .map(|&m| [(m % 5) as f32 * 0.2 + 0.1, (m / 5) as f32 * 0.2 + 0.1])
             .collect();
         Self {
             targets,
-            slip,
+            slip: None,
             slipped: std::cell::Cell::new(false),
         }
     }
@@ -422,4 +431,248 @@ proptest! {
         });
         prop_assert_eq!(plain, grouped);
     }
+}
+
+/// LightsOut 5×5 with a 26th skill that also makes move 7, as a model with more skills than moves
+/// has: skill k < 25 makes move k, skill 25 move 7. The model gives each skill's predicted move
+/// the log-probability `sure` (−0.01) or `unsure` (−3) and every other outcome −50: skill 7 is the
+/// unsure one with `seven_unsure`, else skill 25.
+struct TwoForMoveSeven {
+    game: LightsOut,
+    seven_unsure: bool,
+}
+
+impl TwoForMoveSeven {
+    fn moves(k: usize) -> usize {
+        if k == 25 { 7 } else { k }
+    }
+
+    fn confidence(&self, k: usize) -> f32 {
+        let unsure = if self.seven_unsure { 7 } else { 25 };
+        if k == unsure { -3.0 } else { -0.01 }
+    }
+}
+
+impl Successor for TwoForMoveSeven {
+    fn num_skills(&self) -> usize {
+        26
+    }
+    fn symbolic_len(&self) -> usize {
+        25
+    }
+    fn successors(&mut self, states: &[SymbolicState], out: &mut Vec<SymbolicState>) {
+        for &z in states {
+            out.extend((0..26).map(|k| self.game.apply(z, Self::moves(k))));
+        }
+    }
+    fn log_likelihoods(&mut self, pairs: &[(SymbolicState, SymbolicState)]) -> Option<Vec<f32>> {
+        let this = &*self;
+        Some(
+            pairs
+                .iter()
+                .flat_map(|&(z0, zt)| {
+                    (0..26).map(move |k| {
+                        if this.game.apply(z0, Self::moves(k)) == zt {
+                            this.confidence(k)
+                        } else {
+                            -50.0
+                        }
+                    })
+                })
+                .collect(),
+        )
+    }
+}
+
+/// Two skills for one move, one sure and one unsure: the most likely plan takes the sure one at
+/// every step where the move is made, with the plan's log-probability the sum of its steps'; the
+/// paper's first-found plan takes the lower-numbered one. Both expand the same states.
+#[test]
+fn the_most_likely_plan_takes_the_sure_skill_of_two_for_one_move() {
+    let mut model = TwoForMoveSeven {
+        game: LightsOut::new(5).unwrap(),
+        seven_unsure: true,
+    };
+    let goal = model.game.goal();
+    for moves in [vec![7], vec![7, 12], vec![3, 7, 20], vec![0, 7, 11, 24]] {
+        let board = model.game.apply_all(goal, &moves);
+        let config = |plan| PlannerConfig {
+            plan,
+            ..PlannerConfig::default()
+        };
+        let first = bfs_plan(&mut model, board, goal, &config(PlanChoice::FirstFound)).unwrap();
+        let likely = bfs_plan(&mut model, board, goal, &config(PlanChoice::MostLikely)).unwrap();
+        assert!(first.skills.contains(&7), "{moves:?}: {:?}", first.skills);
+        assert_eq!(first.log_likelihood, None);
+        assert!(
+            !likely.skills.contains(&7),
+            "{moves:?}: {:?}",
+            likely.skills
+        );
+        assert!(
+            likely.skills.contains(&25),
+            "{moves:?}: {:?}",
+            likely.skills
+        );
+        assert_eq!(likely.skills.len(), moves.len(), "still a shortest plan");
+        let sure = -0.01 * moves.len() as f32;
+        let ll = likely.log_likelihood.unwrap();
+        assert!((ll - sure).abs() < 1e-5, "{moves:?}: {ll} against {sure}");
+        let reached = likely.skills.iter().fold(board, |z, &k| {
+            model.game.apply(z, TwoForMoveSeven::moves(k))
+        });
+        assert_eq!(reached, goal);
+        assert_eq!(likely.expanded, first.expanded, "the same search");
+    }
+    // The true rules have no probabilities: the most likely plan is the first found.
+    let lo = &*LIGHTSOUT;
+    let board = lo.apply_all(lo.goal(), &[4, 9]);
+    let plan = bfs_plan(
+        &mut GameSuccessor::new(lo),
+        board,
+        lo.goal(),
+        &PlannerConfig::default(),
+    )
+    .unwrap();
+    assert_eq!((plan.skills, plan.log_likelihood), (vec![4, 9], None));
+}
+
+/// A skill the model is sure of always presses the wrong field (skill 7 presses field 8); skill
+/// 25, which the model doubts, makes move 7. With re-planning, the most likely choice stops taking
+/// skill 7 from a board it failed from and solves every board with skill 25; the paper's choice
+/// takes skill 7 again and again until the task runs out of plans.
+#[test]
+fn replanning_avoids_a_skill_that_failed_from_the_same_board() {
+    let mut fields: Vec<usize> = (0..25).collect();
+    fields[7] = 8;
+    fields.push(7);
+    let policy = CursorPolicy::pressing(&fields);
+    let lo = &*LIGHTSOUT;
+    let mut solved = 0;
+    // A board one move from the goal, the move being 7.
+    let board = lo.apply(lo.goal(), 7);
+    for seed in 0..6 {
+        let mut outcomes = Vec::new();
+        for plan in [PlanChoice::MostLikely, PlanChoice::FirstFound] {
+            let mut env_copy = test_env(1, seed);
+            env_copy.set_board(board).unwrap();
+            let mut model = TwoForMoveSeven {
+                game: LightsOut::new(5).unwrap(),
+                seven_unsure: false,
+            };
+            let config = SolveConfig {
+                replan: true,
+                planner: PlannerConfig {
+                    plan,
+                    ..PlannerConfig::default()
+                },
+                ..SolveConfig::default()
+            };
+            let out = solve(env_copy.as_mut(), &policy, &mut model, lo.goal(), &config).unwrap();
+            outcomes.push(out);
+        }
+        let (likely, first) = (&outcomes[0], &outcomes[1]);
+        assert_eq!(likely.first_plan, vec![7], "the model is sure of skill 7");
+        assert!(likely.solved, "{likely:?}");
+        assert_eq!(likely.executed.last(), Some(&25), "{:?}", likely.executed);
+        assert!(likely.plans <= 4, "{} plans", likely.plans);
+        assert!(!first.solved, "{first:?}");
+        assert_eq!(first.plans, SolveConfig::default().max_plans);
+        assert!(
+            first.executed.iter().all(|&k| k == 7 || k == 8),
+            "{:?}",
+            first.executed
+        );
+        solved += usize::from(likely.solved);
+    }
+    assert_eq!(solved, 6);
+}
+
+/// A successor function that takes `delay` longer per call: a machine that is slower or busy.
+struct Slowed<S>(S, std::time::Duration);
+
+impl<S: Successor> Successor for Slowed<S> {
+    fn num_skills(&self) -> usize {
+        self.0.num_skills()
+    }
+    fn symbolic_len(&self) -> usize {
+        self.0.symbolic_len()
+    }
+    fn successors(&mut self, states: &[SymbolicState], out: &mut Vec<SymbolicState>) {
+        std::thread::sleep(self.1);
+        self.0.successors(states, out);
+    }
+}
+
+/// Under the default limits (expanded states, no clock), an evaluation on a slow or loaded
+/// machine equals the one on an idle machine task for task, the searches that hit the limit
+/// included: a model that lacks moves 22–24 cannot reach some boards, and its searches stop at
+/// the same state however long each call takes.
+#[test]
+fn the_default_limits_give_the_same_evaluation_on_a_slow_machine() {
+    let lo = &*LIGHTSOUT;
+    let evaluation = Evaluation {
+        env: "lightsout-cursor".into(),
+        env_config: EnvConfig::default(),
+        tasks: TaskSet {
+            depths: vec![2, 3],
+            boards: 6,
+            split: Split::Test,
+            seed: Some(5),
+        },
+        solve: SolveConfig {
+            planner: seads_planner::SearchLimits {
+                max_expanded: Some(3000),
+                ..seads_planner::SearchLimits::default()
+            }
+            .planner(),
+            ..SolveConfig::default()
+        },
+        action_noise: None,
+    };
+    assert_eq!(
+        evaluation.solve.planner.timeout_s, None,
+        "no clock by default"
+    );
+    let run = |delay_ms: u64| {
+        let mut tasks = Vec::new();
+        let mut model = Slowed(
+            FirstSkills(GameSuccessor::new(lo), 22),
+            std::time::Duration::from_millis(delay_ms),
+        );
+        let results = evaluate(
+            &evaluation,
+            &CursorPolicy::pressing(&(0..22).collect::<Vec<_>>()),
+            &mut model,
+            |task| {
+                let o = task.outcome;
+                tasks.push((
+                    task.seed,
+                    task.board,
+                    o.solved,
+                    o.plan_found,
+                    o.first_plan.clone(),
+                    o.executed.clone(),
+                    o.plans,
+                    o.failure.clone(),
+                ));
+            },
+        )
+        .unwrap();
+        let solved: Vec<usize> = results.iter().map(|r| r.solved).collect();
+        (tasks, solved)
+    };
+    let (idle, idle_solved) = run(0);
+    let (slow, slow_solved) = run(5);
+    let budget_stops = idle
+        .iter()
+        .filter(|t| t.7.as_deref().is_some_and(|f| f.contains("state budget")))
+        .count();
+    assert!(
+        budget_stops > 0,
+        "some searches end at the budget: {idle:?}"
+    );
+    assert!(idle.iter().any(|t| t.2), "some boards are solved");
+    assert_eq!(idle, slow, "task for task");
+    assert_eq!(idle_solved, slow_solved);
 }

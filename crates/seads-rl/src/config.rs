@@ -554,6 +554,16 @@ impl TrainConfig {
         if self.num_skills == Some(0) {
             return bad("num_skills must be at least 1".into());
         }
+        // TOML integers are 64-bit signed: a larger value would be written into config.toml but
+        // never read back.
+        for (name, value) in [("seed", self.seed), ("env_steps", self.env_steps)] {
+            if i64::try_from(value).is_err() {
+                return bad(format!(
+                    "{name} must be at most {} (a TOML integer), got {value}",
+                    i64::MAX
+                ));
+            }
+        }
         for (name, value) in [
             ("episodes_per_epoch", self.episodes_per_epoch),
             ("buffer_capacity", self.buffer_capacity),

@@ -56,6 +56,15 @@ impl<L: Learner> Run<L> {
                 dir.display()
             )));
         }
+        // What is left of a run whose config was removed is never trained over.
+        let checkpoints = fs::read_dir(dir.join(CHECKPOINTS)).is_ok_and(|mut d| d.next().is_some());
+        if dir.join(METRICS).exists() || checkpoints {
+            return Err(RlError::Config(format!(
+                "{} holds a run's metrics or checkpoints but no config.toml: restore its \
+                 config.toml to resume it, or choose another directory",
+                dir.display()
+            )));
+        }
         Ok(())
     }
 
@@ -365,6 +374,8 @@ pub fn raise_budget(dir: &Path, env_steps: u64) -> Result<(), RlError> {
     }
     if env_steps > config.env_steps {
         config.env_steps = env_steps;
+        // Checked before it is written: a run never holds a config it cannot read.
+        config.validate_values()?;
         write_atomic(&dir.join(CONFIG), config.to_toml().as_bytes())?;
     }
     Ok(())

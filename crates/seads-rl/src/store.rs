@@ -126,10 +126,26 @@ pub(crate) fn check_origin(checkpoint: &Path, config: &crate::TrainConfig) -> Re
 /// Writes `bytes` to `path` atomically and durably: a temporary file in the same folder,
 /// fsynced, renamed over `path`, and the folder fsynced.
 pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<(), RlError> {
+    refuse_special(path)?;
     let mut file =
         atomic_write_file::AtomicWriteFile::open(path).map_err(|e| RlError::io(path, e))?;
     file.write_all(bytes).map_err(|e| RlError::io(path, e))?;
     file.commit().map_err(|e| RlError::io(path, e))
+}
+
+/// An error where `path` exists and is not a regular file: an atomic write renames a new file over
+/// the path, which would replace a device, a FIFO or a symbolic link (not write to its target).
+fn refuse_special(path: &Path) -> Result<(), RlError> {
+    match std::fs::symlink_metadata(path) {
+        Ok(meta) if !meta.file_type().is_file() => Err(RlError::io(
+            path,
+            std::io::Error::new(
+                std::io::ErrorKind::InvalidInput,
+                "not a regular file: an output replaces only a regular file",
+            ),
+        )),
+        _ => Ok(()),
+    }
 }
 
 /// A file written as a stream and put in place of `path` only by [`AtomicFile::commit`]
@@ -143,6 +159,7 @@ pub struct AtomicFile {
 impl AtomicFile {
     /// Starts the file that will replace `path`.
     pub fn open(path: &Path) -> Result<Self, RlError> {
+        refuse_special(path)?;
         let file =
             atomic_write_file::AtomicWriteFile::open(path).map_err(|e| RlError::io(path, e))?;
         Ok(Self {

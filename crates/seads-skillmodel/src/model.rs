@@ -693,6 +693,11 @@ impl seads_games::Successor for ForwardModel {
         }
     }
 
+    /// log q(z_T | z_0, k) for every pair and skill: the scores the forward model trains on.
+    fn log_likelihoods(&mut self, pairs: &[(SymbolicState, SymbolicState)]) -> Option<Vec<f32>> {
+        Some(SkillModel::scores(self, pairs))
+    }
+
     fn preferred_batch(&self) -> usize {
         if self.device == Device::Cpu {
             // Four parts for each of the pool's threads, so that uneven parts even out.

@@ -30,6 +30,8 @@ pub struct PlanBench {
     /// A time limit per search, seconds: a depth whose search hits it is reported as such, and
     /// deeper depths are not run (`None`: no limit).
     pub timeout_s: Option<f64>,
+    /// Which plan each search returns.
+    pub plan: seads_planner::PlanChoice,
 }
 
 /// The timings of one depth.
@@ -179,6 +181,7 @@ impl PlanBench {
             };
             let planner = PlannerConfig {
                 timeout_s: self.timeout_s,
+                plan: self.plan,
                 ..PlannerConfig::default()
             };
             for _ in 0..self.boards {

@@ -7,8 +7,8 @@ use std::path::Path;
 
 use seads_games::BoardGame;
 use seads_planner::{
-    CheckpointId, DepthResult, Evaluation, EvaluationKind, EvaluationRecord, PlannerConfig,
-    Protocol, SearchLimits, SolveConfig, TaskRecord, TaskSet, evaluate,
+    CheckpointId, DepthResult, Evaluation, EvaluationKind, EvaluationRecord, PlanChoice, Protocol,
+    SearchLimits, SolveConfig, TaskRecord, TaskSet, evaluate,
 };
 use seads_rl::{Agent, TrainConfig};
 use serde::{Deserialize, Serialize};
@@ -75,11 +75,15 @@ pub struct CheckpointEvaluation {
     pub replan: bool,
     /// Boards per depth.
     pub boards: usize,
-    /// Seconds per search.
-    pub timeout_s: f64,
+    /// Seconds per search, if the clock bounded it.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub timeout_s: Option<f64>,
     /// States expanded per search, if bounded.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub max_expanded: Option<usize>,
+    /// Which plan each search returned (lines from before the choice: the first found).
+    #[serde(default = "PlanChoice::paper")]
+    pub plan: PlanChoice,
     /// Per depth.
     pub results: Vec<DepthResult>,
 }
@@ -97,6 +101,7 @@ impl CheckpointEvaluation {
             limits: Some(SearchLimits {
                 timeout_s: self.timeout_s,
                 max_expanded: self.max_expanded,
+                plan: self.plan,
             }),
             action_noise: None,
         }
@@ -173,11 +178,7 @@ pub fn evaluate_agent(
         tasks: protocol.tasks.clone(),
         solve: SolveConfig {
             replan: protocol.kind == EvaluationKind::Replan,
-            planner: PlannerConfig {
-                timeout_s: Some(limits.timeout_s),
-                max_expanded: limits.max_expanded,
-                ..PlannerConfig::default()
-            },
+            planner: limits.planner(),
             ..SolveConfig::default()
         },
         action_noise: protocol.action_noise,

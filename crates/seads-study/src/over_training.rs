@@ -181,6 +181,7 @@ pub fn evaluate_checkpoints(
             boards: tasks.boards,
             timeout_s: limits.timeout_s,
             max_expanded: limits.max_expanded,
+            plan: limits.plan,
             results,
         };
         seads_rl::store::append_json_line(&path, &line)?;

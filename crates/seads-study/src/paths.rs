@@ -26,6 +26,48 @@ pub fn refuse_overwriting_input(output: &Path, inputs: &[&Path]) -> Result<()> {
     Ok(())
 }
 
+/// Refuses an output path that would damage something (the user's input to fix, before anything
+/// is written): one that exists and is not a regular file (a device, a FIFO, a symlink, a
+/// folder: outputs are written only as regular files, by renaming a finished file into place,
+/// never onto a special file or a link's target), one inside a folder the command reads (a run
+/// directory given as its agent), or one of its inputs ([`refuse_overwriting_input`]).
+pub fn refuse_unsafe_output(output: &Path, inputs: &[&Path]) -> Result<()> {
+    if let Ok(meta) = std::fs::symlink_metadata(output)
+        && !meta.file_type().is_file()
+    {
+        let kind = if meta.file_type().is_symlink() {
+            "a symbolic link"
+        } else if meta.is_dir() {
+            "a folder"
+        } else {
+            "a special file"
+        };
+        return Err(StudyError::invalid(format!(
+            "{} is {kind}: an output replaces only a regular file",
+            output.display()
+        )));
+    }
+    let parent = output
+        .parent()
+        .filter(|p| !p.as_os_str().is_empty())
+        .unwrap_or(Path::new("."));
+    if let Ok(parent) = std::fs::canonicalize(parent) {
+        for input in inputs {
+            if let Ok(input) = std::fs::canonicalize(input)
+                && input.is_dir()
+                && parent.starts_with(&input)
+            {
+                return Err(StudyError::invalid(format!(
+                    "{} lies inside {}, which this command reads: write it elsewhere",
+                    output.display(),
+                    input.display()
+                )));
+            }
+        }
+    }
+    refuse_overwriting_input(output, inputs)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -45,5 +87,31 @@ mod tests {
         assert!(refuse_overwriting_input(&tmp.path().join("new.json"), &[&input]).is_ok());
         std::fs::write(tmp.path().join("other.json"), "{}").unwrap();
         assert!(refuse_overwriting_input(&tmp.path().join("other.json"), &[&input]).is_ok());
+    }
+
+    #[test]
+    fn special_files_links_and_outputs_inside_an_input_are_refused() {
+        let tmp = tempfile::tempdir().unwrap();
+        let run = tmp.path().join("run");
+        std::fs::create_dir(&run).unwrap();
+        std::fs::write(run.join("config.toml"), "env = 1").unwrap();
+        let target = tmp.path().join("target.json");
+        std::fs::write(&target, "{}").unwrap();
+        let link = tmp.path().join("link.json");
+        std::os::unix::fs::symlink(&target, &link).unwrap();
+        let refused = |out: &Path, inputs: &[&Path], why: &str| {
+            let e = refuse_unsafe_output(out, inputs).unwrap_err();
+            assert!(e.is_invalid() && e.to_string().contains(why), "{e}");
+        };
+        refused(&link, &[], "a symbolic link");
+        refused(&run, &[], "a folder");
+        refused(Path::new("/dev/null"), &[], "a special file");
+        refused(&run.join("config.toml"), &[&run], "inside");
+        refused(&run.join("new.json"), &[&run], "inside");
+        assert!(refuse_unsafe_output(&tmp.path().join("new.json"), &[&run]).is_ok());
+        assert!(
+            refuse_unsafe_output(&target, &[&run]).is_ok(),
+            "a regular file is replaced"
+        );
     }
 }

@@ -29,7 +29,7 @@ pub struct Build<'a> {
 
 impl Build<'_> {
     /// Whether a study may train with this binary: one built from a working tree with uncommitted
-    /// changes is refused ([`StudyError::Invalid`], one line) unless `allow_dirty`, so that a
+    /// changes is refused ([`crate::StudyError::Invalid`], one line) unless `allow_dirty`, so that a
     /// study's runs come from code that is committed. A run it trains anyway says `dirty: true`
     /// in its provenance.
     pub fn allows_study(&self, allow_dirty: bool) -> crate::Result<()> {

@@ -6,7 +6,7 @@ use std::path::Path;
 
 use seads_embodiment::Environment as _;
 use seads_games::{BoardGame, GameKind, Gf2Solver, LightsOut};
-use seads_planner::{DepthResult, EvaluationRecord, PlannerConfig, Protocol, SolveConfig, solve};
+use seads_planner::{DepthResult, EvaluationRecord, Protocol, SolveConfig, solve};
 use seads_rl::Agent;
 use seads_uarm::UarmEnv;
 
@@ -14,7 +14,8 @@ use crate::Result;
 use crate::evaluation::{checkpoint_of, save_evaluation};
 
 /// Evaluates the robot run in `run` at `checkpoint` with re-planning on the tasks of depth 1–5
-/// with `boards` boards per depth and `timeout_s` per search, calling `each` after every task.
+/// with `boards` boards per depth and each search bounded by `limits`, calling `each` after every
+/// task.
 /// Where the board can be set (`settable`: the twin), it is set to each task's board, the boards
 /// a Cursor evaluation plays; the real tablet's boards are whatever the app shows. Results are
 /// keyed by the board's solution depth and saved as `evaluation-replan.json` (or
@@ -25,7 +26,7 @@ pub fn evaluate_robot(
     mut env: UarmEnv,
     settable: bool,
     boards: usize,
-    timeout_s: f64,
+    limits: seads_planner::SearchLimits,
     mut each: impl FnMut(),
 ) -> Result<EvaluationRecord> {
     // The robot's agent runs on the CPU, wherever it trained.
@@ -37,13 +38,10 @@ pub fn evaluate_robot(
     let (policy, model) = agent.parts()?;
     let game = LightsOut::new(5).expect("LightsOut 5×5 exists");
     let solver = Gf2Solver::new(&game);
-    let protocol = Protocol::planning(true, boards, timeout_s);
+    let protocol = Protocol::planning(true, boards, limits);
     let solve_config = SolveConfig {
         replan: true,
-        planner: PlannerConfig {
-            timeout_s: Some(timeout_s),
-            ..PlannerConfig::default()
-        },
+        planner: limits.planner(),
         ..SolveConfig::default()
     };
     let mut results: BTreeMap<usize, DepthResult> = BTreeMap::new();

@@ -31,6 +31,10 @@ pub struct PlanBenchArgs {
     /// arithmetic; for comparison).
     #[arg(long)]
     float32: bool,
+    /// Which plan each search returns: most-likely (default) or first-found (the paper's), to
+    /// compare the two choices' cost with one binary.
+    #[arg(long, value_name = "CHOICE", default_value = "most-likely", value_parser = super::plan_choice)]
+    plan: seads_planner::PlanChoice,
     /// Print JSON.
     #[arg(long)]
     json: bool,
@@ -40,6 +44,7 @@ pub struct PlanBenchArgs {
 pub fn plan_bench(args: PlanBenchArgs) -> Result<()> {
     let device = crate::usable_device(args.device)?;
     let threads = args.threads as usize;
+    crate::check_threads("--threads", threads)?;
     // The search's parts and bookkeeping run on the pool, each part on one libtorch thread.
     seads_rl::set_threads(1);
     let pool = rayon::ThreadPoolBuilder::new()
@@ -53,6 +58,7 @@ pub fn plan_bench(args: PlanBenchArgs) -> Result<()> {
         float32: args.float32,
         device,
         timeout_s: args.timeout,
+        plan: args.plan,
     };
     // A line per depth as it is timed; a failed write ends the command after the benchmark.
     let mut written = Ok(());

@@ -6,7 +6,7 @@ use std::path::PathBuf;
 use anyhow::{Context, Result, bail};
 use clap::Args;
 use seads_games::Split;
-use seads_planner::{EvaluationKind, Protocol, SearchLimits, TaskSet, summarise};
+use seads_planner::{EvaluationKind, Protocol, TaskSet, summarise};
 use seads_rl::ComputeDevice;
 
 use super::{load_agent, run_evaluation};
@@ -43,13 +43,8 @@ pub struct EvaluateArgs {
     /// there are skipped.
     #[arg(long, conflicts_with_all = ["checkpoint", "replan", "seed"])]
     checkpoints: Option<seads_study::over_training::Selection>,
-    /// Time limit per search, seconds (the authors' evaluation used 60).
-    #[arg(long, default_value_t = 60.0, value_parser = seads_study::numbers::positive_finite)]
-    timeout: f64,
-    /// Also stop each search after expanding this many states: a limit that, unlike the clock,
-    /// gives the same results on every machine.
-    #[arg(long, value_parser = clap::value_parser!(u64).range(1..))]
-    max_expanded: Option<u64>,
+    #[command(flatten)]
+    search: super::SearchArgs,
     /// Execute skills with Gaussian noise of this standard deviation on every low-level action
     /// (the authors' evaluation under noise used 0.05 for the cursor), drawn from each task's
     /// seed; the files are named `evaluation-replan-noise-STD…`.
@@ -73,12 +68,7 @@ pub fn evaluate_run(args: EvaluateArgs) -> Result<()> {
         .map_err(|e| BadInput(anyhow::anyhow!("--depths: {e}")))?;
     // The planner's parts run on rayon's threads, each on one libtorch thread.
     seads_rl::set_threads(1);
-    let limits = SearchLimits {
-        timeout_s: args.timeout,
-        max_expanded: args
-            .max_expanded
-            .map(|m| m.try_into().unwrap_or(usize::MAX)),
-    };
+    let limits = args.search.limits();
     let asked = TaskSet {
         depths: depths.clone(),
         ..TaskSet::standard(args.boards)

@@ -9,6 +9,8 @@ mod solve;
 use std::path::Path;
 
 use anyhow::{Context, Result, bail};
+use clap::Args;
+use seads_planner::{PlanChoice, SearchLimits};
 use seads_rl::{Agent, ComputeDevice};
 
 pub use bench::{PlanBenchArgs, plan_bench};
@@ -17,6 +19,60 @@ pub use evaluation::{evaluate_checkpoints, run_evaluation};
 pub use solve::{SolveArgs, solve_board};
 
 use crate::BadInput;
+
+/// How far each search may go: by default 2²² expanded states and no clock, so that the same
+/// agent solves the same boards on any machine, loaded or not.
+#[derive(Debug, Clone, Args)]
+pub struct SearchArgs {
+    /// Stop each search after expanding this many states (the default, 2²² = 4194304, finds
+    /// every 5×5 LightsOut board of depth ≤ 10 with a model as good as the true rules). The
+    /// same on every machine.
+    #[arg(
+        long,
+        value_name = "STATES",
+        default_value_t = seads_planner::DEFAULT_MAX_EXPANDED as u64,
+        value_parser = clap::value_parser!(u64).range(1..)
+    )]
+    max_expanded: u64,
+    /// Also stop each search after this many seconds (off by default: a clock makes the outcome
+    /// depend on the machine's speed and load; the authors used 60).
+    #[arg(long, value_name = "SECONDS", value_parser = seads_study::numbers::positive_finite)]
+    timeout: Option<f64>,
+    /// Which of the shortest plans to take: `most-likely` (the plan the forward model gives the
+    /// highest probability, each step by the skill likeliest to make it; re-planning avoids a
+    /// skill that just failed from the same board) or `first-found` (the paper's search).
+    #[arg(long, value_name = "CHOICE", default_value = "most-likely", value_parser = plan_choice)]
+    plan: PlanChoice,
+}
+
+/// `most-likely` or `first-found`.
+fn plan_choice(text: &str) -> Result<PlanChoice, String> {
+    match text {
+        "most-likely" => Ok(PlanChoice::MostLikely),
+        "first-found" => Ok(PlanChoice::FirstFound),
+        other => Err(format!("{other:?} is not one of most-likely, first-found")),
+    }
+}
+
+impl SearchArgs {
+    /// The limits these options set.
+    pub fn limits(&self) -> SearchLimits {
+        SearchLimits {
+            timeout_s: self.timeout,
+            max_expanded: Some(usize::try_from(self.max_expanded).unwrap_or(usize::MAX)),
+            plan: self.plan,
+        }
+    }
+}
+
+/// `--boards N` of an evaluation on the standard depths 1–5, as bad input where no evaluation
+/// can have it (0 boards, or more tasks than one evaluation may have), before anything is done.
+pub fn check_boards(boards: usize) -> Result<()> {
+    match seads_planner::TaskSet::standard(boards).problem() {
+        Some(problem) => Err(BadInput(anyhow::anyhow!("--boards {boards}: {problem}")).into()),
+        None => Ok(()),
+    }
+}
 
 /// Loads the agent of a run onto `device` (whichever device it trained on), turning a missing or
 /// foreign directory into a clear error.

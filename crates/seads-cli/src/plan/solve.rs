@@ -4,7 +4,7 @@ use std::path::PathBuf;
 
 use anyhow::Result;
 use clap::Args;
-use seads_planner::{PlannerConfig, SolveConfig, solve};
+use seads_planner::{SolveConfig, solve};
 use serde::Serialize;
 
 use super::load_agent;
@@ -29,9 +29,8 @@ pub struct SolveArgs {
     /// Seed of the manipulator's initial state.
     #[arg(long, default_value_t = 0)]
     seed: u64,
-    /// Time limit per search, seconds.
-    #[arg(long, default_value_t = 300.0, value_parser = seads_study::numbers::positive_finite)]
-    timeout: f64,
+    #[command(flatten)]
+    search: super::SearchArgs,
     /// Draw the board and the executed skills' paths into this image (.png or .svg).
     #[arg(long)]
     render: Option<PathBuf>,
@@ -57,10 +56,7 @@ pub fn solve_board(args: SolveArgs) -> Result<()> {
     let before = env.scene();
     let config = SolveConfig {
         replan: args.replan,
-        planner: PlannerConfig {
-            timeout_s: Some(args.timeout),
-            ..PlannerConfig::default()
-        },
+        planner: args.search.limits().planner(),
         ..SolveConfig::default()
     };
     let (policy, model) = agent.parts()?;

@@ -54,7 +54,15 @@ fn at_least_one(option: &str, value: u64) -> Result<usize> {
     if value == 0 {
         return Err(BadInput(anyhow!("{option} must be at least 1")).into());
     }
-    Ok(value as usize)
+    Ok(usize::try_from(value).unwrap_or(usize::MAX))
+}
+
+/// A count of threads or processes on this machine (workers, cores): at least 1 and at most
+/// [`crate::max_threads`], said in one line otherwise.
+fn thread_count(option: &str, value: u64) -> Result<usize> {
+    let value = at_least_one(option, value)?;
+    crate::check_threads(option, value)?;
+    Ok(value)
 }
 
 fn cores() -> usize {
@@ -183,11 +191,11 @@ pub fn run(command: SweepCommand) -> Result<()> {
                 .allows_study(args.allow_dirty)
                 .map_err(crate::study_error)?;
             let cores = match args.cores {
-                Some(c) => at_least_one("--cores", c)?,
+                Some(c) => thread_count("--cores", c)?,
                 None => cores(),
             };
             let workers = match args.workers {
-                Some(w) => at_least_one("--workers", w)?,
+                Some(w) => thread_count("--workers", w)?,
                 None => (cores / 2).max(1),
             };
             let population = args
@@ -218,7 +226,7 @@ pub fn run(command: SweepCommand) -> Result<()> {
             } else {
                 Duration::from_secs(args.wait)
             };
-            let cores = at_least_one("--cores", args.cores)?;
+            let cores = thread_count("--cores", args.cores)?;
             let device = crate::usable_device(args.device)?;
             // The task's threads: rayon's (environments, the planner) as libtorch's.
             rayon::ThreadPoolBuilder::new()
@@ -305,7 +313,8 @@ fn slurm(args: SlurmArgs) -> Result<()> {
         populations,
         allow_dirty: args.allow_dirty,
     };
-    let (array, report) = slurm::write_scripts(&dir, &sweep, &options)?;
+    let (array, report) =
+        slurm::write_scripts(&dir, &sweep, &options).map_err(crate::study_error)?;
     outln!("wrote {} and {}", array.display(), report.display());
     if args.submit {
         let (array_id, report_id) = slurm::submit(&array, &report)?;

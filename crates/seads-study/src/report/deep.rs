@@ -85,7 +85,7 @@ pub fn deep_tables(groups: &[Group<'_>]) -> Option<(String, String)> {
                 mean_search,
                 median_search,
                 median_steps.map_or(String::new(), |m| m.to_string()),
-                limit.timeout_s,
+                limit.timeout_s.map_or(String::new(), |t| t.to_string()),
                 limit.max_expanded.map_or(String::new(), |m| m.to_string()),
             );
         }
@@ -95,10 +95,7 @@ pub fn deep_tables(groups: &[Group<'_>]) -> Option<(String, String)> {
     }
     let limits: Vec<String> = limits
         .iter()
-        .map(|l| match l.max_expanded {
-            Some(m) => format!("{} s or {m} expanded states", l.timeout_s),
-            None => format!("{} s", l.timeout_s),
-        })
+        .map(seads_planner::SearchLimits::describe)
         .collect();
     let _ = write!(
         md,
@@ -136,8 +133,9 @@ mod tests {
     #[test]
     fn deep_rows_pool_the_runs_evaluated_deeper() {
         let limits = SearchLimits {
-            timeout_s: 60.0,
+            timeout_s: Some(60.0),
             max_expanded: None,
+            plan: seads_planner::PlanChoice::FirstFound,
         };
         let mut a = bare_run(1);
         a.deep = Some(DeepSearch {

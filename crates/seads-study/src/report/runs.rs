@@ -307,15 +307,25 @@ pub fn collect(inputs: &[PathBuf]) -> Result<Collection> {
         unreadable: Vec::new(),
         absent: 0,
     };
+    // Each run once, however often and by whichever path it is given (a run named twice, or in
+    // a sweep named twice, is one run).
+    let mut seen = std::collections::BTreeSet::new();
+    let mut first_time =
+        |dir: &Path| seen.insert(std::fs::canonicalize(dir).unwrap_or_else(|_| dir.to_path_buf()));
     for input in inputs {
         if input.join(crate::sweep::INDEX).is_file() {
             let sweep = Sweep::load(input)?;
+            let mut new_runs = false;
             for run in &sweep.runs {
                 let dir = input.join(&run.dir);
                 if !dir.exists() {
                     collection.absent += 1;
                     continue;
                 }
+                if !first_time(&dir) {
+                    continue;
+                }
+                new_runs = true;
                 match RunData::load(
                     &dir,
                     run.variant.clone(),
@@ -326,9 +336,14 @@ pub fn collect(inputs: &[PathBuf]) -> Result<Collection> {
                 }
             }
             collection.reference.get_or_insert(sweep.reference.clone());
-            collection.sweeps.push(sweep.name);
-            collection.sweep_dirs.push(input.clone());
+            if new_runs || !collection.sweeps.contains(&sweep.name) {
+                collection.sweeps.push(sweep.name);
+                collection.sweep_dirs.push(input.clone());
+            }
         } else if input.join("config.toml").is_file() {
+            if !first_time(input) {
+                continue;
+            }
             let name = input.file_name().map_or_else(
                 || input.display().to_string(),
                 |n| n.to_string_lossy().into_owned(),
@@ -342,6 +357,11 @@ pub fn collect(inputs: &[PathBuf]) -> Result<Collection> {
         } else if input.is_dir() {
             fail!(
                 "{} is neither a sweep (sweep.json) nor a run directory (config.toml)",
+                input.display()
+            );
+        } else if input.exists() {
+            fail!(
+                "{} is a file, not a sweep or run directory",
                 input.display()
             );
         } else {

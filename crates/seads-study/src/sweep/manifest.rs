@@ -62,12 +62,16 @@ pub struct EvaluationPlan {
     pub every: usize,
     /// Boards per depth.
     pub boards: usize,
-    /// Seconds per search (the authors used 60; an agent that lacks a skill searches until then).
-    pub timeout: f64,
-    /// Also stop each search after expanding this many states: unlike the clock, the same on
-    /// every machine.
+    /// Also stop each search after this many seconds (none by default: a clock makes the
+    /// outcome depend on the machine's speed and load; the authors used 60).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub timeout: Option<f64>,
+    /// Stop each search after expanding this many states (default 2²², the same on every
+    /// machine).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub max_expanded: Option<usize>,
+    /// Which plan each search returns: `most-likely` (default) or `first-found` (the paper's).
+    pub plan: seads_planner::PlanChoice,
 }
 
 impl Default for EvaluationPlan {
@@ -76,8 +80,9 @@ impl Default for EvaluationPlan {
             last: true,
             every: 0,
             boards: 20,
-            timeout: 10.0,
-            max_expanded: None,
+            timeout: None,
+            max_expanded: Some(seads_planner::DEFAULT_MAX_EXPANDED),
+            plan: seads_planner::PlanChoice::MostLikely,
         }
     }
 }
@@ -88,6 +93,7 @@ impl EvaluationPlan {
         seads_planner::SearchLimits {
             timeout_s: self.timeout,
             max_expanded: self.max_expanded,
+            plan: self.plan,
         }
     }
 }
@@ -187,8 +193,8 @@ impl Manifest {
             );
         }
         let e = &self.evaluation;
-        if e.boards == 0 || !(e.timeout.is_finite() && e.timeout > 0.0) || e.max_expanded == Some(0)
-        {
+        let bad_timeout = e.timeout.is_some_and(|t| !(t.is_finite() && t > 0.0));
+        if e.boards == 0 || bad_timeout || e.max_expanded == Some(0) {
             fail!(
                 "evaluation.boards and evaluation.max_expanded must be at least 1 and \
                  evaluation.timeout above 0"

@@ -92,7 +92,7 @@ pub fn scripts(dir: &Path, sweep: &Sweep, options: &SlurmOptions) -> (String, St
          #SBATCH --time={time}\n\
          {partition}\
          {gres}\
-         #SBATCH --output={logs}/task-%a.out\n\
+         #SBATCH --output=\"{logs}/task-%a.out\"\n\
          #SBATCH --requeue\n\
          {members}\
          exec {seads} sweep task {dir} --index {index} --cores \"${{SLURM_CPUS_PER_TASK:-{cpus}}}\"{device}{dirty}\n",
@@ -118,7 +118,7 @@ pub fn scripts(dir: &Path, sweep: &Sweep, options: &SlurmOptions) -> (String, St
          #SBATCH --cpus-per-task=1\n\
          #SBATCH --time={time}\n\
          {partition}\
-         #SBATCH --output={logs}/report.out\n\
+         #SBATCH --output=\"{logs}/report.out\"\n\
          {seads} sweep status {dir}\n\
          exec {seads} report {dir} --out {out}\n",
         name = sweep.name,
@@ -129,12 +129,44 @@ pub fn scripts(dir: &Path, sweep: &Sweep, options: &SlurmOptions) -> (String, St
     (array, report)
 }
 
+/// Refuses what the scripts could not hold safely ([`crate::StudyError::Invalid`], before
+/// anything is written): a newline would end an `#SBATCH` line and start a command, `%` is
+/// expanded by Slurm in `--output`, and the values of `#SBATCH` lines are one word each.
+pub fn check_options(dir: &Path, options: &SlurmOptions) -> Result<()> {
+    let word = |name: &str, value: &str| -> Result<()> {
+        if value.is_empty()
+            || value
+                .chars()
+                .any(|c| c.is_whitespace() || "%\"'\\".contains(c))
+        {
+            return Err(crate::StudyError::invalid(format!(
+                "{name} {value:?} must be one word without spaces, quotes or %"
+            )));
+        }
+        Ok(())
+    };
+    word("--time", &options.time)?;
+    if let Some(partition) = &options.partition {
+        word("--partition", partition)?;
+    }
+    for (name, path) in [("the sweep directory", dir), ("--seads", &options.seads)] {
+        let text = path.to_string_lossy();
+        if text.chars().any(|c| c.is_control() || c == '%' || c == '"') {
+            return Err(crate::StudyError::invalid(format!(
+                "{name} {text:?} holds a newline, a quote or %, which a Slurm script cannot hold"
+            )));
+        }
+    }
+    Ok(())
+}
+
 /// Writes the scripts into `dir/slurm/`; returns their paths.
 pub fn write_scripts(
     dir: &Path,
     sweep: &Sweep,
     options: &SlurmOptions,
 ) -> Result<(PathBuf, PathBuf)> {
+    check_options(dir, options)?;
     let (array, report) = scripts(dir, sweep, options);
     let folder = dir.join(SLURM_DIR);
     std::fs::create_dir_all(folder.join("logs"))
