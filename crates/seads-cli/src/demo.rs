@@ -22,9 +22,8 @@ pub struct RunArgs {
     #[arg(long, default_value = "lightsout-cursor")]
     env: String,
     /// Training budget in environment steps (the paper's Cursor budget is 500000). With the
-    /// default, seed 1 ends at epoch 1706 with skill coverage 24.75/25 (25/25 at epoch 1700;
-    /// portable numerics; an AMD EPYC and an Intel Xeon give the same run), and coverage
-    /// wobbles by about a skill between evaluations (docs/results/demo).
+    /// default, seed 1 ends at epoch 1699 with skill coverage 24.80/25 (portable numerics, an
+    /// AMD EPYC), and coverage wobbles by about a skill between evaluations (docs/results/demo).
     #[arg(long, default_value_t = 157_252)]
     env_steps: u64,
     /// Seed of the run.
