@@ -1790,3 +1790,50 @@ fn a_run_given_twice_is_reported_once() {
         "is a file",
     );
 }
+
+/// An evaluation plays the agent as it was trained: a `config.toml` whose environment settings
+/// were edited since the checkpoint is refused in one line, as resuming refuses it, and nothing
+/// is written; the budget may differ.
+#[test]
+fn an_evaluation_refuses_a_config_edited_since_the_checkpoint() {
+    let dir = tempfile::tempdir().unwrap();
+    let run = dir.path().join("run");
+    copy_dir(&tiny_run().join("run"), &run);
+    let path = run.join("config.toml");
+    let original = std::fs::read_to_string(&path).unwrap();
+    assert!(original.contains("max_solution_depth = 5"), "{original}");
+    std::fs::write(
+        &path,
+        original.replace("max_solution_depth = 5", "max_solution_depth = 3"),
+    )
+    .unwrap();
+    let before: Vec<_> = std::fs::read_dir(&run).unwrap().collect();
+    check_bad_input(
+        &[
+            "evaluate",
+            "--run",
+            s(&run),
+            "--depths",
+            "1",
+            "--boards",
+            "1",
+        ],
+        "`env_config.max_solution_depth` is 3, was 5",
+    );
+    assert_eq!(std::fs::read_dir(&run).unwrap().count(), before.len());
+    std::fs::write(
+        &path,
+        original.replace("env_steps = 600", "env_steps = 900"),
+    )
+    .unwrap();
+    seads_ok(&[
+        "evaluate",
+        "--run",
+        s(&run),
+        "--depths",
+        "1",
+        "--boards",
+        "1",
+        "--quiet",
+    ]);
+}

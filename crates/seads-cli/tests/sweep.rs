@@ -328,7 +328,10 @@ fn a_sweep_is_planned_once_run_to_the_end_and_reported() {
     assert!(md.contains("| seed-1 |"), "{md}");
     seads_ok(&["report", s(&sweep), s(&run), "--out", s(&report)]);
     let md = std::fs::read_to_string(report.join("report.md")).unwrap();
-    assert!(!md.contains("| seed-1 |") && md.contains("from 4 run(s)"), "{md}");
+    assert!(
+        !md.contains("| seed-1 |") && md.contains("from 4 run(s)"),
+        "{md}"
+    );
 
     // Runs of one row must be one environment: the same variant name on two board sizes is an error.
     let other = tmp.path().join("other/seed-1");

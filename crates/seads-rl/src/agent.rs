@@ -94,6 +94,10 @@ impl Agent {
     ) -> Result<Self, RlError> {
         crate::numerics::check(config.portable_numerics)?;
         crate::store::check_origin(checkpoint, &config)?;
+        // The agent as it was trained: a config.toml edited since (an environment setting, a
+        // network size) would evaluate another agent than the one trained, so it is refused as
+        // a resume refuses it.
+        crate::store::check_config(checkpoint, &config)?;
         let k = config.num_skills.unwrap_or(spec.num_skills);
         let device = config.device.resolve()?;
         let mut sac = Sac::new(

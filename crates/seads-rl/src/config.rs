@@ -699,10 +699,11 @@ pub fn merge_toml(base: &mut toml::Table, layer: &toml::Table) {
     }
 }
 
-/// Fields that a resumed run may change: the budget (`--env-steps`) and the thread counts,
-/// which sweeps and the robot set per task and which do not change a run's numbers (a test in
-/// `tests/training.rs` checks).
-const RESUMABLE_CHANGES: [&str; 3] = ["env_steps", "threads", "sac_threads_alone"];
+/// Fields that a resumed or evaluated run may change: the budget (`--env-steps`) and the thread
+/// counts, which sweeps and the robot set per task and which do not change a run's numbers (a
+/// test in `tests/training.rs` checks), and the device (`--device`: a checkpoint moves between
+/// devices).
+const RESUMABLE_CHANGES: [&str; 4] = ["env_steps", "threads", "sac_threads_alone", "device"];
 
 /// The first field in which two configurations differ, other than those a resumed run may
 /// change (the budget, thread counts), as `(dotted name, this value, that value)`.

@@ -95,6 +95,7 @@ pub fn load_agent(run: &Path, checkpoint: Option<u64>, device: ComputeDevice) ->
         .map_err(|e| match e {
             seads_rl::RlError::Checkpoint { .. }
             | seads_rl::RlError::Unreadable { .. }
+            | seads_rl::RlError::Config(_)
             | seads_rl::RlError::SkillModel(_) => anyhow::Error::from(BadInput(e.into())),
             other => anyhow::Error::from(other),
         })
