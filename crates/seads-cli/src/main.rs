@@ -159,10 +159,19 @@ pub fn study_error(e: seads_study::StudyError) -> anyhow::Error {
 /// [`seads_rl::store::RunLock`]); another writer holding it is exit 2, naming it. Waits a moment, for a
 /// `sweep status` that looks at the lock.
 pub fn lock_run(dir: &std::path::Path) -> anyhow::Result<seads_rl::store::RunLock> {
-    use anyhow::Context as _;
     // Only a run directory is locked: anything else is said as such.
-    seads_rl::load_config(dir).with_context(|| format!("loading run {}", dir.display()))?;
+    run_config(dir)?;
     acquire(dir, std::time::Duration::from_secs(2))
+}
+
+/// The configuration of the run the user named in `dir`: a directory that is missing, is a file,
+/// loops through links or holds no readable or valid `config.toml` is bad input (exit 2, one
+/// line), as any malformed input is.
+pub fn run_config(dir: &std::path::Path) -> anyhow::Result<seads_rl::TrainConfig> {
+    seads_rl::load_config(dir).map_err(|e| {
+        let what = anyhow::Error::from(e).context(format!("loading run {}", dir.display()));
+        BadInput(what).into()
+    })
 }
 
 /// Takes the directory of a new run for this command (creating it) before anything is written

@@ -41,8 +41,7 @@ pub struct PlotArgs {
 pub fn plot(args: PlotArgs) -> Result<()> {
     crate::plan::check_boards(args.boards)?;
     // Plotting may evaluate the run and save that evaluation into it.
-    seads_rl::load_config(&args.run)
-        .with_context(|| format!("loading run {}", args.run.display()))?;
+    crate::run_config(&args.run)?;
     let _lock = crate::lock_run(&args.run)?;
     let written = write_figures(
         &args.run,

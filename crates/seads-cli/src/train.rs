@@ -56,7 +56,7 @@ fn config(args: &TrainArgs) -> Result<TrainConfig> {
     let mut config = match (&args.config, &args.env) {
         (Some(path), env) => {
             let text = std::fs::read_to_string(path)
-                .with_context(|| format!("reading {}", path.display()))?;
+                .map_err(|e| BadInput(anyhow::anyhow!("reading {}: {e}", path.display())))?;
             // What the file leaves out comes from its environment's preset.
             let algorithm = args.algorithm.as_deref().map(|a| algorithm(Some(a)));
             TrainConfig::from_user_toml(&text, env.as_deref(), algorithm)
@@ -100,7 +100,7 @@ pub fn train(args: TrainArgs) -> Result<()> {
             // The device is checked before anything is written.
             let device = match args.device {
                 Some(device) => device,
-                None => seads_rl::load_config(dir)?.device,
+                None => crate::run_config(dir)?.device,
             };
             crate::usable_device(device)?;
             if let Some(steps) = args.env_steps {
@@ -109,8 +109,7 @@ pub fn train(args: TrainArgs) -> Result<()> {
                     other => anyhow::Error::from(other),
                 })?;
             }
-            let config = seads_rl::load_config(dir)
-                .with_context(|| format!("resuming {}", dir.display()))?;
+            let config = crate::run_config(dir)?;
             crate::kernels::use_kernels(config.portable_numerics)?;
             match config.algorithm {
                 Algorithm::Seads => drive(&mut resume_on::<Trainer>(dir, device)?, args.quiet),
@@ -166,7 +165,8 @@ pub fn resume<L: Learner>(
     let run = run.map_err(|e| match e {
         seads_rl::RlError::Damaged { .. }
         | seads_rl::RlError::CheckpointsMissing { .. }
-        | seads_rl::RlError::NoCheckpoint { .. } => BadInput(e.into()).into(),
+        | seads_rl::RlError::NoCheckpoint { .. }
+        | seads_rl::RlError::Config(_) => BadInput(e.into()).into(),
         other => anyhow::Error::from(other),
     });
     let run = run.with_context(|| format!("resuming {}", dir.display()))?;

@@ -349,8 +349,7 @@ pub struct UarmEvaluateArgs {
 /// `seads uarm evaluate`: success with re-planning of a robot run's checkpoint, as at the end of
 /// `seads uarm train`.
 pub fn evaluate_run(args: UarmEvaluateArgs) -> Result<()> {
-    let config =
-        load_config(&args.run).with_context(|| format!("loading run {}", args.run.display()))?;
+    let config = crate::run_config(&args.run)?;
     let _lock = crate::lock_run(&args.run)?;
     crate::kernels::use_kernels(config.portable_numerics)?;
     let action_space = ActionSpace::of_env(&config.env).ok_or_else(|| {

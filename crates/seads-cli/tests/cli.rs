@@ -1837,3 +1837,69 @@ fn an_evaluation_refuses_a_config_edited_since_the_checkpoint() {
         "--quiet",
     ]);
 }
+
+/// A run directory whose name holds a comma and a quote (`a,"b`) is its own variant in the
+/// report; every CSV the report writes reads back with one field per column in every row.
+#[test]
+fn report_csvs_quote_names_with_commas() {
+    let dir = tempfile::tempdir().unwrap();
+    let odd = dir.path().join("a,\"b");
+    copy_dir(&tiny_run().join("run"), &odd);
+    let report = dir.path().join("report");
+    seads_ok(&["report", s(&odd), "--out", s(&report)]);
+    let mut checked = 0;
+    for entry in std::fs::read_dir(&report).unwrap() {
+        let path = entry.unwrap().path();
+        if path.extension().is_none_or(|e| e != "csv") {
+            continue;
+        }
+        let mut reader = csv::Reader::from_path(&path).unwrap();
+        let columns = reader.headers().unwrap().len();
+        let (mut rows, mut named) = (0, 0);
+        for record in reader.records() {
+            let record = record.unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+            assert_eq!(record.len(), columns, "{}: {record:?}", path.display());
+            rows += 1;
+            named += usize::from(record.iter().any(|f| f.contains("a,\"b")));
+        }
+        assert_eq!(named, rows, "{}: every row names the run", path.display());
+        checked += usize::from(rows > 0);
+    }
+    assert!(checked >= 3, "{checked} CSV files with rows");
+}
+
+/// A run that is not there, a file or a link loop given as a run, a folder given as `--config`,
+/// and a run whose `config.toml` is garbage or was edited since its checkpoint are the user's
+/// input to fix: exit 2 and one line, whatever the command.
+#[test]
+fn runs_that_cannot_be_read_are_bad_input() {
+    let dir = tempfile::tempdir().unwrap();
+    let missing = dir.path().join("missing");
+    let file = dir.path().join("file");
+    std::fs::write(&file, "not a run").unwrap();
+    let looped = dir.path().join("loop");
+    std::os::unix::fs::symlink(&looped, &looped).unwrap();
+    for run in [&missing, &file, &looped] {
+        check_bad_input(&["evaluate", "--run", s(run)], "loading run");
+        check_bad_input(&["train", "--resume", s(run)], "loading run");
+        check_bad_input(
+            &["plot", "--run", s(run), "--out", s(&dir.path().join("f"))],
+            "loading run",
+        );
+    }
+    check_bad_input(
+        &["train", "--config", s(dir.path()), "--out", s(&missing)],
+        "reading",
+    );
+    let run = dir.path().join("run");
+    copy_dir(&tiny_run().join("run"), &run);
+    let config = std::fs::read_to_string(run.join("config.toml")).unwrap();
+    std::fs::write(run.join("config.toml"), "env = [").unwrap();
+    check_bad_input(&["train", "--resume", s(&run)], "loading run");
+    std::fs::write(
+        run.join("config.toml"),
+        config.replace("max_solution_depth = 5", "max_solution_depth = 4"),
+    )
+    .unwrap();
+    check_bad_input(&["train", "--resume", s(&run)], "max_solution_depth");
+}

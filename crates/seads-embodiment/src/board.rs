@@ -7,7 +7,7 @@ use rand::{RngExt, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use seads_games::{
     BoardDataset, BoardGame, GameKind, LightsOut, MoveId, Split, SymbolicState, TileSwap,
-    sample_by_action_sampling,
+    action_sampling_boards, sample_by_action_sampling,
 };
 
 use crate::{EnvConfig, EnvError};
@@ -71,6 +71,21 @@ impl BoardState {
             }
             BoardSource::Dataset(data)
         } else {
+            // A depth that few move sets reach may have no board in the split (7×7 has one board
+            // of depth 49): said now, not found by drawing for ever.
+            let split = config.reset_split;
+            let depths = if config.random_solution_depth {
+                1..=max_depth
+            } else {
+                max_depth..=max_depth
+            };
+            for d in depths {
+                if lacks_boards(game.as_ref(), size, d, split) {
+                    return Err(EnvError::InvalidConfig(format!(
+                        "{kind} {size}×{size} has no {split} boards of solution depth {d} (max_solution_depth = {max_depth})"
+                    )));
+                }
+            }
             BoardSource::ActionSampling
         };
         let goal = game.goal();
@@ -119,6 +134,7 @@ impl BoardState {
                 .expect("checked in new()"),
             BoardSource::ActionSampling => {
                 sample_by_action_sampling(self.game.as_ref(), depth, self.split, &mut self.rng)
+                    .expect("checked in new()")
             }
         };
     }
@@ -154,6 +170,17 @@ pub(crate) fn shared<K: Ord, V>(cache: &Shared<K, V>, key: K, make: impl FnOnce(
     cache.entry(key).or_insert_with(|| Arc::new(make())).clone()
 }
 
+/// Whether `split` holds no board that `depth` distinct moves make, for a game too large to
+/// enumerate (listed only where few move sets reach the depth), remembered per process: every
+/// environment of a vector asks it.
+fn lacks_boards(game: &dyn BoardGame, size: usize, depth: usize, split: Split) -> bool {
+    static CACHE: Shared<(GameKind, usize, usize, bool), bool> = OnceLock::new();
+    let key = (game.kind(), size, depth, split == Split::Train);
+    *shared(&CACHE, key, || {
+        action_sampling_boards(game, depth, split).is_some_and(|b| b.is_empty())
+    })
+}
+
 /// Enumerated boards are shared by every environment of the same game, size and depth.
 fn dataset(kind: GameKind, size: usize, max_depth: usize) -> Arc<BoardDataset> {
     static CACHE: Shared<(GameKind, usize, usize), BoardDataset> = OnceLock::new();
@@ -166,4 +193,39 @@ fn dataset(kind: GameKind, size: usize, max_depth: usize) -> Arc<BoardDataset> {
         };
         data.expect("LightsOut ≤ 5×5 and TileSwap are enumerable")
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use seads_games::{LightsOut, split_of};
+
+    /// 7×7 LightsOut has one board of depth 49: an environment that would reset to depth 49 in
+    /// the split that lacks it is refused when it is made (it used to draw for ever), and one in
+    /// the split that has it resets to that board.
+    #[test]
+    fn a_depth_a_split_lacks_is_refused_when_the_board_is_made() {
+        let game = LightsOut::new(7).unwrap();
+        let all = game.apply_all(game.goal(), &(0..49).collect::<Vec<_>>());
+        let has = split_of(&game.values(all));
+        let lacks = match has {
+            Split::Train => Split::Test,
+            Split::Test => Split::Train,
+        };
+        let config = |split| EnvConfig {
+            reset_split: split,
+            max_solution_depth: 49,
+            random_solution_depth: false,
+            ..EnvConfig::default()
+        };
+        let refused = BoardState::new(GameKind::LightsOut, 7, &config(lacks))
+            .err()
+            .unwrap();
+        assert!(refused.to_string().contains("no"), "{refused}");
+        assert!(refused.to_string().contains("depth 49"), "{refused}");
+        let mut board = BoardState::new(GameKind::LightsOut, 7, &config(has)).unwrap();
+        board.seed(3);
+        board.reset();
+        assert_eq!(board.board(), all);
+    }
 }

@@ -1,6 +1,7 @@
 //! Sampling boards of a given solution depth from a given split (SPEC §1.5).
 
-use rand::seq::SliceRandom;
+use itertools::Itertools as _;
+use rand::seq::{IndexedRandom as _, SliceRandom};
 use rand::{Rng, RngExt};
 
 use crate::{BoardGame, Enumerable, GameError, Split, SymbolicState, enumerate, split_of};
@@ -76,21 +77,63 @@ fn split_index(split: Split) -> usize {
 /// A board made by `depth` distinct random moves from the goal, redrawn until it lies in `split`
 /// (the reference's `reset_by_action_sampling`, used for boards too large to enumerate). The true
 /// solution depth may be smaller than `depth`.
+///
+/// `None` where no such board lies in `split`: a depth that few move sets reach (at most
+/// [`FEW_MOVE_SETS`]) may have none there, which [`action_sampling_boards`] tells beforehand. The
+/// draws stop after [`MAX_DRAWS`]; then such a depth's boards are listed and one is drawn
+/// among them.
 pub fn sample_by_action_sampling<R: Rng + ?Sized>(
     game: &dyn BoardGame,
     depth: usize,
     split: Split,
     rng: &mut R,
-) -> SymbolicState {
+) -> Option<SymbolicState> {
     let mut moves: Vec<usize> = (0..game.num_moves()).collect();
     let depth = depth.min(moves.len());
-    loop {
+    for _ in 0..MAX_DRAWS {
         moves.shuffle(rng);
         let board = game.apply_all(game.goal(), &moves[..depth]);
         if split_of(&game.values(board)) == split {
-            return board;
+            return Some(board);
         }
     }
+    action_sampling_boards(game, depth, split)?
+        .choose(rng)
+        .copied()
+}
+
+/// Draws of [`sample_by_action_sampling`] before it lists the boards instead.
+pub const MAX_DRAWS: usize = 10_000;
+
+/// The most move sets of one size that [`action_sampling_boards`] lists.
+pub const FEW_MOVE_SETS: u128 = 4096;
+
+/// The boards in `split` that `depth` distinct moves from the goal make, listed (distinct, in
+/// move-set order) where there are at most [`FEW_MOVE_SETS`] such move sets; `None` where there
+/// are more (then both splits hold many of them).
+pub fn action_sampling_boards(
+    game: &dyn BoardGame,
+    depth: usize,
+    split: Split,
+) -> Option<Vec<SymbolicState>> {
+    let n = game.num_moves();
+    let depth = depth.min(n);
+    // C(n, depth), stopped once it passes the limit.
+    let mut sets: u128 = 1;
+    for i in 0..depth.min(n - depth) {
+        sets = sets * (n - i) as u128 / (i + 1) as u128;
+        if sets > FEW_MOVE_SETS {
+            return None;
+        }
+    }
+    let mut boards: Vec<SymbolicState> = (0..n)
+        .combinations(depth)
+        .map(|moves| game.apply_all(game.goal(), &moves))
+        .filter(|&board| split_of(&game.values(board)) == split)
+        .collect();
+    let mut seen = std::collections::BTreeSet::new();
+    boards.retain(|&b| seen.insert(b));
+    Some(boards)
 }
 
 #[cfg(test)]
@@ -138,11 +181,41 @@ mod tests {
         let g = LightsOut::new(9).unwrap();
         let draw = |seed| {
             let mut rng = ChaCha8Rng::seed_from_u64(seed);
-            sample_by_action_sampling(&g, 5, Split::Train, &mut rng)
+            sample_by_action_sampling(&g, 5, Split::Train, &mut rng).unwrap()
         };
         let b = draw(3);
         assert_eq!(split_of(&g.values(b)), Split::Train);
         assert!(b.count_ones() > 0);
         assert_eq!(draw(3), b);
+    }
+
+    /// 7×7 LightsOut has one board that all 49 moves make: the other split has no board of
+    /// depth 49, which is said (`None`, an empty list) instead of drawn for ever; depth 48's 49
+    /// boards are listed and split; depths that many move sets reach are not listed.
+    #[test]
+    fn a_depth_without_boards_in_a_split_is_said_not_drawn_for_ever() {
+        let g = LightsOut::new(7).unwrap();
+        let all = g.apply_all(g.goal(), &(0..49).collect::<Vec<_>>());
+        let (has, lacks) = match split_of(&g.values(all)) {
+            Split::Train => (Split::Train, Split::Test),
+            Split::Test => (Split::Test, Split::Train),
+        };
+        let mut rng = ChaCha8Rng::seed_from_u64(1);
+        assert_eq!(action_sampling_boards(&g, 49, has), Some(vec![all]));
+        assert_eq!(action_sampling_boards(&g, 49, lacks), Some(Vec::new()));
+        assert_eq!(sample_by_action_sampling(&g, 49, has, &mut rng), Some(all));
+        assert_eq!(sample_by_action_sampling(&g, 49, lacks, &mut rng), None);
+        let train = action_sampling_boards(&g, 48, Split::Train).unwrap();
+        let test = action_sampling_boards(&g, 48, Split::Test).unwrap();
+        assert_eq!(
+            train.len() + test.len(),
+            49,
+            "49 distinct boards of 48 moves"
+        );
+        assert_eq!(
+            action_sampling_boards(&g, 5, Split::Train),
+            None,
+            "C(49, 5) sets"
+        );
     }
 }

@@ -48,7 +48,9 @@ pub mod tables;
 mod tileswap;
 
 pub use bits::SymbolicState;
-pub use dataset::{BoardDataset, sample_by_action_sampling};
+pub use dataset::{
+    BoardDataset, FEW_MOVE_SETS, MAX_DRAWS, action_sampling_boards, sample_by_action_sampling,
+};
 pub use enumerate::{DepthTable, Enumerable, Enumeration, enumerate};
 pub use gf2::Gf2Solver;
 pub use lightsout::LightsOut;

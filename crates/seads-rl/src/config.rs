@@ -554,6 +554,43 @@ impl TrainConfig {
         if self.num_skills == Some(0) {
             return bad("num_skills must be at least 1".into());
         }
+        // Counts that set a loop's length or a pool's size: beyond these a run would spawn more
+        // threads than a machine has, or never finish an epoch.
+        let caps: [(&str, u64, u64); 6] = [
+            ("threads", self.threads as u64, MAX_THREADS),
+            (
+                "sac_threads_alone",
+                self.sac_threads_alone as u64,
+                MAX_THREADS,
+            ),
+            ("eval_seeds", self.eval_seeds, MAX_PER_EPOCH),
+            (
+                "sac.updates_per_epoch",
+                self.sac.updates_per_epoch as u64,
+                MAX_PER_EPOCH,
+            ),
+            (
+                "baseline.samples_per_epoch",
+                self.baseline.samples_per_epoch as u64,
+                MAX_PER_EPOCH,
+            ),
+            (
+                "baseline.eval_boards",
+                self.baseline.eval_boards as u64,
+                MAX_PER_EPOCH,
+            ),
+        ];
+        for (name, value, most) in caps {
+            if value > most {
+                return bad(format!("{name} must be at most {most}, got {value}"));
+            }
+        }
+        if self.baseline.updates_per_epoch > MAX_PER_EPOCH as f64 {
+            return bad(format!(
+                "baseline.updates_per_epoch must be at most {MAX_PER_EPOCH}, got {}",
+                self.baseline.updates_per_epoch
+            ));
+        }
         // TOML integers are 64-bit signed: a larger value would be written into config.toml but
         // never read back.
         for (name, value) in [("seed", self.seed), ("env_steps", self.env_steps)] {
@@ -698,6 +735,15 @@ pub fn merge_toml(base: &mut toml::Table, layer: &toml::Table) {
         }
     }
 }
+
+/// The most threads a configuration may ask for (libtorch's and the environments'): more than
+/// any machine this runs on has cores.
+const MAX_THREADS: u64 = 1024;
+
+/// The most evaluations, updates, samples or boards a configuration may ask for per epoch (or
+/// per evaluation): a million, far beyond the paper's settings (tens to thousands), far below
+/// what would never end.
+const MAX_PER_EPOCH: u64 = 1_000_000;
 
 /// Fields that a resumed or evaluated run may change: the budget (`--env-steps`) and the thread
 /// counts, which sweeps and the robot set per task and which do not change a run's numbers (a
@@ -897,6 +943,9 @@ mod tests {
             (sac_batch, model_batch, replay) in (size(), size(), size()),
             (lr, alpha, gamma, p) in (real(), real(), real(), real()),
             baseline in any::<bool>(),
+            (threads, eval_seeds, updates) in (size(), size(), size()),
+            (samples, boards) in (size(), size()),
+            (seed, env_steps) in (any::<u64>(), any::<u64>()),
         ) {
             let mut config = TrainConfig::preset("lightsout-cursor").unwrap();
             config.num_skills = Some(num_skills);
@@ -912,9 +961,17 @@ mod tests {
             config.sac.alpha = alpha;
             config.sac.gamma = gamma;
             config.relabel.sac_p = p;
+            config.threads = threads;
+            config.eval_seeds = eval_seeds as u64;
+            config.seed = seed;
+            config.env_steps = env_steps;
             if baseline {
                 config = TrainConfig { algorithm: Algorithm::Sac, ..config };
                 config.baseline.replay_capacity = replay;
+                config.baseline.samples_per_epoch = samples;
+                config.baseline.eval_boards = boards;
+            } else {
+                config.sac.updates_per_epoch = updates;
             }
             if config.validate().is_ok() {
                 let env = seads_embodiment::make_env(&config.env, &config.env_config).unwrap();
@@ -923,6 +980,15 @@ mod tests {
                 prop_assert!(lr.is_finite() && lr > 0.0 && alpha.is_finite() && alpha > 0.0);
                 prop_assert!((0.0..=1.0).contains(&gamma) && (0.0..=1.0).contains(&p));
                 prop_assert!(num_skills > 0 && sac_batch > 0 && episodes > 0);
+                prop_assert!(threads as u64 <= MAX_THREADS);
+                prop_assert!((eval_seeds as u64) <= MAX_PER_EPOCH);
+                prop_assert!(config.sac.updates_per_epoch as u64 <= MAX_PER_EPOCH);
+                prop_assert!(config.baseline.samples_per_epoch as u64 <= MAX_PER_EPOCH);
+                prop_assert!(config.baseline.eval_boards as u64 <= MAX_PER_EPOCH);
+                prop_assert!(i64::try_from(seed).is_ok() && i64::try_from(env_steps).is_ok());
+                // What is accepted is written and read back as it was.
+                let back = TrainConfig::from_toml(&config.to_toml());
+                prop_assert!(back.is_ok(), "{:?}", back.err());
             }
         }
     }

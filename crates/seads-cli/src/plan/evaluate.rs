@@ -3,7 +3,7 @@
 
 use std::path::PathBuf;
 
-use anyhow::{Context, Result, bail};
+use anyhow::{Result, bail};
 use clap::Args;
 use seads_games::Split;
 use seads_planner::{EvaluationKind, Protocol, TaskSet, summarise};
@@ -79,8 +79,7 @@ pub fn evaluate_run(args: EvaluateArgs) -> Result<()> {
             args.boards
         )));
     }
-    let mut config = seads_rl::load_config(&args.run)
-        .with_context(|| format!("loading run {}", args.run.display()))?;
+    let mut config = crate::run_config(&args.run)?;
     config.device = crate::usable_device(args.device)?;
     let _lock = crate::lock_run(&args.run)?;
     if config.algorithm.is_baseline() {

@@ -77,8 +77,7 @@ pub fn check_boards(boards: usize) -> Result<()> {
 /// Loads the agent of a run onto `device` (whichever device it trained on), turning a missing or
 /// foreign directory into a clear error.
 pub fn load_agent(run: &Path, checkpoint: Option<u64>, device: ComputeDevice) -> Result<Agent> {
-    let mut config = seads_rl::load_config(run)
-        .with_context(|| format!("loading the agent of run {}", run.display()))?;
+    let mut config = crate::run_config(run)?;
     config.device = crate::usable_device(device)?;
     crate::kernels::use_kernels(config.portable_numerics)?;
     if config.algorithm != seads_rl::Algorithm::Seads {

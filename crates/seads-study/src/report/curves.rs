@@ -6,6 +6,7 @@
 
 use std::fmt::Write as _;
 
+use super::csv_field;
 use super::runs::Group;
 use super::stats::{summary, worse_than};
 
@@ -81,7 +82,11 @@ pub fn coverage_over_training(
                     let _ = writeln!(
                         csv,
                         "{},{},{},coverage_at,{s},{:.4},{:.4}",
-                        g.env, g.variant, v.n, v.mean, v.std
+                        csv_field(&g.env),
+                        csv_field(&g.variant),
+                        v.n,
+                        v.mean,
+                        v.std
                     );
                 }
                 None => md += " – |",
@@ -94,7 +99,11 @@ pub fn coverage_over_training(
                 let _ = writeln!(
                     csv,
                     "{},{},{},mean_over_training,,{:.4},{:.4}",
-                    g.env, g.variant, v.n, v.mean, v.std
+                    csv_field(&g.env),
+                    csv_field(&g.variant),
+                    v.n,
+                    v.mean,
+                    v.std
                 );
             }
             None => md += " – |",

@@ -3,6 +3,7 @@
 
 use std::fmt::Write as _;
 
+use super::csv_field;
 use super::runs::Group;
 use super::stats::{median, summary};
 
@@ -77,8 +78,8 @@ pub fn deep_tables(groups: &[Group<'_>]) -> Option<(String, String)> {
             let _ = writeln!(
                 csv,
                 "{},{},{depth},{},{tasks},{solved},{:.4},{:.4},{:.3},{:.3},{timeouts},{},{},{}",
-                g.env,
-                g.variant,
+                csv_field(&g.env),
+                csv_field(&g.variant),
                 rows.len(),
                 rate.mean,
                 rate.std,

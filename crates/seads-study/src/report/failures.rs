@@ -9,6 +9,7 @@ use std::path::Path;
 use crate::Result;
 use serde::Deserialize;
 
+use super::csv_field;
 use super::runs::Group;
 use seads_planner::{EvaluationKind, STANDARD_DEPTHS};
 
@@ -164,9 +165,20 @@ pub fn failure_tables(groups: &[Group<'_>]) -> Result<Option<(String, String, St
             g.variant,
             counts.join(" | ")
         );
-        let _ = writeln!(csv, "{},{},{}", g.env, g.variant, counts.join(","));
+        let _ = writeln!(
+            csv,
+            "{},{},{}",
+            csv_field(&g.env),
+            csv_field(&g.variant),
+            counts.join(",")
+        );
         for (k, (all, unchanged)) in &s.per_skill {
-            let _ = writeln!(per_skill, "{},{},{k},{all},{unchanged}", g.env, g.variant);
+            let _ = writeln!(
+                per_skill,
+                "{},{},{k},{all},{unchanged}",
+                csv_field(&g.env),
+                csv_field(&g.variant)
+            );
         }
     }
     md += "\nFrom each run's `evaluation-replan-tasks.jsonl` (runs evaluated before that file existed \

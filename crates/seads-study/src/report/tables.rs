@@ -6,6 +6,7 @@ use std::fmt::Write as _;
 
 use seads_planner::DepthResult;
 
+use super::csv_field;
 use super::runs::{Group, RunData};
 use super::stats::{Summary, Test, median, summary, worse_than};
 use seads_planner::EvaluationKind as Mode;
@@ -132,7 +133,14 @@ pub fn coverage_csv(cells: &[CoverageCell]) -> String {
         let _ = writeln!(
             csv,
             "{},{},{},{},{:.4},{:.4},{:.4},{:.4},{u},{p},{p_exact},{sig}",
-            c.env, c.variant, c.skills, s.n, s.mean, s.std, s.min, s.max
+            csv_field(&c.env),
+            csv_field(&c.variant),
+            c.skills,
+            s.n,
+            s.mean,
+            s.std,
+            s.min,
+            s.max
         );
     }
     csv
@@ -237,7 +245,11 @@ pub fn noise_tables(groups: &[Group<'_>]) -> Option<(String, String)> {
                             let _ = writeln!(
                                 csv,
                                 "{},{},{mode},{sigma},{},{d},{:.4},{:.4}",
-                                g.env, g.variant, s.n, s.mean, s.std
+                                csv_field(&g.env),
+                                csv_field(&g.variant),
+                                s.n,
+                                s.mean,
+                                s.std
                             );
                         }
                         None => md += " – |",
@@ -296,7 +308,11 @@ pub fn success_tables(groups: &[Group<'_>]) -> (String, String) {
                         let _ = writeln!(
                             csv,
                             "{},{},{mode},{},{d},{:.4},{:.4}",
-                            g.env, g.variant, s.n, s.mean, s.std
+                            csv_field(&g.env),
+                            csv_field(&g.variant),
+                            s.n,
+                            s.mean,
+                            s.std
                         );
                     }
                     None => md += " – |",
@@ -446,8 +462,8 @@ pub fn length_tables(groups: &[Group<'_>]) -> (String, String) {
             let _ = writeln!(
                 csv,
                 "{},{},{d},{},{},{}",
-                g.env,
-                g.variant,
+                csv_field(&g.env),
+                csv_field(&g.variant),
                 solutions.len(),
                 median(&skills).map_or(String::new(), |v| v.to_string()),
                 median(&solutions).map_or(String::new(), |v| v.to_string())

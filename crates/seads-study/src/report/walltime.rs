@@ -88,8 +88,8 @@ pub fn walltime_tables(groups: &[Group<'_>]) -> (String, String) {
             let _ = write!(
                 csv,
                 "{},{},{},{},{}",
-                g.env,
-                g.variant,
+                csv_field(&g.env),
+                csv_field(&g.variant),
                 csv_field(&run.dir.display().to_string()),
                 s.wall_s,
                 s.env_steps
