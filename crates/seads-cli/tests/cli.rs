@@ -1903,3 +1903,75 @@ fn runs_that_cannot_be_read_are_bad_input() {
     .unwrap();
     check_bad_input(&["train", "--resume", s(&run)], "max_solution_depth");
 }
+
+/// `report --copy-runs` refuses, before writing anything, two runs that would be copied to one
+/// place (both named `lo1`) and a report folder inside a run it copies; a run given as `..` is
+/// copied under its own name.
+#[test]
+fn report_copies_never_collide_or_land_inside_a_run() {
+    let dir = tempfile::tempdir().unwrap();
+    let (a, b) = (dir.path().join("a/lo1"), dir.path().join("b/lo1"));
+    copy_dir(&tiny_run().join("run"), &a);
+    copy_dir(&tiny_run().join("run"), &b);
+    let out = dir.path().join("r");
+    check_bad_input(
+        &["report", s(&a), s(&b), "--out", s(&out), "--copy-runs"],
+        "would both be copied to runs/lo1",
+    );
+    assert!(!out.exists());
+    let inside = a.join("report");
+    check_bad_input(
+        &["report", s(&a), "--out", s(&inside), "--copy-runs"],
+        "lies inside",
+    );
+    assert!(!inside.exists());
+    let up = dir.path().join("up");
+    let done = seads_command()
+        .current_dir(a.join("checkpoints"))
+        .args(["report", "..", "--out", s(&up), "--copy-runs"])
+        .output()
+        .unwrap();
+    assert!(
+        done.status.success(),
+        "{}",
+        String::from_utf8_lossy(&done.stderr)
+    );
+    assert!(up.join("runs/lo1/metrics.jsonl").is_file());
+    assert!(
+        !up.join("metrics.jsonl").exists(),
+        "nothing copied into the report's top"
+    );
+}
+
+/// Metrics with a repeated or an out-of-order epoch are damage: resuming refuses the run in one
+/// line (exit 2) and a report leaves it out as damaged, never taking it as progress.
+#[test]
+fn repeated_or_out_of_order_epochs_are_damage() {
+    let dir = tempfile::tempdir().unwrap();
+    for (name, reorder) in [("repeated", false), ("reversed", true)] {
+        let run = dir.path().join(name);
+        copy_dir(&tiny_run().join("run"), &run);
+        let text = std::fs::read_to_string(run.join("metrics.jsonl")).unwrap();
+        let mut lines: Vec<&str> = text.lines().collect();
+        if reorder {
+            let n = lines.len();
+            lines.swap(n - 1, n - 2);
+        } else {
+            lines.push(lines[lines.len() - 1]);
+        }
+        std::fs::write(run.join("metrics.jsonl"), lines.join("\n") + "\n").unwrap();
+        check_bad_input(
+            &["train", "--resume", s(&run), "--env-steps", "900"],
+            "after epoch",
+        );
+        let report = dir.path().join(format!("report-{name}"));
+        let out = seads(&["report", s(&run), "--out", s(&report)]);
+        let md = std::fs::read_to_string(report.join("report.md")).unwrap_or_default();
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        assert!(
+            md.contains("damaged") || stderr.contains("after epoch"),
+            "{name}: {stderr}\n{md}"
+        );
+        assert!(!md.contains("1 finished"), "{name}: {md}");
+    }
+}

@@ -961,6 +961,10 @@ fn thread_counts_beyond_the_machine_are_refused() {
         &["plan-bench", "--depths", "1", "--threads", "1000000"],
         "more than this machine can run",
     );
+    check_bad_input(
+        &["plan-bench", "--depths", "1", "--hidden", "1000000,1000000"],
+        "each from 1 to 16384",
+    );
     assert_eq!(snapshot(&out), planned, "nothing trained or written");
 }
 

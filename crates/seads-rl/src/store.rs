@@ -478,7 +478,22 @@ pub fn is_copy_without_checkpoints(dir: &Path) -> bool {
 
 /// The whole lines of `dir/metrics.jsonl`, and whether a torn last line was left out.
 pub(crate) fn read_metrics_text<M: MetricsLine>(dir: &Path) -> Result<(Vec<M>, bool), RlError> {
-    read_json_lines(&dir.join(METRICS))
+    let (lines, torn): (Vec<M>, bool) = read_json_lines(&dir.join(METRICS))?;
+    // Training appends one line per evaluated epoch, in order: a repeated or an earlier epoch is
+    // damage, which neither resume nor a report may take as progress.
+    for (i, pair) in lines.windows(2).enumerate() {
+        let (before, after) = (pair[0].epoch(), pair[1].epoch());
+        if after <= before {
+            return Err(RlError::Damaged {
+                dir: dir.display().to_string(),
+                reason: format!(
+                    "{METRICS} line {} has epoch {after} after epoch {before}",
+                    i + 2
+                ),
+            });
+        }
+    }
+    Ok((lines, torn))
 }
 
 /// The whole lines of a JSON Lines file, and whether a torn last line (a line without its

@@ -40,11 +40,22 @@ pub struct PlanBenchArgs {
     json: bool,
 }
 
+/// The widest hidden layer `--hidden` may ask for (the paper's is 256).
+const MAX_WIDTH: i64 = 16_384;
+
 /// `seads plan-bench`: BFS with a forward model fitted to the LightsOut 5×5 move table.
 pub fn plan_bench(args: PlanBenchArgs) -> Result<()> {
     let device = crate::usable_device(args.device)?;
     let threads = args.threads as usize;
     crate::check_threads("--threads", threads)?;
+    // The fitted model's layers: a size beyond these would exhaust memory inside libtorch.
+    if args.hidden.is_empty() || args.hidden.iter().any(|&h| !(1..=MAX_WIDTH).contains(&h)) {
+        return Err(crate::BadInput(anyhow::anyhow!(
+            "--hidden {:?}: one or more layer sizes, each from 1 to {MAX_WIDTH}",
+            args.hidden
+        ))
+        .into());
+    }
     // The search's parts and bookkeeping run on the pool, each part on one libtorch thread.
     seads_rl::set_threads(1);
     let pool = rayon::ThreadPoolBuilder::new()

@@ -78,6 +78,9 @@ pub fn write_report(options: &ReportOptions, out: &Path) -> Result<ReportSummary
             "--reference {r:?} is not a variant of these runs"
         )));
     }
+    if options.copy_runs {
+        check_copies(&collection, out)?;
+    }
     std::fs::create_dir_all(out).doing(|| format!("creating {}", out.display()))?;
     let write = |name: &str, text: &str| -> Result<()> {
         seads_rl::store::write_atomic(&out.join(name), text.as_bytes())?;
@@ -291,6 +294,52 @@ pub fn write_report(options: &ReportOptions, out: &Path) -> Result<ReportSummary
         figures: figures.len(),
         report: out.join("report.md"),
     })
+}
+
+/// Refuses, before anything is written, copies that would collide or land inside what they
+/// copy: two runs with one destination under `runs/` (runs of the same name outside a sweep), or
+/// a report folder inside a run or sweep it copies.
+fn check_copies(collection: &runs::Collection, out: &Path) -> Result<()> {
+    let mut taken: std::collections::BTreeMap<PathBuf, &Path> = Default::default();
+    for run in collection
+        .runs
+        .iter()
+        .filter(|r| r.finished() && r.damage.is_empty())
+    {
+        if let Some(other) = taken.insert(run.copy_to.clone(), &run.dir) {
+            return Err(StudyError::invalid(format!(
+                "{} and {} would both be copied to runs/{}: report them without --copy-runs, \
+                 or rename one",
+                other.display(),
+                run.dir.display(),
+                run.copy_to.display()
+            )));
+        }
+    }
+    // The report folder, or the nearest folder above it that exists, as a real path.
+    let mut probe = out.to_path_buf();
+    let target = loop {
+        if let Ok(real) = std::fs::canonicalize(&probe) {
+            break real;
+        }
+        match probe.parent() {
+            Some(parent) if !parent.as_os_str().is_empty() => probe = parent.to_path_buf(),
+            _ => break std::env::current_dir().unwrap_or_default(),
+        }
+    };
+    let dirs = collection.runs.iter().map(|r| r.dir.as_path());
+    for dir in dirs.chain(collection.sweep_dirs.iter().map(PathBuf::as_path)) {
+        if let Ok(dir) = std::fs::canonicalize(dir)
+            && target.starts_with(&dir)
+        {
+            return Err(StudyError::invalid(format!(
+                "{} lies inside {}, which --copy-runs copies: write the report elsewhere",
+                out.display(),
+                dir.display()
+            )));
+        }
+    }
+    Ok(())
 }
 
 /// Which evaluation files the end-of-training tables left out (they evaluated an earlier

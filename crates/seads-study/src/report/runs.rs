@@ -344,7 +344,9 @@ pub fn collect(inputs: &[PathBuf]) -> Result<Collection> {
             if !first_time(input) {
                 continue;
             }
-            let name = input.file_name().map_or_else(
+            // Named by the directory itself, also when given as `.` or `..`.
+            let real = std::fs::canonicalize(input).unwrap_or_else(|_| input.clone());
+            let name = real.file_name().map_or_else(
                 || input.display().to_string(),
                 |n| n.to_string_lossy().into_owned(),
             );

@@ -148,12 +148,17 @@ impl Manifest {
             );
         }
         let known = env_names();
+        let mut listed = std::collections::BTreeSet::new();
         for env in &self.environments {
             if !known.contains(&env.as_str()) {
                 fail!(
                     "unknown environment {env:?}; valid environments: {}",
                     known.join(", ")
                 );
+            }
+            // One run directory per environment: listed twice, its runs would be counted twice.
+            if !listed.insert(env.as_str()) {
+                fail!("environment {env:?} is listed twice");
             }
         }
         let mut names = std::collections::BTreeSet::new();
@@ -381,6 +386,13 @@ env_overrides = { "lightsout-cursor" = { num_skills = 30 }, "tileswap-cursor" = 
             (
                 SMALL.replace("seeds = [1, 2]", "seeds = [1, 1]"),
                 "listed twice",
+            ),
+            (
+                SMALL.replace(
+                    "environments = [\"lightsout-cursor\"",
+                    "environments = [\"lightsout-cursor\", \"lightsout-cursor\"",
+                ),
+                "environment \"lightsout-cursor\" is listed twice",
             ),
             (
                 SMALL.replace("name = \"small\"", "name = \"small\"\nreference = \"sead\""),

@@ -126,7 +126,7 @@ pub fn check_outputs(run: &Path, record: &Record) -> std::result::Result<(), Mis
         let path = run.join(&name);
         let readable = if name == seads_rl::store::METRICS {
             match seads_rl::store::read_json_lines::<serde_json::Value>(&path) {
-                Ok((lines, false)) if !lines.is_empty() => Ok(()),
+                Ok((lines, false)) if !lines.is_empty() => metrics_in_order(&lines),
                 Ok(_) => Err("it is empty or ends in a torn line".to_owned()),
                 Err(e) => Err(format!("{e}")),
             }
@@ -151,6 +151,46 @@ pub fn check_outputs(run: &Path, record: &Record) -> std::result::Result<(), Mis
         }
     }
     Ok(())
+}
+
+/// Whether metrics lines are what training writes: each an object with a whole `epoch` and
+/// `env_steps`, the epochs strictly rising (a line of another type, a repeated or an
+/// out-of-order epoch is damage, not progress).
+fn metrics_in_order(lines: &[serde_json::Value]) -> std::result::Result<(), String> {
+    let mut last: Option<u64> = None;
+    for (i, line) in lines.iter().enumerate() {
+        let field = |key: &str| line.get(key).and_then(serde_json::Value::as_u64);
+        let (Some(epoch), Some(_)) = (field("epoch"), field("env_steps")) else {
+            return Err(format!("line {} is not a metrics line", i + 1));
+        };
+        if last.is_some_and(|l| epoch <= l) {
+            return Err(format!(
+                "line {} has epoch {epoch} after epoch {}",
+                i + 1,
+                last.unwrap_or_default()
+            ));
+        }
+        last = Some(epoch);
+    }
+    Ok(())
+}
+
+/// Whether the run's budget (`config.toml`) lies beyond its last metrics line: raised with
+/// `train --resume --env-steps` after its task finished, so there is training left.
+fn budget_raised(run: &Path) -> bool {
+    let Ok(config) = seads_rl::load_config(run) else {
+        return false;
+    };
+    let Ok((lines, _)) =
+        seads_rl::store::read_json_lines::<serde_json::Value>(&run.join(seads_rl::store::METRICS))
+    else {
+        return false;
+    };
+    let steps = lines
+        .last()
+        .and_then(|l| l.get("env_steps"))
+        .and_then(serde_json::Value::as_u64);
+    steps.is_some_and(|s| s < config.env_steps)
 }
 
 /// The host name, for the record (empty if unknown).
@@ -270,6 +310,7 @@ pub fn status(run: &Path) -> Result<(Status, Option<Record>)> {
     } else {
         match record.as_ref().map(|r| r.outcome) {
             Some(Outcome::Done) => match check_outputs(run, record.as_ref().expect("done")) {
+                Ok(()) if budget_raised(run) => Status::Pending,
                 Ok(()) => Status::Done,
                 Err(Missing::Gone(_)) => Status::Pending,
                 Err(Missing::Unreadable(_)) => Status::Damaged,
@@ -336,7 +377,11 @@ mod tests {
         let dir = tempfile::tempdir().unwrap();
         let run = dir.path();
         std::fs::create_dir(run.join("checkpoints")).unwrap();
-        std::fs::write(run.join("metrics.jsonl"), "{\"epoch\":1}\n").unwrap();
+        std::fs::write(
+            run.join("metrics.jsonl"),
+            "{\"epoch\":1,\"env_steps\":10}\n",
+        )
+        .unwrap();
         // A run that trained (checkpoints folder present) and was killed: to be resumed.
         assert_eq!(status(run).unwrap().0, Status::Pending);
         std::fs::remove_dir(run.join("checkpoints")).unwrap();
@@ -353,7 +398,11 @@ mod tests {
         assert_eq!(status(planned.path()).unwrap().0, Status::Pending);
         // Done needs readable outputs: a gone evaluation is made again, an unreadable one is
         // damage, named.
-        std::fs::write(run.join("metrics.jsonl"), "{\"epoch\":1}\n").unwrap();
+        std::fs::write(
+            run.join("metrics.jsonl"),
+            "{\"epoch\":1,\"env_steps\":10}\n",
+        )
+        .unwrap();
         std::fs::write(run.join("evaluation-replan.json"), "{}").unwrap();
         Record::write(run, Outcome::Done, 1, None).unwrap();
         let record = Record::read(run).unwrap().unwrap();
@@ -375,11 +424,60 @@ mod tests {
                 .contains("evaluation-replan.json is gone")
         );
         std::fs::write(run.join("evaluation-replan.json"), "{}").unwrap();
-        std::fs::write(run.join("metrics.jsonl"), "{\"epoch\":1}\n{\"ep").unwrap();
+        std::fs::write(
+            run.join("metrics.jsonl"),
+            "{\"epoch\":1,\"env_steps\":10}\n{\"ep",
+        )
+        .unwrap();
         assert_eq!(status(run).unwrap().0, Status::Damaged);
-        std::fs::write(run.join("metrics.jsonl"), "{\"epoch\":1}\n").unwrap();
+        std::fs::write(
+            run.join("metrics.jsonl"),
+            "{\"epoch\":1,\"env_steps\":10}\n",
+        )
+        .unwrap();
         // Held by a task, it is running whatever its files say.
         let _claim = Claim::take(run, PATIENCE).unwrap();
         assert_eq!(status(run).unwrap().0, Status::Running);
+    }
+
+    /// Metrics that are not what training writes (a valid JSON line of another type, a repeated
+    /// or an out-of-order epoch) are damage, not progress; a finished run whose budget was
+    /// raised since (`train --resume --env-steps`) is pending again, so that a sweep trains
+    /// and evaluates it on.
+    #[test]
+    fn bad_metrics_are_damage_and_a_raised_budget_is_pending() {
+        let dir = tempfile::tempdir().unwrap();
+        let run = dir.path();
+        let line = |e: u64, s: u64| format!("{{\"epoch\":{e},\"env_steps\":{s}}}\n");
+        std::fs::write(run.join("metrics.jsonl"), line(1, 10) + &line(2, 20)).unwrap();
+        Record::write(run, Outcome::Done, 1, None).unwrap();
+        assert_eq!(status(run).unwrap().0, Status::Done);
+        for (bad, why) in [
+            (line(1, 10) + "[1, 2]\n", "line 2 is not a metrics line"),
+            (
+                line(1, 10) + "{\"epoch\":\"2\",\"env_steps\":20}\n",
+                "line 2 is not",
+            ),
+            (line(1, 10) + &line(1, 10), "epoch 1 after epoch 1"),
+            (line(2, 20) + &line(1, 10), "epoch 1 after epoch 2"),
+        ] {
+            std::fs::write(run.join("metrics.jsonl"), bad).unwrap();
+            assert_eq!(status(run).unwrap().0, Status::Damaged, "{why}");
+            assert!(damage(run).unwrap().contains(why), "{:?}", damage(run));
+        }
+        // The budget of config.toml beyond the last line: pending, not done.
+        std::fs::write(run.join("metrics.jsonl"), line(1, 10) + &line(2, 20)).unwrap();
+        let config = seads_rl::TrainConfig {
+            env_steps: 20,
+            ..seads_rl::TrainConfig::preset("lightsout-cursor").unwrap()
+        };
+        std::fs::write(run.join("config.toml"), config.to_toml()).unwrap();
+        assert_eq!(status(run).unwrap().0, Status::Done);
+        let raised = seads_rl::TrainConfig {
+            env_steps: 30,
+            ..config
+        };
+        std::fs::write(run.join("config.toml"), raised.to_toml()).unwrap();
+        assert_eq!(status(run).unwrap().0, Status::Pending);
     }
 }
