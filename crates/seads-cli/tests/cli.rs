@@ -1975,3 +1975,30 @@ fn repeated_or_out_of_order_epochs_are_damage() {
         assert!(!md.contains("1 finished"), "{name}: {md}");
     }
 }
+
+/// A damaged JSON Lines file of a run is named as what it is, with its line, not as a checkpoint
+/// that cannot be loaded.
+#[test]
+fn a_garbage_evaluation_file_is_named_as_such() {
+    let dir = tempfile::tempdir().unwrap();
+    let run = dir.path().join("run");
+    copy_dir(&tiny_run().join("run"), &run);
+    std::fs::write(run.join("evaluation-over-training.jsonl"), "garbage\n").unwrap();
+    let out = seads(&[
+        "evaluate",
+        "--run",
+        s(&run),
+        "--checkpoints",
+        "all",
+        "--boards",
+        "1",
+    ]);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(!out.status.success());
+    assert_eq!(stderr.lines().count(), 1, "{stderr}");
+    assert!(
+        stderr.contains("cannot read") && stderr.contains("evaluation-over-training.jsonl:1"),
+        "{stderr}"
+    );
+    assert!(!stderr.contains("cannot load checkpoint"), "{stderr}");
+}

@@ -124,8 +124,9 @@ pub enum RlError {
         /// What went wrong.
         reason: String,
     },
-    /// A checkpoint file could not be read or parsed.
-    #[error("cannot load checkpoint {path}")]
+    /// A file of the run (a checkpoint's, a JSON Lines file's line) could not be read or parsed;
+    /// `path` names it (`file:line` for a line).
+    #[error("cannot read {path}")]
     Unreadable {
         /// The file.
         path: String,
