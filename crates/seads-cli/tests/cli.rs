@@ -1438,7 +1438,7 @@ proptest::proptest! {
     /// or a memory kill; a command that accepts a huge value may still be working at the end.
     #[test]
     fn numeric_options_never_panic(
-        option in 0usize..9,
+        option in 0usize..13,
         value in proptest::sample::select(vec![
             "0", "1", "-1", "nan", "inf", "-inf", "1e300", "1e-300", "4294967297",
             "9223372036854775807", "18446744073709551615", "18446744073709551616", "abc", "",
@@ -1450,7 +1450,7 @@ proptest::proptest! {
         let run = tiny_run().join("run");
         let run = run.to_str().unwrap();
         let board = vec!["0"; 25].join(",");
-        let templates: [&[&str]; 9] = [
+        let templates: [&[&str]; 13] = [
             &["record", "--env", "lightsout-cursor", "--episodes", "1", "--steps", "V", "--out", out],
             &["record", "--env", "lightsout-cursor", "--episodes", "V", "--steps", "1", "--out", out],
             &["env-bench", "--env", "lightsout-cursor", "--steps", "V", "--threads", "1"],
@@ -1460,6 +1460,10 @@ proptest::proptest! {
             &["evaluate", "--run", run, "--boards", "V", "--quiet", "--timeout", "1"],
             &["solve", "--run", run, "--board", &board, "--timeout", "V"],
             &["uarm", "calibrate", "--port", "sim", "--d-max-mm", "V", "--out", out],
+            &["evaluate", "--run", run, "--boards", "1", "--quiet", "--max-expanded", "V"],
+            &["plan-bench", "--depths", "1", "--boards", "1", "--threads", "V"],
+            &["train", "--env", "lightsout-cursor", "--out", out, "--quiet", "--env-steps", "V"],
+            &["train", "--env", "lightsout-cursor", "--out", out, "--quiet", "--env-steps", "1", "--seed", "V"],
         ];
         let args: Vec<String> = templates[option]
             .iter()
