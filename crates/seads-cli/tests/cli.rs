@@ -399,13 +399,7 @@ fn train_rejects_bad_input() {
 
 /// A copy of the shared tiny run at `to`, for a test that writes into it.
 fn copy_tiny_run(to: &std::path::Path) {
-    let status = std::process::Command::new("cp")
-        .arg("-r")
-        .arg(tiny_run().join("run"))
-        .arg(to)
-        .status()
-        .unwrap();
-    assert!(status.success());
+    copy_dir(&tiny_run().join("run"), to);
 }
 
 /// One tiny trained run shared by the planning tests.
@@ -555,7 +549,7 @@ fn devices_that_are_not_there_are_refused_before_anything_is_written() {
     // Its own copy of the shared run, which other tests write evaluations into meanwhile.
     let dir = tempfile::tempdir().unwrap();
     let run = dir.path().join("run");
-    copy_dir(&tiny_run().join("run"), &run);
+    copy_tiny_run(&run);
     let run = run.to_str().unwrap();
     let out = dir.path().join("new");
     let out = out.to_str().unwrap();
@@ -1550,7 +1544,7 @@ fn an_evaluation_under_action_noise_has_files_of_its_own_and_repeats() {
 fn outputs_replace_only_regular_files_and_any_run_name_works() {
     let dir = tempfile::tempdir().unwrap();
     let run = dir.path().join("run");
-    copy_dir(&tiny_run().join("run"), &run);
+    copy_tiny_run(&run);
     let fifo = dir.path().join("fifo");
     let made = std::process::Command::new("mkfifo")
         .arg(&fifo)
@@ -1626,7 +1620,7 @@ fn outputs_replace_only_regular_files_and_any_run_name_works() {
 fn budgets_and_seeds_beyond_a_toml_integer_are_refused_before_writing() {
     let dir = tempfile::tempdir().unwrap();
     let run = dir.path().join("run");
-    copy_dir(&tiny_run().join("run"), &run);
+    copy_tiny_run(&run);
     let config = std::fs::read(run.join("config.toml")).unwrap();
     let huge = "9223372036854775808";
     check_bad_input(
@@ -1668,7 +1662,7 @@ fn budgets_and_seeds_beyond_a_toml_integer_are_refused_before_writing() {
 fn evaluations_of_no_board_or_too_many_are_refused_up_front() {
     let dir = tempfile::tempdir().unwrap();
     let run = dir.path().join("run");
-    copy_dir(&tiny_run().join("run"), &run);
+    copy_tiny_run(&run);
     let before: Vec<_> = std::fs::read_dir(&run).unwrap().collect();
     let figures = dir.path().join("figures");
     check_bad_input(
@@ -1762,7 +1756,7 @@ fn one_writer_wins_a_new_run_and_a_damaged_run_is_not_trained_over() {
         assert_eq!(provenance.lines().count(), 1, "one process trained it");
     }
     let damaged = dir.path().join("damaged");
-    copy_dir(&tiny_run().join("run"), &damaged);
+    copy_tiny_run(&damaged);
     std::fs::remove_file(damaged.join("config.toml")).unwrap();
     let metrics = std::fs::read(damaged.join("metrics.jsonl")).unwrap();
     check_bad_input(
@@ -1782,7 +1776,7 @@ fn one_writer_wins_a_new_run_and_a_damaged_run_is_not_trained_over() {
 fn a_run_given_twice_is_reported_once() {
     let dir = tempfile::tempdir().unwrap();
     let base = dir.path().join("base");
-    copy_dir(&tiny_run().join("run"), &base);
+    copy_tiny_run(&base);
     let again = dir.path().join(".").join("base");
     let report = dir.path().join("report");
     seads_ok(&["report", s(&base), s(&base), s(&again), "--out", s(&report)]);
@@ -1802,7 +1796,7 @@ fn a_run_given_twice_is_reported_once() {
 fn an_evaluation_refuses_a_config_edited_since_the_checkpoint() {
     let dir = tempfile::tempdir().unwrap();
     let run = dir.path().join("run");
-    copy_dir(&tiny_run().join("run"), &run);
+    copy_tiny_run(&run);
     let path = run.join("config.toml");
     let original = std::fs::read_to_string(&path).unwrap();
     assert!(original.contains("max_solution_depth = 5"), "{original}");
@@ -1848,7 +1842,7 @@ fn an_evaluation_refuses_a_config_edited_since_the_checkpoint() {
 fn report_csvs_quote_names_with_commas() {
     let dir = tempfile::tempdir().unwrap();
     let odd = dir.path().join("a,\"b");
-    copy_dir(&tiny_run().join("run"), &odd);
+    copy_tiny_run(&odd);
     let report = dir.path().join("report");
     seads_ok(&["report", s(&odd), "--out", s(&report)]);
     let mut checked = 0;
@@ -1896,7 +1890,7 @@ fn runs_that_cannot_be_read_are_bad_input() {
         "reading",
     );
     let run = dir.path().join("run");
-    copy_dir(&tiny_run().join("run"), &run);
+    copy_tiny_run(&run);
     let config = std::fs::read_to_string(run.join("config.toml")).unwrap();
     std::fs::write(run.join("config.toml"), "env = [").unwrap();
     check_bad_input(&["train", "--resume", s(&run)], "loading run");
@@ -1915,8 +1909,8 @@ fn runs_that_cannot_be_read_are_bad_input() {
 fn report_copies_never_collide_or_land_inside_a_run() {
     let dir = tempfile::tempdir().unwrap();
     let (a, b) = (dir.path().join("a/lo1"), dir.path().join("b/lo1"));
-    copy_dir(&tiny_run().join("run"), &a);
-    copy_dir(&tiny_run().join("run"), &b);
+    copy_tiny_run(&a);
+    copy_tiny_run(&b);
     let out = dir.path().join("r");
     check_bad_input(
         &["report", s(&a), s(&b), "--out", s(&out), "--copy-runs"],
@@ -1954,7 +1948,7 @@ fn repeated_or_out_of_order_epochs_are_damage() {
     let dir = tempfile::tempdir().unwrap();
     for (name, reorder) in [("repeated", false), ("reversed", true)] {
         let run = dir.path().join(name);
-        copy_dir(&tiny_run().join("run"), &run);
+        copy_tiny_run(&run);
         let text = std::fs::read_to_string(run.join("metrics.jsonl")).unwrap();
         let mut lines: Vec<&str> = text.lines().collect();
         if reorder {
@@ -1986,7 +1980,7 @@ fn repeated_or_out_of_order_epochs_are_damage() {
 fn a_garbage_evaluation_file_is_named_as_such() {
     let dir = tempfile::tempdir().unwrap();
     let run = dir.path().join("run");
-    copy_dir(&tiny_run().join("run"), &run);
+    copy_tiny_run(&run);
     std::fs::write(run.join("evaluation-over-training.jsonl"), "garbage\n").unwrap();
     let out = seads(&[
         "evaluate",

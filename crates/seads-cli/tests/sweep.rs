@@ -885,9 +885,7 @@ fn a_copy_of_a_sweep_in_progress_holds_its_finished_runs_and_reports_again() {
 #[test]
 fn a_study_refuses_a_dirty_binary() {
     let tmp = tempfile::tempdir().unwrap();
-    let manifest = write_manifest(tmp.path(), MANIFEST);
-    let out = tmp.path().join("sweep");
-    seads_ok(&["sweep", "plan", s(&manifest), "--out", s(&out)]);
+    let (_, out) = planned_sweep(tmp.path());
     let planned = snapshot(&out);
     let version = String::from_utf8(seads_ok(&["--version"]).stdout).unwrap();
     let dirty = if version.contains("uncommitted changes: true") {
@@ -938,9 +936,7 @@ fn a_study_refuses_a_dirty_binary() {
 #[test]
 fn thread_counts_beyond_the_machine_are_refused() {
     let tmp = tempfile::tempdir().unwrap();
-    let manifest = write_manifest(tmp.path(), MANIFEST);
-    let out = tmp.path().join("sweep");
-    seads_ok(&["sweep", "plan", s(&manifest), "--out", s(&out)]);
+    let (_, out) = planned_sweep(tmp.path());
     let planned = snapshot(&out);
     let huge = ["100000", "18446744073709551615"];
     for n in huge {
@@ -974,9 +970,7 @@ fn thread_counts_beyond_the_machine_are_refused() {
 #[test]
 fn slurm_scripts_refuse_values_that_would_change_them() {
     let tmp = tempfile::tempdir().unwrap();
-    let manifest = write_manifest(tmp.path(), MANIFEST);
-    let out = tmp.path().join("sweep");
-    seads_ok(&["sweep", "plan", s(&manifest), "--out", s(&out)]);
+    let (manifest, out) = planned_sweep(tmp.path());
     for (option, value) in [
         ("--time", "01:00:00\necho INJECTED"),
         ("--time", "1%a"),
@@ -1000,4 +994,13 @@ fn slurm_scripts_refuse_values_that_would_change_them() {
     let array = std::fs::read_to_string(out.join("slurm").join("array.sbatch")).unwrap();
     assert!(array.contains("#SBATCH --time=01:00:00\n"), "{array}");
     assert!(array.contains("--output=\""), "{array}");
+}
+
+/// The test manifest written into `dir` and planned into `dir/sweep`: the manifest's path and the
+/// sweep directory.
+fn planned_sweep(dir: &Path) -> (PathBuf, PathBuf) {
+    let manifest = write_manifest(dir, MANIFEST);
+    let out = dir.join("sweep");
+    seads_ok(&["sweep", "plan", s(&manifest), "--out", s(&out)]);
+    (manifest, out)
 }
