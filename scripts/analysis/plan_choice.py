@@ -1,9 +1,12 @@
-"""The cost of the planner's plan choice, from docs/results/plan-choice/plan-bench.json.
+"""The planner's plan choice: its cost (docs/results/plan-choice/plan-bench.json) and what it
+changes for trained agents (docs/results/plan-choice/agents/<choice>/seed-N/).
 
 `seads plan-bench` was run with `--plan first-found` and `--plan most-likely`, alternately, twice
 each, with one binary. Writes docs/results/plan-choice/summary.md: per depth, the expanded states
 (the same search both ways), each choice's mean milliseconds per plan (the two runs in brackets)
-and their ratio. Standard library only:
+and their ratio; then, for each agent evaluated with both choices (the same tasks), the boards
+solved per depth and the tasks that one choice solved and the other did not. Standard library
+only:
     python3 scripts/analysis/plan_choice.py
 """
 
@@ -34,5 +37,40 @@ for i, row in enumerate(runs[0]["result"]["depths"]):
         f"| {row['depth']} | {', '.join(map(str, expanded))} | {cells['first-found']} | "
         f"{cells['most-likely']} | {mean['most-likely'] / mean['first-found']:.2f} |"
     )
+
+agents = FOLDER / "agents"
+seeds = sorted(p.name for p in (agents / "most-likely").glob("seed-*")) if agents.is_dir() else []
+if seeds:
+    lines += [
+        "",
+        "Agents: `seads evaluate --replan --plan CHOICE --max-expanded 1048576` on the 20 standard "
+        "test boards per depth 1-5 of each agent (the init-check agents, 10^5 steps).",
+        "",
+        "| agent | most likely: solved per depth | first found: solved per depth | tasks only most likely solved | tasks only first found solved |",
+        "|---|---|---|---|---|",
+    ]
+    totals = {"most-likely": 0, "first-found": 0}
+    tasks_total = 0
+    for seed in seeds:
+        solved, tasks = {}, {}
+        for choice in ("most-likely", "first-found"):
+            folder = agents / choice / seed
+            record = json.loads((folder / "evaluation-replan.json").read_text())
+            solved[choice] = [r["solved"] for r in record["results"]]
+            totals[choice] += sum(solved[choice])
+            lines_ = (folder / "evaluation-replan-tasks.jsonl").read_text().splitlines()
+            tasks[choice] = {(t["depth"], t["seed"], t["board"]): t["solved"] for t in map(json.loads, lines_)}
+        tasks_total += len(tasks["most-likely"])
+        only = lambda a, b: sum(1 for k, v in tasks[a].items() if v and not tasks[b].get(k, False))
+        lines.append(
+            f"| {seed} | {' / '.join(map(str, solved['most-likely']))} | "
+            f"{' / '.join(map(str, solved['first-found']))} | {only('most-likely', 'first-found')} | "
+            f"{only('first-found', 'most-likely')} |"
+        )
+    lines += [
+        "",
+        f"In all: most likely {totals['most-likely']} of {tasks_total} tasks, first found "
+        f"{totals['first-found']} of {tasks_total}.",
+    ]
 (FOLDER / "summary.md").write_text("\n".join(lines) + "\n")
 print("\n".join(lines))
