@@ -388,13 +388,15 @@ fn train_rejects_bad_input() {
         ],
         "unknown field",
     );
-    let missing = seads(&[
-        "train",
-        "--resume",
-        dir.path().join("nothing").to_str().unwrap(),
-    ]);
-    assert_eq!(missing.status.code(), Some(1));
-    assert!(String::from_utf8_lossy(&missing.stderr).contains("config.toml"));
+    // A run that is not there is the user's to fix: exit 2, naming what is missing.
+    check_bad_input(
+        &[
+            "train",
+            "--resume",
+            dir.path().join("nothing").to_str().unwrap(),
+        ],
+        "config.toml",
+    );
 }
 
 /// A copy of the shared tiny run at `to`, for a test that writes into it.
@@ -536,9 +538,10 @@ fn planning_commands_reject_bad_input() {
     );
     check_bad_input(&["evaluate", "--run", run, "--depths", "five"], "--depths");
     check_bad_input(&["evaluate", "--run", run, "--depths", "0-2"], "--depths");
-    let missing = seads(&["solve", "--run", "/nonexistent/run", "--board", "0,0"]);
-    assert_eq!(missing.status.code(), Some(1));
-    assert!(String::from_utf8_lossy(&missing.stderr).contains("loading the agent"));
+    check_bad_input(
+        &["solve", "--run", "/nonexistent/run", "--board", "0,0"],
+        "loading run /nonexistent/run",
+    );
 }
 
 /// A device that is not there, or not a device, is one line of bad input from every command
