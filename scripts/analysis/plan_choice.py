@@ -38,13 +38,23 @@ for i, row in enumerate(runs[0]["result"]["depths"]):
         f"{cells['most-likely']} | {mean['most-likely'] / mean['first-found']:.2f} |"
     )
 
-agents = FOLDER / "agents"
-seeds = sorted(p.name for p in (agents / "most-likely").glob("seed-*")) if agents.is_dir() else []
-if seeds:
+GROUPS = [
+    ("agents", "the init-check agents: K = 25, 10^5 steps"),
+    ("agents-k30", "the more-skills agents: K = 30 for 25 moves, 5*10^5 steps"),
+]
+for folder_name, what in GROUPS:
+    agents = FOLDER / folder_name
+    if not (agents / "most-likely").is_dir():
+        continue
+    seeds = sorted(
+        p.name
+        for p in (agents / "most-likely").glob("seed-*")
+        if (agents / "first-found" / p.name / "evaluation-replan.json").is_file()
+    )
     lines += [
         "",
-        "Agents: `seads evaluate --replan --plan CHOICE --max-expanded 1048576` on the 20 standard "
-        "test boards per depth 1-5 of each agent (the init-check agents, 10^5 steps).",
+        f"`{folder_name}/`, {what}: `seads evaluate --replan --plan CHOICE --max-expanded 1048576` "
+        "on the 20 standard test boards per depth 1-5 of each agent.",
         "",
         "| agent | most likely: solved per depth | first found: solved per depth | tasks only most likely solved | tasks only first found solved |",
         "|---|---|---|---|---|",
@@ -58,10 +68,15 @@ if seeds:
             record = json.loads((folder / "evaluation-replan.json").read_text())
             solved[choice] = [r["solved"] for r in record["results"]]
             totals[choice] += sum(solved[choice])
-            lines_ = (folder / "evaluation-replan-tasks.jsonl").read_text().splitlines()
-            tasks[choice] = {(t["depth"], t["seed"], t["board"]): t["solved"] for t in map(json.loads, lines_)}
+            rows = (folder / "evaluation-replan-tasks.jsonl").read_text().splitlines()
+            tasks[choice] = {
+                (t["depth"], t["seed"], t["board"]): t["solved"] for t in map(json.loads, rows)
+            }
         tasks_total += len(tasks["most-likely"])
-        only = lambda a, b: sum(1 for k, v in tasks[a].items() if v and not tasks[b].get(k, False))
+
+        def only(a, b):
+            return sum(1 for k, v in tasks[a].items() if v and not tasks[b].get(k, False))
+
         lines.append(
             f"| {seed} | {' / '.join(map(str, solved['most-likely']))} | "
             f"{' / '.join(map(str, solved['first-found']))} | {only('most-likely', 'first-found')} | "
