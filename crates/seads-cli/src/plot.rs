@@ -75,7 +75,7 @@ pub fn write_figures(
     let metrics = read_metrics(run)?;
     let config = seads_rl::load_config(run)?;
     let title = format!("{} (seed {})", config.env, config.seed);
-    if let Some(mut twin) = crate::uarm::twin_for_figures(&config)? {
+    if let Some(mut twin) = crate::uarm::twin_for_figures(run, &config)? {
         // A robot run: its skills are shown on the twin, and its success is what `seads uarm
         // train` measured (with re-planning only).
         let spec = twin.spec().clone();

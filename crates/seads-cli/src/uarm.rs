@@ -8,8 +8,9 @@ use clap::{Args, Subcommand};
 use seads_embodiment::Environment;
 use seads_rl::{Run, TrainConfig, Trainer, find_checkpoint, load_config};
 use seads_uarm::{
-    ActionSpace, AdbTablet, Calibration, CalibrationFile, DriverConfig, RobotSettings,
-    SerialTransport, Swift, Tablet, Twin, UarmConfig, UarmEnv, UarmError, twin_screen_corners,
+    ActionSpace, AdbTablet, Calibration, CalibrationFile, DriverConfig, Observation, RobotSettings,
+    SerialTransport, Swift, Tablet, Twin, TwinNoise, UarmConfig, UarmEnv, UarmError,
+    twin_screen_corners,
 };
 
 use crate::BadInput;
@@ -37,21 +38,33 @@ pub struct Connection {
 }
 
 impl Connection {
-    /// The twin that `--port sim` or `sim:SEED` asks for; any other port is a serial port.
-    fn twin(&self) -> Result<Option<Twin>> {
-        if self.port == "sim" {
-            return Ok(Some(Twin::new(0)));
-        }
-        let Some(seed) = self.port.strip_prefix("sim:") else {
+    /// Whether the port names the twin.
+    fn is_twin(&self) -> bool {
+        self.port == "sim" || self.port.starts_with("sim:")
+    }
+
+    /// The twin that `--port sim` or `sim:SEED` asks for, with `noise`; any other port is a
+    /// serial port, which takes no noise.
+    fn twin(&self, noise: TwinNoise) -> Result<Option<Twin>> {
+        let seed = if self.port == "sim" {
+            0
+        } else if let Some(seed) = self.port.strip_prefix("sim:") {
+            seed.parse().map_err(|_| {
+                BadInput(anyhow::anyhow!(
+                    "--port {}: the twin's seed must be a whole number (sim:SEED)",
+                    self.port
+                ))
+            })?
+        } else if noise.is_none() {
             return Ok(None);
+        } else {
+            bail!(BadInput(anyhow::anyhow!(
+                "--tap-sd-mm and --late-reports need the twin (--port sim): a real arm has its own noise"
+            )));
         };
-        let seed = seed.parse().map_err(|_| {
-            BadInput(anyhow::anyhow!(
-                "--port {}: the twin's seed must be a whole number (sim:SEED)",
-                self.port
-            ))
-        })?;
-        Ok(Some(Twin::new(seed)))
+        Ok(Some(
+            Twin::with_noise(seed, noise).map_err(|e| BadInput(e.into()))?,
+        ))
     }
 
     fn arm(&self, twin: Option<&Twin>) -> Result<Swift> {
@@ -120,7 +133,7 @@ fn record_corners(arm: &mut Swift, twin: Option<&Twin>, quiet: bool) -> Result<[
 
 /// `seads uarm calibrate`.
 pub fn calibrate(args: CalibrateArgs) -> Result<()> {
-    let twin = args.connection.twin()?;
+    let twin = args.connection.twin(TwinNoise::default())?;
     let mut arm = args.connection.arm(twin.as_ref())?;
     let corners = record_corners(&mut arm, twin.as_ref(), false)?;
     let calibration = Calibration::fit(CalibrationFile {
@@ -148,9 +161,10 @@ pub struct UarmTrainArgs {
     /// Action space: absolute (press at (x, y)) or displacement (the Cursor in hardware).
     #[arg(long, default_value = "absolute")]
     action_space: ActionSpace,
-    /// Interactions (environment steps) to train for (the paper: 5000 with absolute pushes).
-    #[arg(long, default_value_t = 5000)]
-    env_steps: u64,
+    /// Interactions (environment steps) to train for [default: 5000, the paper's with absolute
+    /// pushes]. With --resume: raises the run's budget to this many.
+    #[arg(long, value_parser = clap::value_parser!(u64).range(1..=i64::MAX as u64))]
+    env_steps: Option<u64>,
     /// Run directory.
     #[arg(long, default_value = "runs/uarm")]
     out: PathBuf,
@@ -177,15 +191,75 @@ pub struct UarmTrainArgs {
     /// The paper's arm resets neither (seed S.5), and neither does the twin without this flag.
     #[arg(long)]
     reset_board: bool,
+    /// What the skills see: board-and-pen, board, pen or nothing (what is not seen reads 0; the
+    /// forward model always sees the board). A resumed run keeps its own.
+    #[arg(long, default_value = "board-and-pen")]
+    observe: Observation,
+    /// The twin only: standard deviation, mm, of where a tap lands around the commanded point
+    /// (pen offset, the arm's repeatability). A resumed run keeps its own.
+    #[arg(long, default_value_t = 0.0, value_name = "MM")]
+    tap_sd_mm: f64,
+    /// The twin only: probability that the tablet logs a tap too late for its press (the report
+    /// comes with the next press's). A resumed run keeps its own.
+    #[arg(long, default_value_t = 0.0, value_name = "P")]
+    late_reports: f64,
+    /// The training settings that a new run may change from the robot's (`seads uarm train`'s
+    /// defaults); a resumed run keeps its `config.toml`.
+    #[command(flatten)]
+    training: RobotTraining,
+}
+
+/// Training settings of a new robot run that the paper does not state for the robot (seed S.5
+/// gives α and the episodes per epoch; the rest is the Cursor's).
+#[derive(Debug, Args)]
+pub struct RobotTraining {
+    /// SAC updates per epoch (default: the Cursor's 16).
+    #[arg(long, value_name = "N", conflicts_with = "resume",
+          value_parser = clap::value_parser!(u64).range(1..=100_000))]
+    updates_per_epoch: Option<u64>,
+    /// New episodes per epoch (default: 4 with absolute pushes, as the paper's robot; the
+    /// Cursor's 32 with displacements).
+    #[arg(long, value_name = "N", conflicts_with = "resume",
+          value_parser = clap::value_parser!(u64).range(1..=100_000))]
+    episodes_per_epoch: Option<u64>,
+    /// SAC's entropy temperature α (default: the paper's 0.1 for the robot).
+    #[arg(long, value_name = "ALPHA", conflicts_with = "resume",
+          value_parser = seads_study::numbers::positive_finite)]
+    alpha: Option<f64>,
+}
+
+impl UarmTrainArgs {
+    /// The twin's noise these options ask for.
+    fn noise(&self) -> TwinNoise {
+        TwinNoise {
+            tap_sd_mm: self.tap_sd_mm,
+            late_report_p: self.late_reports,
+        }
+    }
+
+    /// What the run records in `robot.toml`.
+    fn settings(&self) -> RobotSettings {
+        RobotSettings {
+            action_space: self.action_space,
+            reset_board: self.reset_board,
+            observe: self.observe,
+            twin_noise: self.noise(),
+        }
+    }
 }
 
 fn build_env(
     connection: &Connection,
     calibration: Option<&Path>,
-    action_space: ActionSpace,
-    reset_board: bool,
+    settings: &RobotSettings,
     twin: Option<&Twin>,
 ) -> Result<UarmEnv> {
+    let RobotSettings {
+        action_space,
+        reset_board,
+        observe,
+        twin_noise: _,
+    } = *settings;
     if reset_board && twin.is_none() {
         bail!(BadInput(anyhow::anyhow!(
             "--reset-board needs the twin (--port sim): the real tablet's board cannot be set"
@@ -203,6 +277,7 @@ fn build_env(
         step_limit: action_space.step_limit(),
         reset_board,
         tap_timeout_s: if twin.is_some() { 0.0 } else { 2.0 },
+        observe,
     };
     let arm = connection.arm(twin)?;
     let tablet = connection.tablet(twin)?;
@@ -219,32 +294,66 @@ fn calibrate_twin(connection: &Connection, twin: &Twin) -> Result<Calibration> {
     })?)
 }
 
-/// The twin acting as the robot run `config` did, to show its skills: every reset draws a new
-/// board and pen position, like the Cursor's coverage initialisations. `None` when `config` is not
-/// a robot run.
-pub fn twin_for_figures(config: &TrainConfig) -> Result<Option<UarmEnv>> {
+/// The twin acting as the robot run in `run` (with `config`) did, to show its skills: the run's
+/// observation and noise, and every reset draws a new board and pen position, like the Cursor's
+/// coverage initialisations. `None` when `config` is not a robot run.
+pub fn twin_for_figures(run: &Path, config: &TrainConfig) -> Result<Option<UarmEnv>> {
     let Some(space) = ActionSpace::of_env(&config.env) else {
         return Ok(None);
     };
-    let twin = Twin::new(0);
+    let settings = RobotSettings {
+        reset_board: true,
+        ..run_settings(run, space)?
+    };
+    let twin = Twin::with_noise(0, settings.twin_noise).map_err(|e| BadInput(e.into()))?;
     let connection = Connection {
         port: "sim".into(),
         adb: String::new(),
     };
-    build_env(&connection, None, space, true, Some(&twin)).map(Some)
+    build_env(&connection, None, &settings, Some(&twin)).map(Some)
 }
+
+/// The settings the robot run in `run` records; a run from before `robot.toml` had `space`'s
+/// defaults.
+fn run_settings(run: &Path, space: ActionSpace) -> Result<RobotSettings> {
+    let recorded = RobotSettings::read(run).map_err(|e| match e {
+        UarmError::Config(_) => BadInput(e.into()).into(),
+        other => anyhow::Error::from(other),
+    })?;
+    Ok(recorded.unwrap_or(RobotSettings {
+        action_space: space,
+        reset_board: false,
+        observe: Observation::default(),
+        twin_noise: TwinNoise::default(),
+    }))
+}
+
+/// Interactions of a new robot run unless `--env-steps` says otherwise: the paper's 5000 with
+/// absolute pushes (seed S.5).
+const DEFAULT_ENV_STEPS: u64 = 5000;
 
 /// The training settings of the robot (seed S.5): the Cursor's, with SAC α = 0.1 and, for
 /// absolute pushes, 4 new episodes per epoch.
 fn robot_config(env: &UarmEnv, args: &UarmTrainArgs) -> Result<TrainConfig> {
     let mut config = TrainConfig::preset("lightsout-cursor")?;
     config.env = env.spec().name.clone();
-    config.env_steps = args.env_steps;
+    config.env_steps = args.env_steps.unwrap_or(DEFAULT_ENV_STEPS);
     config.seed = args.seed;
     config.sac.alpha = 0.1;
     if args.action_space == ActionSpace::Absolute {
         config.episodes_per_epoch = 4;
     }
+    let training = &args.training;
+    if let Some(n) = training.updates_per_epoch {
+        config.sac.updates_per_epoch = n as usize;
+    }
+    if let Some(n) = training.episodes_per_epoch {
+        config.episodes_per_epoch = n as usize;
+    }
+    if let Some(alpha) = training.alpha {
+        config.sac.alpha = alpha;
+    }
+    config.validate_values().map_err(|e| BadInput(e.into()))?;
     Ok(config)
 }
 
@@ -260,12 +369,11 @@ pub fn train(mut args: UarmTrainArgs) -> Result<()> {
     if args.resume {
         adopt_run_settings(&mut args)?;
     }
-    let twin = args.connection.twin()?;
+    let twin = args.connection.twin(args.noise())?;
     let env = build_env(
         &args.connection,
         args.calibration.as_deref(),
-        args.action_space,
-        args.reset_board,
+        &args.settings(),
         twin.as_ref(),
     )?;
     let cores = args.cores.map(|c| c as usize);
@@ -280,6 +388,12 @@ pub fn train(mut args: UarmTrainArgs) -> Result<()> {
     };
     let (mut run, _lock) = if args.resume {
         let lock = crate::lock_run(&args.out)?;
+        if let Some(steps) = args.env_steps {
+            seads_rl::raise_budget(&args.out, steps).map_err(|e| match e {
+                seads_rl::RlError::Config(_) => BadInput(e.into()).into(),
+                other => anyhow::Error::from(other),
+            })?;
+        }
         let run = crate::train::resume(&args.out, Run::resume_with(&args.out, trainer))?;
         (run, lock)
     } else {
@@ -287,11 +401,7 @@ pub fn train(mut args: UarmTrainArgs) -> Result<()> {
         // The lock first: nothing is written into a directory another command holds.
         let lock = crate::lock_new_run(&args.out)?;
         let run = Run::with_trainer(&args.out, trainer(config)?).map_err(|e| BadInput(e.into()))?;
-        RobotSettings {
-            action_space: args.action_space,
-            reset_board: args.reset_board,
-        }
-        .write(&args.out)?;
+        args.settings().write(&args.out)?;
         (run, lock)
     };
     crate::train::drive(&mut run, args.quiet)?;
@@ -307,8 +417,8 @@ pub fn train(mut args: UarmTrainArgs) -> Result<()> {
     )
 }
 
-/// A resumed run acts as it was trained, whatever `--action-space` and `--reset-board` say. A run
-/// from before `robot.toml` keeps the flags given.
+/// A resumed run acts and sees as it was trained, on a twin with its noise, whatever the options
+/// say. A run from before `robot.toml` keeps the flags given.
 fn adopt_run_settings(args: &mut UarmTrainArgs) -> Result<()> {
     if let Some(settings) = RobotSettings::read(&args.out).map_err(|e| match e {
         UarmError::Config(_) => BadInput(e.into()).into(),
@@ -316,6 +426,9 @@ fn adopt_run_settings(args: &mut UarmTrainArgs) -> Result<()> {
     })? {
         args.action_space = settings.action_space;
         args.reset_board = settings.reset_board;
+        args.observe = settings.observe;
+        args.tap_sd_mm = settings.twin_noise.tap_sd_mm;
+        args.late_reports = settings.twin_noise.late_report_p;
     }
     Ok(())
 }
@@ -359,12 +472,21 @@ pub fn evaluate_run(args: UarmEvaluateArgs) -> Result<()> {
             config.env
         ))
     })?;
-    let twin = args.connection.twin()?;
+    // The run's observation and, on the twin, its noise; boards are set, not reset.
+    let settings = RobotSettings {
+        reset_board: false,
+        ..run_settings(&args.run, action_space)?
+    };
+    let noise = if args.connection.is_twin() {
+        settings.twin_noise
+    } else {
+        TwinNoise::default()
+    };
+    let twin = args.connection.twin(noise)?;
     let env = build_env(
         &args.connection,
         args.calibration.as_deref(),
-        action_space,
-        false,
+        &settings,
         twin.as_ref(),
     )?;
     evaluate(

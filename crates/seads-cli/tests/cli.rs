@@ -838,7 +838,7 @@ fn uarm_twin_calibrates_and_trains() {
     // The paper's protocol unless asked otherwise, recorded for a resume.
     assert_eq!(
         std::fs::read_to_string(run.join("robot.toml")).unwrap(),
-        "action_space = \"absolute\"\nreset_board = false\n"
+        "action_space = \"absolute\"\nreset_board = false\nobserve = \"board-and-pen\"\n"
     );
     // A robot run has figures and a report too: what its directory holds.
     let figures = dir.path().join("figures");
@@ -1113,6 +1113,102 @@ fn uarm_rejects_bad_input() {
             run.to_str().unwrap(),
         ],
         "needs the twin",
+    );
+    // And only the twin's noise.
+    check_bad_input(
+        &[
+            "uarm",
+            "train",
+            "--port",
+            "/dev/ttyACM9",
+            "--calibration",
+            cal.to_str().unwrap(),
+            "--tap-sd-mm",
+            "2",
+            "--out",
+            run.to_str().unwrap(),
+        ],
+        "need the twin",
+    );
+    for (flag, value, needle) in [
+        ("--late-reports", "1.5", "probability"),
+        ("--tap-sd-mm=-1", "0", "tap deviation"),
+        ("--alpha", "0", "--alpha"),
+        ("--updates-per-epoch", "0", "--updates-per-epoch"),
+        ("--observe", "eyes", "board-and-pen"),
+    ] {
+        check_bad_input(
+            &["uarm", "train", flag, value, "--out", run.to_str().unwrap()]
+                .into_iter()
+                .filter(|a| *a != "0" || flag != "--tap-sd-mm=-1")
+                .collect::<Vec<_>>(),
+            needle,
+        );
+    }
+    assert!(!run.exists(), "a refused command writes nothing");
+}
+
+/// The settings an ablation of the robot changes are recorded with the run, and a resume keeps
+/// them whatever its options say.
+#[test]
+fn a_robot_run_records_its_ablation_settings() {
+    let dir = tempfile::tempdir().unwrap();
+    let run = dir.path().join("run");
+    let train = |extra: &[&str]| {
+        let mut args = vec!["uarm", "train", "--port", "sim:2", "--boards", "1"];
+        args.extend(["--out", s(&run), "--quiet", "--max-expanded", "1000"]);
+        args.extend(extra);
+        seads_ok(&args)
+    };
+    train(&[
+        "--env-steps",
+        "8",
+        "--observe",
+        "pen",
+        "--tap-sd-mm",
+        "5",
+        "--late-reports",
+        "0.25",
+        "--updates-per-epoch",
+        "3",
+        "--episodes-per-epoch",
+        "2",
+        "--alpha",
+        "0.05",
+    ]);
+    let robot = || std::fs::read_to_string(run.join("robot.toml")).unwrap();
+    assert_eq!(
+        robot(),
+        "action_space = \"absolute\"\nreset_board = false\nobserve = \"pen\"\n\n\
+         [twin_noise]\ntap_sd_mm = 5.0\nlate_report_p = 0.25\n"
+    );
+    let config = std::fs::read_to_string(run.join("config.toml")).unwrap();
+    for line in [
+        "episodes_per_epoch = 2",
+        "updates_per_epoch = 3",
+        "alpha = 0.05",
+    ] {
+        assert!(config.contains(line), "{line}: {config}");
+    }
+    let recorded = robot();
+    train(&["--resume", "--env-steps", "12", "--observe", "nothing"]);
+    assert_eq!(robot(), recorded, "a resume keeps the run's settings");
+    assert_eq!(
+        std::fs::read_to_string(run.join("config.toml")).unwrap(),
+        config.replace("env_steps = 8", "env_steps = 12")
+    );
+    // Training options belong to a new run.
+    check_bad_input(
+        &[
+            "uarm",
+            "train",
+            "--resume",
+            "--alpha",
+            "0.2",
+            "--out",
+            s(&run),
+        ],
+        "--alpha",
     );
 }
 

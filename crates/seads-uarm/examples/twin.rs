@@ -43,6 +43,7 @@ fn run() -> Result<Vec<usize>, Box<dyn std::error::Error>> {
         step_limit: 1,
         tap_timeout_s: 0.0,
         reset_board: true,
+        ..UarmConfig::default()
     };
     let mut env = UarmEnv::new(arm, twin.tablet(), calibration, config)?;
     env.seed(1);

@@ -16,6 +16,7 @@ use crate::UarmError;
 use crate::calibration::Calibration;
 use crate::driver::Swift;
 use crate::tablet::Tablet;
+use crate::twin::TwinNoise;
 
 /// How actions move the pen.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
@@ -76,15 +77,76 @@ impl std::str::FromStr for ActionSpace {
     }
 }
 
+/// What the skills see of the world. The observation keeps its size; what is not seen reads 0.
+/// The forward model sees the board in every case (it reads the tablet's report).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum Observation {
+    /// The pen's position and the board (as the Cursor sees its world).
+    #[default]
+    BoardAndPen,
+    /// The board only.
+    Board,
+    /// The pen's position only.
+    Pen,
+    /// Neither: every absolute push is the same whatever the world shows.
+    Nothing,
+}
+
+impl Observation {
+    /// Every choice, in `--observe`'s order.
+    pub const ALL: [Self; 4] = [Self::BoardAndPen, Self::Board, Self::Pen, Self::Nothing];
+
+    /// The name in options and files.
+    pub fn name(self) -> &'static str {
+        match self {
+            Self::BoardAndPen => "board-and-pen",
+            Self::Board => "board",
+            Self::Pen => "pen",
+            Self::Nothing => "nothing",
+        }
+    }
+
+    fn pen(self) -> bool {
+        matches!(self, Self::BoardAndPen | Self::Pen)
+    }
+
+    fn board(self) -> bool {
+        matches!(self, Self::BoardAndPen | Self::Board)
+    }
+}
+
+impl std::str::FromStr for Observation {
+    type Err = String;
+
+    /// `board-and-pen`, `board`, `pen` or `nothing`.
+    fn from_str(text: &str) -> Result<Self, String> {
+        Self::ALL
+            .into_iter()
+            .find(|o| o.name() == text)
+            .ok_or_else(|| {
+                format!("unknown observation {text:?} (valid: board-and-pen, board, pen, nothing)")
+            })
+    }
+}
+
 /// What a robot run's `config.toml` does not hold, kept beside it in [`RobotSettings::FILE`]: how
-/// the arm acts and whether the twin resets the board. A resumed run keeps them.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+/// the arm acts, what the skills see and, on the twin, whether it resets the board and how it
+/// departs from a perfect arm. A resumed run and its evaluations keep them. Files from before the
+/// observation and the noise read as the defaults (all seen, no noise), which those runs had.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct RobotSettings {
     /// How actions move the pen.
     pub action_space: ActionSpace,
     /// Whether reset draws a new board (the twin only).
     pub reset_board: bool,
+    /// What the skills see.
+    #[serde(default)]
+    pub observe: Observation,
+    /// The twin's noise (the twin only).
+    #[serde(default, skip_serializing_if = "TwinNoise::is_none")]
+    pub twin_noise: TwinNoise,
 }
 
 impl RobotSettings {
@@ -111,7 +173,7 @@ impl RobotSettings {
 
     /// Writes them into the run in `run`, atomically.
     pub fn write(&self, run: &std::path::Path) -> Result<(), UarmError> {
-        let text = toml::to_string(self).expect("two plain fields serialise");
+        let text = toml::to_string(self).expect("plain fields serialise");
         crate::calibration::write_atomic(&run.join(Self::FILE), &text)
     }
 }
@@ -131,6 +193,8 @@ pub struct UarmConfig {
     /// app's. The paper's protocol resets neither board nor arm (SPEC §7.3, seed S.5), so an
     /// episode starts where the previous one ended; that is the default.
     pub reset_board: bool,
+    /// What the skills see.
+    pub observe: Observation,
 }
 
 impl Default for UarmConfig {
@@ -140,6 +204,7 @@ impl Default for UarmConfig {
             step_limit: 1,
             tap_timeout_s: 2.0,
             reset_board: false,
+            observe: Observation::BoardAndPen,
         }
     }
 }
@@ -371,6 +436,13 @@ impl Environment for UarmEnv {
         out[0] = hw.cursor[0] as f32;
         out[1] = hw.cursor[1] as f32;
         self.spec.observe_board(hw.board.board(), self.steps, out);
+        let observe = self.config.observe;
+        if !observe.pen() {
+            out[..2].fill(0.0);
+        }
+        if !observe.board() {
+            out[2..2 + self.spec.symbolic_len].fill(0.0);
+        }
     }
 
     fn board(&self) -> SymbolicState {

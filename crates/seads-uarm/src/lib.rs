@@ -38,6 +38,7 @@
 //!     step_limit: 1,
 //!     tap_timeout_s: 0.0,
 //!     reset_board: true,
+//!     ..UarmConfig::default()
 //! };
 //! let mut env = UarmEnv::new(arm, twin.tablet(), calibration, config)?;
 //! env.seed(1);
@@ -65,9 +66,9 @@ pub use calibration::{Calibration, CalibrationFile};
 /// Side of the LightsOut board the robot plays (on the tablet); its K is the game's 25 moves.
 pub const BOARD_SIZE: usize = 5;
 pub use driver::{DriverConfig, SerialTransport, Swift, Transport};
-pub use env::{ActionSpace, RobotSettings, UarmConfig, UarmEnv};
+pub use env::{ActionSpace, Observation, RobotSettings, UarmConfig, UarmEnv};
 pub use tablet::{AdbTablet, Tablet, TabletReport};
-pub use twin::{Faults, Twin, twin_screen_corners};
+pub use twin::{Faults, Twin, TwinNoise, twin_screen_corners};
 
 /// What can go wrong with the robot.
 #[derive(Debug, thiserror::Error)]

@@ -15,7 +15,9 @@ use std::time::Duration;
 use rand::seq::SliceRandom;
 use rand::{RngExt, SeedableRng};
 use rand_chacha::ChaCha8Rng;
+use rand_distr::{Distribution, Normal};
 use seads_games::{BoardGame, LightsOut, SymbolicState};
+use serde::{Deserialize, Serialize};
 
 use seads_embodiment::Layout;
 
@@ -37,6 +39,47 @@ pub struct Faults {
     pub disconnect_at: Option<usize>,
 }
 
+/// How the twin departs from a perfect arm and tablet (both off by default). Its random draws
+/// come from the twin's seed, on a stream of their own.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct TwinNoise {
+    /// Standard deviation of where a tap lands on the screen around the commanded point, mm, on
+    /// each screen axis (the pen's offset and the arm's repeatability).
+    pub tap_sd_mm: f64,
+    /// Probability that the tablet logs a tap too late for the press that made it: the press
+    /// sees no report, and the report arrives at the next press (the tablet's latency).
+    pub late_report_p: f64,
+}
+
+impl TwinNoise {
+    /// Checks that both values are in range: a finite, non-negative deviation of at most 100 mm
+    /// and a probability.
+    pub fn check(&self) -> Result<(), UarmError> {
+        if !(self.tap_sd_mm.is_finite() && (0.0..=100.0).contains(&self.tap_sd_mm)) {
+            return Err(UarmError::Config(format!(
+                "the twin's tap deviation must be 0 to 100 mm, not {}",
+                self.tap_sd_mm
+            )));
+        }
+        if !(0.0..=1.0).contains(&self.late_report_p) {
+            return Err(UarmError::Config(format!(
+                "the twin's late-report probability must be in [0, 1], not {}",
+                self.late_report_p
+            )));
+        }
+        Ok(())
+    }
+
+    /// Whether the twin is perfect.
+    pub fn is_none(&self) -> bool {
+        *self == Self::default()
+    }
+}
+
+/// The stream of the noise's draws (the board's scrambles use stream 0).
+const NOISE_STREAM: u64 = 1;
+
 struct World {
     /// Pen tip position, arm coordinates (mm).
     pen: [f64; 3],
@@ -53,6 +96,14 @@ struct World {
     last_move: Option<usize>,
     /// Every G0 target received (for tests: where the arm was sent).
     trail: Vec<[f64; 3]>,
+    noise: TwinNoise,
+    noise_rng: ChaCha8Rng,
+    /// The screen's width and height, mm (the tap deviation's scale).
+    screen_mm: [f64; 2],
+    /// The last report whose timing was drawn (each tap's is drawn once).
+    timed: u64,
+    /// A report is late: the next wait receives it.
+    late: bool,
 }
 
 /// The shared simulated world; hand out its arm transport and its tablet.
@@ -75,6 +126,12 @@ pub fn twin_screen_corners() -> [[f64; 3]; 4] {
 impl Twin {
     /// A twin with a random board drawn from `seed`.
     pub fn new(seed: u64) -> Self {
+        Self::with_noise(seed, TwinNoise::default()).expect("no noise is valid noise")
+    }
+
+    /// A twin with a random board drawn from `seed` whose taps and reports follow `noise`.
+    pub fn with_noise(seed: u64, noise: TwinNoise) -> Result<Self, UarmError> {
+        noise.check()?;
         let screen = Calibration::fit(CalibrationFile {
             corners: twin_screen_corners(),
             d_max_mm: 100.0,
@@ -97,10 +154,19 @@ impl Twin {
             seq: 0,
             last_move: None,
             trail: Vec::new(),
+            noise,
+            noise_rng: {
+                let mut rng = ChaCha8Rng::seed_from_u64(seed);
+                rng.set_stream(NOISE_STREAM);
+                rng
+            },
+            screen_mm: screen_size_mm(),
+            timed: 0,
+            late: false,
         };
-        Self {
+        Ok(Self {
             world: Arc::new(Mutex::new(world)),
-        }
+        })
     }
 
     fn lock(&self) -> MutexGuard<'_, World> {
@@ -161,6 +227,16 @@ impl Twin {
         let mut w = self.lock();
         w.pen = to;
     }
+}
+
+/// The twin screen's width (top-left to top-right corner) and height (top-left to bottom-left),
+/// mm.
+fn screen_size_mm() -> [f64; 2] {
+    let [a, b, _, d] = twin_screen_corners();
+    let dist = |p: [f64; 3], q: [f64; 3]| {
+        ((p[0] - q[0]).powi(2) + (p[1] - q[1]).powi(2) + (p[2] - q[2]).powi(2)).sqrt()
+    };
+    [dist(a, b), dist(a, d)]
 }
 
 /// A board 1–5 distinct moves from the goal, not the goal.
@@ -244,6 +320,8 @@ impl World {
         let inside = (0.0..=1.0).contains(&x) && (0.0..=1.0).contains(&y);
         if inside && height_mm <= 0.5 && !self.touching {
             self.touching = true;
+            // The tap lands where the noise puts it, on the screen.
+            let (x, y) = self.tap_point(x, y);
             // The app's fields tile the screen as the Cursor's board does.
             let mv = Layout::Grid { n: 5 }
                 .locate(x, y)
@@ -254,6 +332,35 @@ impl World {
         } else if height_mm > 1.0 {
             self.touching = false;
         }
+    }
+}
+
+impl World {
+    /// Where a tap commanded at screen point (x, y) lands.
+    fn tap_point(&mut self, x: f64, y: f64) -> (f64, f64) {
+        let sd = self.noise.tap_sd_mm;
+        if sd == 0.0 {
+            return (x, y);
+        }
+        let normal = Normal::new(0.0, sd).expect("a checked deviation");
+        let dx = normal.sample(&mut self.noise_rng) / self.screen_mm[0];
+        let dy = normal.sample(&mut self.noise_rng) / self.screen_mm[1];
+        ((x + dx).clamp(0.0, 1.0), (y + dy).clamp(0.0, 1.0))
+    }
+
+    /// Whether the newest report reaches a waiting press now. A tap's report is late with the
+    /// noise's probability; a late report arrives at the next wait, with whatever the board
+    /// became since (so a press that receives a late report also receives its own tap's).
+    fn report_in_time(&mut self) -> bool {
+        if self.late || self.seq == self.timed {
+            self.late = false;
+            self.timed = self.seq;
+            return true;
+        }
+        self.timed = self.seq;
+        let p = self.noise.late_report_p;
+        self.late = p > 0.0 && self.noise_rng.random::<f64>() < p;
+        !self.late
     }
 }
 
@@ -322,8 +429,8 @@ impl Tablet for SimTablet {
         after: u64,
         _timeout: Duration,
     ) -> Result<Option<TabletReport>, UarmError> {
-        let w = self.twin.lock();
-        Ok((w.seq > after).then(|| Self::report(&w)))
+        let mut w = self.twin.lock();
+        Ok((w.seq > after && w.report_in_time()).then(|| Self::report(&w)))
     }
 
     fn set_board(&mut self, board: SymbolicState) -> Result<(), UarmError> {
@@ -334,6 +441,9 @@ impl Tablet for SimTablet {
         w.board = board;
         w.seq += 1;
         w.last_move = None;
+        // A late report of the board before is no longer news.
+        w.late = false;
+        w.timed = w.seq;
         Ok(())
     }
 }

@@ -4,8 +4,8 @@
 use seads_embodiment::{EnvError, Environment, Push, record_episode, replay_episode};
 use seads_games::{BoardGame, LightsOut};
 use seads_uarm::{
-    ActionSpace, Calibration, CalibrationFile, DriverConfig, Faults, Swift, Twin, UarmConfig,
-    UarmEnv, UarmError, twin_screen_corners,
+    ActionSpace, Calibration, CalibrationFile, DriverConfig, Faults, Observation, RobotSettings,
+    Swift, Twin, TwinNoise, UarmConfig, UarmEnv, UarmError, twin_screen_corners,
 };
 
 fn driver(twin: &Twin) -> Swift {
@@ -50,6 +50,7 @@ fn env_with(twin: &Twin, space: ActionSpace, reset_board: bool) -> UarmEnv {
         },
         tap_timeout_s: 0.0,
         reset_board,
+        ..UarmConfig::default()
     };
     UarmEnv::new(driver(twin), twin.tablet(), calibrate(twin), config).unwrap()
 }
@@ -392,4 +393,186 @@ fn the_twin_observes_its_board_and_remaining_time_as_the_cursor_does() {
             cursor.step(&[0.0, 0.0, -1.0]).unwrap();
         }
     }
+}
+
+/// The centre field's press, `n` times on a twin with `noise`, each on a new board: what the
+/// robot sees of them.
+fn centre_presses(noise: TwinNoise, n: usize) -> Vec<Push> {
+    let twin = Twin::with_noise(11, noise).unwrap();
+    let mut env = env_with(&twin, ActionSpace::Absolute, true);
+    env.seed(1);
+    (0..n)
+        .map(|_| {
+            env.reset().unwrap();
+            env.step(&[0.5, 0.5]).unwrap().push
+        })
+        .collect()
+}
+
+#[test]
+fn taps_scatter_as_the_noise_says_and_repeat_with_the_seed() {
+    let noise = TwinNoise {
+        tap_sd_mm: 10.0,
+        late_report_p: 0.0,
+    };
+    let n = 3000;
+    let pushes = centre_presses(noise, n);
+    assert_eq!(
+        pushes,
+        centre_presses(noise, n),
+        "the same seed, the same taps"
+    );
+    let share = |f: &dyn Fn(usize) -> bool| {
+        let hits = pushes
+            .iter()
+            .filter(|p| matches!(p, Push::Move(m) if f(*m)))
+            .count();
+        hits as f64 / n as f64
+    };
+    // The centre field is 217/5 = 43.4 mm wide and 136.18/5 = 27.24 mm high on the twin's screen
+    // (its corners), so a tap with 10 mm deviation per axis stays in it with probability
+    // erf(21.7 / (10 √2)) · erf(13.62 / (10 √2)) = 0.9700 · 0.8264 = 0.8016, in its column
+    // (same x) with 0.9700 and in its row (same y) with 0.8264 (Python's math.erf).
+    let centre = share(&|m| m == 12);
+    assert!((centre - 0.8016).abs() < 0.03, "{centre}");
+    let column = share(&|m| m % 5 == 2);
+    assert!((column - 0.9700).abs() < 0.015, "{column}");
+    let row = share(&|m| m / 5 == 2);
+    assert!((row - 0.8264).abs() < 0.03, "{row}");
+    // Without noise, every tap is the centre's.
+    let exact = centre_presses(TwinNoise::default(), 50);
+    assert!(exact.iter().all(|p| *p == Push::Move(12)), "{exact:?}");
+}
+
+#[test]
+fn late_reports_reach_the_next_press() {
+    let late = |p: f64| TwinNoise {
+        tap_sd_mm: 0.0,
+        late_report_p: p,
+    };
+    // Always late: the press sees nothing, the tablet has the move, the robot's board lags.
+    let twin = Twin::with_noise(3, late(1.0)).unwrap();
+    let mut env = env_with(&twin, ActionSpace::Absolute, false);
+    env.reset().unwrap();
+    let before = env.board();
+    assert_eq!(env.step(&[0.5, 0.5]).unwrap().push, Push::Miss);
+    assert_eq!(env.board(), before);
+    assert_ne!(twin.board(), before);
+    // A press off the board (no tap) then receives the late report: the centre's move.
+    let twin = Twin::with_noise(3, late(1.0)).unwrap();
+    let mut env = env_with(&twin, ActionSpace::Displacement, false);
+    env.reset().unwrap();
+    let before = env.board();
+    assert_eq!(env.step(&[0.0, 0.0, 1.0]).unwrap().push, Push::Miss);
+    env.reset().unwrap();
+    assert_eq!(env.step(&[0.0, 0.0, -1.0]).unwrap().push, Push::None);
+    let game = LightsOut::new(5).unwrap();
+    assert_eq!(env.board(), before, "not yet");
+    // The next press, on the field to the right, receives the late report with its own tap's:
+    // the robot sees both moves, the last one as the press's.
+    let out = env.step(&[0.2, 0.0, 1.0]).unwrap();
+    assert_eq!(out.push, Push::Move(13));
+    assert_eq!(env.board(), game.apply_all(before, &[12, 13]));
+    assert_eq!(twin.board(), env.board());
+    // Sometimes late: a share p of the presses on new boards miss (a new board makes a late
+    // report of the one before obsolete). Within 0.035: over 3 binomial σ for 2000 presses.
+    let misses = centre_presses(late(0.3), 2000)
+        .iter()
+        .filter(|p| **p == Push::Miss)
+        .count() as f64
+        / 2000.0;
+    assert!((misses - 0.3).abs() < 0.035, "{misses}");
+}
+
+#[test]
+fn noise_out_of_range_is_refused() {
+    for (tap_sd_mm, late_report_p) in [(-1.0, 0.0), (f64::NAN, 0.0), (101.0, 0.0), (0.0, 1.5)] {
+        let noise = TwinNoise {
+            tap_sd_mm,
+            late_report_p,
+        };
+        assert!(
+            matches!(Twin::with_noise(1, noise), Err(UarmError::Config(_))),
+            "{noise:?}"
+        );
+    }
+    assert!(
+        Twin::with_noise(
+            1,
+            TwinNoise {
+                tap_sd_mm: 0.0,
+                late_report_p: f64::NAN
+            }
+        )
+        .is_err()
+    );
+}
+
+#[test]
+fn what_the_skills_do_not_see_reads_zero() {
+    let twin = Twin::new(12);
+    let calibration = calibrate(&twin);
+    let observed = |observe: Observation| {
+        let config = UarmConfig {
+            observe,
+            tap_timeout_s: 0.0,
+            ..UarmConfig::default()
+        };
+        let mut env =
+            UarmEnv::new(driver(&twin), twin.tablet(), calibration.clone(), config).unwrap();
+        let board = LightsOut::new(5)
+            .unwrap()
+            .apply_all(Default::default(), &[3]);
+        env.set_board(board).unwrap();
+        env.restore_manipulator(&[0.25, 0.75]).unwrap();
+        env.observation()
+    };
+    let all = observed(Observation::BoardAndPen);
+    assert_eq!(all[..2], [0.25, 0.75]);
+    assert_eq!(
+        all[2..27].iter().filter(|v| **v != 0.0).count(),
+        4,
+        "move 3 lights 4"
+    );
+    let zero_pen = [vec![0.0, 0.0], all[2..].to_vec()].concat();
+    let mut zero_board = all.clone();
+    zero_board[2..27].fill(0.0);
+    let mut nothing = zero_pen.clone();
+    nothing[2..27].fill(0.0);
+    assert_eq!(observed(Observation::Board), zero_pen);
+    assert_eq!(observed(Observation::Pen), zero_board);
+    assert_eq!(observed(Observation::Nothing), nothing);
+    assert_eq!(
+        *nothing.last().unwrap(),
+        *all.last().unwrap(),
+        "the time is always seen"
+    );
+}
+
+#[test]
+fn robot_settings_from_before_the_observation_read_as_the_defaults() {
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::write(
+        dir.path().join(RobotSettings::FILE),
+        "action_space = \"absolute\"\nreset_board = false\n",
+    )
+    .unwrap();
+    let old = RobotSettings::read(dir.path()).unwrap().unwrap();
+    assert_eq!(old.observe, Observation::BoardAndPen);
+    assert_eq!(old.twin_noise, TwinNoise::default());
+    let new = RobotSettings {
+        observe: Observation::Pen,
+        twin_noise: TwinNoise {
+            tap_sd_mm: 2.5,
+            late_report_p: 0.1,
+        },
+        ..old
+    };
+    new.write(dir.path()).unwrap();
+    assert_eq!(RobotSettings::read(dir.path()).unwrap(), Some(new));
+    std::fs::write(dir.path().join(RobotSettings::FILE), "observe = \"eyes\"\n").unwrap();
+    assert!(matches!(
+        RobotSettings::read(dir.path()),
+        Err(UarmError::Config(_))
+    ));
 }
