@@ -30,6 +30,25 @@ impl PlanChoice {
     }
 }
 
+/// How a search goes.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum Search {
+    /// Breadth-first from the start (the reference's search).
+    #[default]
+    Breadth,
+    /// From both ends where the model's skills act as masks, every joined plan verified with
+    /// the forward model ([`meet_plan`](crate::meet_plan)); breadth-first elsewhere.
+    BothEnds,
+}
+
+impl Search {
+    /// Whether this is the default, breadth-first search (records leave it out).
+    pub fn is_breadth(&self) -> bool {
+        *self == Self::Breadth
+    }
+}
+
 /// Limits of one search. `Default` = the reference's 20 layers, a 4 GiB memory bound, no time
 /// limit (the authors' evaluation used 60 s per search), the most likely plan.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -49,6 +68,8 @@ pub struct PlannerConfig {
     pub batch_size: usize,
     /// Which plan to return.
     pub plan: PlanChoice,
+    /// How to search ([`find_plan`]; [`bfs_plan`] is breadth-first whatever this says).
+    pub search: Search,
 }
 
 impl Default for PlannerConfig {
@@ -60,6 +81,7 @@ impl Default for PlannerConfig {
             max_expanded: None,
             batch_size: 1024,
             plan: PlanChoice::MostLikely,
+            search: Search::Breadth,
         }
     }
 }
@@ -114,6 +136,19 @@ pub enum PlanError {
         /// States expanded.
         expanded: usize,
     },
+}
+
+/// A plan from `start` to `goal` by the search `config.search` names.
+pub fn find_plan(
+    successor: &mut dyn Successor,
+    start: SymbolicState,
+    goal: SymbolicState,
+    config: &PlannerConfig,
+) -> Result<Plan, PlanError> {
+    match config.search {
+        Search::Breadth => bfs_plan(successor, start, goal, config),
+        Search::BothEnds => crate::meet_plan(successor, start, goal, config),
+    }
 }
 
 /// A symbolic state packed into a hash key as small as the state allows.
@@ -420,7 +455,7 @@ const MAX_CANDIDATES: usize = 64;
 /// Of `candidates` (plans from `start`, in search order), the one the model is surest of, each
 /// step's skill the likeliest of the skills whose predicted successor is that step's state; the
 /// earliest of equals. `None` where the model has no probabilities or there is no candidate.
-fn most_likely(
+pub(crate) fn most_likely(
     successor: &mut dyn Successor,
     start: SymbolicState,
     candidates: Vec<Plan>,

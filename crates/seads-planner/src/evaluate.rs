@@ -306,6 +306,7 @@ mod tests {
                     timeout_s: Some(10.0),
                     max_expanded: None,
                     plan: crate::PlanChoice::FirstFound,
+                    search: crate::Search::Breadth,
                 }),
                 action_noise: None,
             }),

@@ -7,7 +7,7 @@ use seads_embodiment::{EnvError, Environment, SkillPolicy, SkillRun, execute_ski
 use seads_games::{Successor, SymbolicState};
 use serde::{Deserialize, Serialize};
 
-use crate::{PlanChoice, PlanError, PlannerConfig, bfs_plan};
+use crate::{PlanChoice, PlanError, PlannerConfig, find_plan};
 
 /// How a task is solved. `Default` = with re-planning, at most 10 plans (the reference).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -180,17 +180,17 @@ fn search(
         PlanChoice::FirstFound => Vec::new(),
     };
     let mut plan = if failed.is_empty() {
-        bfs_plan(successor, start, goal, &config.planner)
+        find_plan(successor, start, goal, &config.planner)
     } else {
         let mut avoiding = Avoiding {
             inner: successor,
             failed: &failed,
         };
-        bfs_plan(&mut avoiding, start, goal, &config.planner)
+        find_plan(&mut avoiding, start, goal, &config.planner)
     };
     if plan.is_err() && !failed.is_empty() {
         outcome.timed_out |= matches!(plan, Err(PlanError::Timeout { .. }));
-        plan = bfs_plan(successor, start, goal, &config.planner);
+        plan = find_plan(successor, start, goal, &config.planner);
     }
     outcome.planning_s += began.elapsed().as_secs_f64();
     outcome.timed_out |= matches!(plan, Err(PlanError::Timeout { .. }));

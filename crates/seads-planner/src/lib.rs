@@ -30,14 +30,16 @@
 mod bfs;
 mod evaluate;
 mod execute;
+mod meet;
 mod protocol;
 
-pub use bfs::{Plan, PlanChoice, PlanError, PlannerConfig, bfs_plan};
+pub use bfs::{Plan, PlanChoice, PlanError, PlannerConfig, Search, bfs_plan, find_plan};
 pub use evaluate::{
     CheckpointId, DepthResult, Evaluation, EvaluationRecord, EvaluationSummary, TaskRecord,
     evaluate, summarise,
 };
 pub use execute::{Deviation, SolveConfig, SolveOutcome, solve};
+pub use meet::meet_plan;
 pub use protocol::{
     DEFAULT_MAX_EXPANDED, EVALUATION_SEEDS, EvaluationKind, Protocol, STANDARD_DEPTHS,
     SearchLimits, TASK_STREAM_SEED, TaskSet,

@@ -25,7 +25,7 @@ use rand_chacha::ChaCha8Rng;
 use seads_embodiment::{BoardState, EnvConfig, EnvError};
 use seads_games::{GameKind, Split, SymbolicState};
 
-use crate::PlanChoice;
+use crate::{PlanChoice, Search};
 use serde::{Deserialize, Serialize};
 
 /// The 20 environment seeds of the authors' evaluation jobs (the first 20 draws of
@@ -157,6 +157,9 @@ pub struct SearchLimits {
     /// Which plan a search returns (records from before the choice: the first found).
     #[serde(default = "PlanChoice::paper")]
     pub plan: PlanChoice,
+    /// How each search goes (records without it: breadth-first).
+    #[serde(default, skip_serializing_if = "Search::is_breadth")]
+    pub search: Search,
 }
 
 impl Default for SearchLimits {
@@ -165,6 +168,7 @@ impl Default for SearchLimits {
             timeout_s: None,
             max_expanded: Some(DEFAULT_MAX_EXPANDED),
             plan: PlanChoice::MostLikely,
+            search: Search::Breadth,
         }
     }
 }
@@ -177,6 +181,7 @@ impl SearchLimits {
             timeout_s: self.timeout_s,
             max_expanded: self.max_expanded,
             plan: self.plan,
+            search: self.search,
             ..crate::PlannerConfig::default()
         }
     }

@@ -6,7 +6,7 @@ use std::time::Instant;
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 use seads_games::{BoardDataset, BoardGame, LightsOut, Split};
-use seads_planner::{PlanError, PlannerConfig, bfs_plan};
+use seads_planner::{PlanError, PlannerConfig, find_plan};
 use seads_rl::ComputeDevice;
 use seads_skillmodel::{SkillModelConfig, agreement_with_game, fit_to_game};
 use serde::Serialize;
@@ -32,6 +32,8 @@ pub struct PlanBench {
     pub timeout_s: Option<f64>,
     /// Which plan each search returns.
     pub plan: seads_planner::PlanChoice,
+    /// How each search goes.
+    pub search: seads_planner::Search,
 }
 
 /// The timings of one depth.
@@ -182,6 +184,7 @@ impl PlanBench {
             let planner = PlannerConfig {
                 timeout_s: self.timeout_s,
                 plan: self.plan,
+                search: self.search,
                 ..PlannerConfig::default()
             };
             for _ in 0..self.boards {
@@ -189,7 +192,7 @@ impl PlanBench {
                     StudyError::invalid(format!("LightsOut 5×5 has no test board of depth {depth}"))
                 })?;
                 let start = Instant::now();
-                let plan = bfs_plan(&mut model, board, game.goal(), &planner);
+                let plan = find_plan(&mut model, board, game.goal(), &planner);
                 row.seconds.push(start.elapsed().as_secs_f64());
                 if let Err(PlanError::Timeout { .. }) = plan {
                     row.timed_out = true;

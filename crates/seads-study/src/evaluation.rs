@@ -84,6 +84,9 @@ pub struct CheckpointEvaluation {
     /// Which plan each search returned (lines from before the choice: the first found).
     #[serde(default = "PlanChoice::paper")]
     pub plan: PlanChoice,
+    /// How each search went (lines without it: breadth-first).
+    #[serde(default, skip_serializing_if = "seads_planner::Search::is_breadth")]
+    pub search: seads_planner::Search,
     /// Per depth.
     pub results: Vec<DepthResult>,
 }
@@ -102,6 +105,7 @@ impl CheckpointEvaluation {
                 timeout_s: self.timeout_s,
                 max_expanded: self.max_expanded,
                 plan: self.plan,
+                search: self.search,
             }),
             action_noise: None,
         }

@@ -182,6 +182,7 @@ pub fn evaluate_checkpoints(
             timeout_s: limits.timeout_s,
             max_expanded: limits.max_expanded,
             plan: limits.plan,
+            search: limits.search,
             results,
         };
         seads_rl::store::append_json_line(&path, &line)?;

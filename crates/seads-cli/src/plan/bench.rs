@@ -35,6 +35,10 @@ pub struct PlanBenchArgs {
     /// compare the two choices' cost with one binary.
     #[arg(long, value_name = "CHOICE", default_value = "most-likely", value_parser = super::plan_choice)]
     plan: seads_planner::PlanChoice,
+    /// How each search goes: breadth (default, the paper's) or both-ends, to compare the two
+    /// searches' cost with one binary.
+    #[arg(long, value_name = "SEARCH", default_value = "breadth", value_parser = super::search_kind)]
+    search: seads_planner::Search,
     /// Print JSON.
     #[arg(long)]
     json: bool,
@@ -70,6 +74,7 @@ pub fn plan_bench(args: PlanBenchArgs) -> Result<()> {
         device,
         timeout_s: args.timeout,
         plan: args.plan,
+        search: args.search,
     };
     // A line per depth as it is timed; a failed write ends the command after the benchmark.
     let mut written = Ok(());

@@ -10,7 +10,7 @@ use std::path::Path;
 
 use anyhow::{Context, Result, bail};
 use clap::Args;
-use seads_planner::{PlanChoice, SearchLimits};
+use seads_planner::{PlanChoice, Search, SearchLimits};
 use seads_rl::{Agent, ComputeDevice};
 
 pub use bench::{PlanBenchArgs, plan_bench};
@@ -43,6 +43,21 @@ pub struct SearchArgs {
     /// skill that just failed from the same board) or `first-found` (the paper's search).
     #[arg(long, value_name = "CHOICE", default_value = "most-likely", value_parser = plan_choice)]
     plan: PlanChoice,
+    /// How each search goes: `breadth` (breadth-first from the board, the paper's) or
+    /// `both-ends` (also backwards from the goal where the model's skills act the same on every
+    /// board, as on LightsOut; every joined plan is checked with the forward model; far fewer
+    /// states for deep boards, breadth-first where the skills do not allow it).
+    #[arg(long, value_name = "SEARCH", default_value = "breadth", value_parser = search_kind)]
+    search: Search,
+}
+
+/// `breadth` or `both-ends`.
+fn search_kind(text: &str) -> Result<Search, String> {
+    match text {
+        "breadth" => Ok(Search::Breadth),
+        "both-ends" => Ok(Search::BothEnds),
+        other => Err(format!("{other:?} is not one of breadth, both-ends")),
+    }
 }
 
 /// `most-likely` or `first-found`.
@@ -61,6 +76,7 @@ impl SearchArgs {
             timeout_s: self.timeout,
             max_expanded: Some(usize::try_from(self.max_expanded).unwrap_or(usize::MAX)),
             plan: self.plan,
+            search: self.search,
         }
     }
 }

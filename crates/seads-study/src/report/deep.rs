@@ -137,6 +137,7 @@ mod tests {
             timeout_s: Some(60.0),
             max_expanded: None,
             plan: seads_planner::PlanChoice::FirstFound,
+            search: seads_planner::Search::Breadth,
         };
         let mut a = bare_run(1);
         a.deep = Some(DeepSearch {

@@ -94,6 +94,7 @@ impl EvaluationPlan {
             timeout_s: self.timeout,
             max_expanded: self.max_expanded,
             plan: self.plan,
+            search: seads_planner::Search::Breadth,
         }
     }
 }
