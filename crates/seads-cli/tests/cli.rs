@@ -1543,7 +1543,7 @@ proptest::proptest! {
         let run = tiny_run().join("run");
         let run = run.to_str().unwrap();
         let board = vec!["0"; 25].join(",");
-        let templates: [&[&str]; 13] = [
+        let templates: [&[&str]; 14] = [
             &["record", "--env", "lightsout-cursor", "--episodes", "1", "--steps", "V", "--out", out],
             &["record", "--env", "lightsout-cursor", "--episodes", "V", "--steps", "1", "--out", out],
             &["env-bench", "--env", "lightsout-cursor", "--steps", "V", "--threads", "1"],
@@ -1554,6 +1554,7 @@ proptest::proptest! {
             &["solve", "--run", run, "--board", &board, "--timeout", "V"],
             &["uarm", "calibrate", "--port", "sim", "--d-max-mm", "V", "--out", out],
             &["evaluate", "--run", run, "--boards", "1", "--quiet", "--max-expanded", "V"],
+            &["evaluate", "--run", run, "--boards", "1", "--quiet", "--memory-limit", "V"],
             &["plan-bench", "--depths", "1", "--boards", "1", "--threads", "V"],
             &["train", "--env", "lightsout-cursor", "--out", out, "--quiet", "--env-steps", "V"],
             &["train", "--env", "lightsout-cursor", "--out", out, "--quiet", "--env-steps", "1", "--seed", "V"],
@@ -1570,6 +1571,49 @@ proptest::proptest! {
             proptest::prop_assert_eq!(stderr.trim().lines().count(), 1, "{:?}: {}", args, stderr);
         }
     }
+}
+
+/// `seads evaluate --search both-ends --memory-limit GIB` records both in its protocol and solves
+/// as many of the tiny agent's boards as breadth-first search does; an unknown search is bad
+/// input.
+#[test]
+fn an_evaluation_records_its_search_and_memory_bound() {
+    let dir = tempfile::tempdir().unwrap();
+    let run = dir.path().join("run");
+    copy_tiny_run(&run);
+    let evaluate = |extra: &[&str]| -> serde_json::Value {
+        let mut args = vec!["evaluate", "--run", s(&run), "--boards", "3", "--replan"];
+        args.extend(["--max-expanded", "20000", "--json"]);
+        args.extend(extra);
+        seads_ok(&args);
+        serde_json::from_slice(&std::fs::read(run.join("evaluation-replan.json")).unwrap()).unwrap()
+    };
+    let breadth = evaluate(&[]);
+    let limits = &breadth["protocol"]["limits"];
+    assert!(
+        limits.get("search").is_none() && limits.get("memory_limit_mib").is_none(),
+        "{limits}"
+    );
+    let both = evaluate(&["--search", "both-ends", "--memory-limit", "16"]);
+    let limits = &both["protocol"]["limits"];
+    assert_eq!(limits["search"], "both-ends", "{limits}");
+    assert_eq!(limits["memory_limit_mib"], 16384, "{limits}");
+    let outcomes = |record: &serde_json::Value| -> Vec<(u64, u64)> {
+        let results = record["results"].as_array().unwrap().iter();
+        results
+            .map(|d| {
+                (
+                    d["solved"].as_u64().unwrap(),
+                    d["plan_found"].as_u64().unwrap(),
+                )
+            })
+            .collect()
+    };
+    assert_eq!(outcomes(&both), outcomes(&breadth));
+    check_bad_input(
+        &["evaluate", "--run", s(&run), "--search", "sideways"],
+        "breadth, both-ends",
+    );
 }
 
 /// `seads evaluate --action-noise STD` plays the same tasks with noisy actions, into files of

@@ -307,6 +307,7 @@ mod tests {
                     max_expanded: None,
                     plan: crate::PlanChoice::FirstFound,
                     search: crate::Search::Breadth,
+                    memory_limit_mib: None,
                 }),
                 action_noise: None,
             }),

@@ -160,6 +160,10 @@ pub struct SearchLimits {
     /// How each search goes (records without it: breadth-first).
     #[serde(default, skip_serializing_if = "Search::is_breadth")]
     pub search: Search,
+    /// Memory of each search's structures, MiB (`None`: the planner's default, 4 GiB; the
+    /// paper's deeper search stopped at about 16 GB).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub memory_limit_mib: Option<usize>,
 }
 
 impl Default for SearchLimits {
@@ -169,6 +173,7 @@ impl Default for SearchLimits {
             max_expanded: Some(DEFAULT_MAX_EXPANDED),
             plan: PlanChoice::MostLikely,
             search: Search::Breadth,
+            memory_limit_mib: None,
         }
     }
 }
@@ -182,6 +187,9 @@ impl SearchLimits {
             max_expanded: self.max_expanded,
             plan: self.plan,
             search: self.search,
+            memory_limit_mib: self
+                .memory_limit_mib
+                .unwrap_or(crate::PlannerConfig::default().memory_limit_mib),
             ..crate::PlannerConfig::default()
         }
     }
@@ -386,5 +394,28 @@ mod tests {
             replan.tasks_file(&STANDARD_DEPTHS, None),
             "evaluation-replan-tasks.jsonl"
         );
+    }
+
+    /// Records name a search from both ends and a memory bound, and those from before either
+    /// read as breadth-first search under the planner's default memory.
+    #[test]
+    fn limits_record_the_search_and_memory_and_old_records_read_as_breadth_first() {
+        let old: SearchLimits =
+            serde_json::from_str(r#"{"max_expanded":100,"plan":"most-likely"}"#).unwrap();
+        assert_eq!(old.search, Search::Breadth);
+        assert_eq!(old.memory_limit_mib, None);
+        assert_eq!(old.planner().memory_limit_mib, 4096);
+        let both = SearchLimits {
+            search: Search::BothEnds,
+            memory_limit_mib: Some(16 * 1024),
+            ..old
+        };
+        let text = serde_json::to_string(&both).unwrap();
+        assert!(text.contains(r#""search":"both-ends""#), "{text}");
+        assert!(text.contains(r#""memory_limit_mib":16384"#), "{text}");
+        assert_eq!(serde_json::from_str::<SearchLimits>(&text).unwrap(), both);
+        assert_eq!(both.planner().search, Search::BothEnds);
+        assert_eq!(both.planner().memory_limit_mib, 16384);
+        assert!(!serde_json::to_string(&old).unwrap().contains("search"));
     }
 }

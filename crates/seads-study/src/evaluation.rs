@@ -87,6 +87,9 @@ pub struct CheckpointEvaluation {
     /// How each search went (lines without it: breadth-first).
     #[serde(default, skip_serializing_if = "seads_planner::Search::is_breadth")]
     pub search: seads_planner::Search,
+    /// Memory of each search, MiB, if not the planner's default.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub memory_limit_mib: Option<usize>,
     /// Per depth.
     pub results: Vec<DepthResult>,
 }
@@ -106,6 +109,7 @@ impl CheckpointEvaluation {
                 max_expanded: self.max_expanded,
                 plan: self.plan,
                 search: self.search,
+                memory_limit_mib: self.memory_limit_mib,
             }),
             action_noise: None,
         }

@@ -183,6 +183,7 @@ pub fn evaluate_checkpoints(
             max_expanded: limits.max_expanded,
             plan: limits.plan,
             search: limits.search,
+            memory_limit_mib: limits.memory_limit_mib,
             results,
         };
         seads_rl::store::append_json_line(&path, &line)?;

@@ -49,6 +49,10 @@ pub struct SearchArgs {
     /// states for deep boards, breadth-first where the skills do not allow it).
     #[arg(long, value_name = "SEARCH", default_value = "breadth", value_parser = search_kind)]
     search: Search,
+    /// Stop each search when its structures outgrow this many GiB (default 4; the paper's
+    /// deeper search stopped at about 16 GB).
+    #[arg(long, value_name = "GIB", value_parser = clap::value_parser!(u32).range(1..=4096))]
+    memory_limit: Option<u32>,
 }
 
 /// `breadth` or `both-ends`.
@@ -77,6 +81,7 @@ impl SearchArgs {
             max_expanded: Some(usize::try_from(self.max_expanded).unwrap_or(usize::MAX)),
             plan: self.plan,
             search: self.search,
+            memory_limit_mib: self.memory_limit.map(|gib| gib as usize * 1024),
         }
     }
 }

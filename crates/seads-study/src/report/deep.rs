@@ -138,6 +138,7 @@ mod tests {
             max_expanded: None,
             plan: seads_planner::PlanChoice::FirstFound,
             search: seads_planner::Search::Breadth,
+            memory_limit_mib: None,
         };
         let mut a = bare_run(1);
         a.deep = Some(DeepSearch {

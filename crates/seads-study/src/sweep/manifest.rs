@@ -95,6 +95,7 @@ impl EvaluationPlan {
             max_expanded: self.max_expanded,
             plan: self.plan,
             search: seads_planner::Search::Breadth,
+            memory_limit_mib: None,
         }
     }
 }
