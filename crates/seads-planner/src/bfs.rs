@@ -68,7 +68,8 @@ pub struct PlannerConfig {
     pub batch_size: usize,
     /// Which plan to return.
     pub plan: PlanChoice,
-    /// How to search ([`find_plan`]; [`bfs_plan`] is breadth-first whatever this says).
+    /// How to search ([`find_plan`](crate::find_plan); [`bfs_plan`] is breadth-first whatever
+    /// this says).
     pub search: Search,
 }
 
@@ -136,19 +137,6 @@ pub enum PlanError {
         /// States expanded.
         expanded: usize,
     },
-}
-
-/// A plan from `start` to `goal` by the search `config.search` names.
-pub fn find_plan(
-    successor: &mut dyn Successor,
-    start: SymbolicState,
-    goal: SymbolicState,
-    config: &PlannerConfig,
-) -> Result<Plan, PlanError> {
-    match config.search {
-        Search::Breadth => bfs_plan(successor, start, goal, config),
-        Search::BothEnds => crate::meet_plan(successor, start, goal, config),
-    }
 }
 
 /// A symbolic state packed into a hash key as small as the state allows.

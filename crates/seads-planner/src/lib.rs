@@ -33,7 +33,7 @@ mod execute;
 mod meet;
 mod protocol;
 
-pub use bfs::{Plan, PlanChoice, PlanError, PlannerConfig, Search, bfs_plan, find_plan};
+pub use bfs::{Plan, PlanChoice, PlanError, PlannerConfig, Search, bfs_plan};
 pub use evaluate::{
     CheckpointId, DepthResult, Evaluation, EvaluationRecord, EvaluationSummary, TaskRecord,
     evaluate, summarise,
@@ -44,3 +44,16 @@ pub use protocol::{
     DEFAULT_MAX_EXPANDED, EVALUATION_SEEDS, EvaluationKind, Protocol, STANDARD_DEPTHS,
     SearchLimits, TASK_STREAM_SEED, TaskSet,
 };
+
+/// A plan from `start` to `goal` by the search `config.search` names.
+pub fn find_plan(
+    successor: &mut dyn seads_games::Successor,
+    start: seads_games::SymbolicState,
+    goal: seads_games::SymbolicState,
+    config: &PlannerConfig,
+) -> Result<Plan, PlanError> {
+    match config.search {
+        Search::Breadth => bfs_plan(successor, start, goal, config),
+        Search::BothEnds => meet_plan(successor, start, goal, config),
+    }
+}
