@@ -127,6 +127,7 @@ fn crate_dependencies_point_one_way_and_only_five_crates_link_libtorch() {
             ],
         ),
         ("seads-planner", &["seads-embodiment", "seads-games"]),
+        ("seads-infer", &["seads-embodiment", "seads-games"]),
         ("seads-uarm", &["seads-embodiment", "seads-games"]),
         (
             "seads-py",
@@ -242,6 +243,7 @@ fn light_crates_pull_in_neither_libtorch_nor_rapier() {
             &["tch", "torch-sys", "rapier3d"][..],
         ),
         (&["-p", "seads-planner"], &["tch", "torch-sys", "rapier3d"]),
+        (&["-p", "seads-infer"], &["tch", "torch-sys", "rapier3d"]),
         (&["-p", "seads-uarm"], &["tch", "torch-sys", "rapier3d"]),
         (
             &["-p", "seads-embodiment", "--no-default-features"],

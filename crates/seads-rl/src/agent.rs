@@ -38,6 +38,29 @@ impl SkillPolicy for AgentPolicy {
     }
 }
 
+impl AgentPolicy {
+    /// Actions for rows of observations, row i executing skill `skills[i]`: deterministic when
+    /// `rng` is `None`, else sampled with noise from `rng` (as training collects episodes).
+    pub fn actions(
+        &self,
+        observations: &[f32],
+        skills: &[usize],
+        rng: Option<&mut rand_chacha::ChaCha8Rng>,
+    ) -> Vec<f32> {
+        let obs_dim = observations.len() / skills.len().max(1);
+        let width = obs_dim + self.k;
+        let mut inputs = vec![0.0; skills.len() * width];
+        for ((obs, &k), row) in observations
+            .chunks(obs_dim.max(1))
+            .zip(skills)
+            .zip(inputs.chunks_mut(width))
+        {
+            policy_input(obs, k, row);
+        }
+        self.sac.act(&inputs, rng)
+    }
+}
+
 /// A trained SEADS agent.
 pub struct Agent {
     /// The run's configuration.

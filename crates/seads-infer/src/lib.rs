@@ -1,0 +1,209 @@
+//! A trained SEADS agent without libtorch (SPEC §3–4): reads a run directory's checkpoint (two
+//! safetensors files and the config it was trained with) and evaluates its networks in plain
+//! Rust, with `ndarray`'s matrix products:
+//!
+//! - [`Policy`], the skill policy π(a | s, k): deterministic actions and seeded samples, as the
+//!   trainer computes them, and a [`SkillPolicy`](seads_embodiment::SkillPolicy), so the
+//!   planner's executor runs its skills;
+//! - [`ForwardModel`], the symbolic forward model q(z_T | z_0, k): a
+//!   [`Successor`](seads_games::Successor), so the planner plans with it, with the model's
+//!   log-probabilities for the most likely plan.
+//!
+//! The networks are small perceptrons (two hidden layers of 256, ReLU), so a CPU evaluates them
+//! quickly; the crate links neither libtorch nor a physics engine, and so serves the Python
+//! package, where a second libtorch beside PyTorch's would crash the process.
+//!
+//! # Example
+//!
+//! ```no_run
+//! use seads_games::{BoardGame, LightsOut};
+//! use seads_infer::Agent;
+//! use seads_planner::{PlannerConfig, find_plan};
+//!
+//! let mut agent = Agent::load("runs/demo".as_ref(), None)?; // the latest checkpoint
+//! let game = LightsOut::new(5)?;
+//! let board = game.apply_all(game.goal(), &[3, 12]);
+//! let plan = find_plan(&mut agent.model, board, game.goal(), &PlannerConfig::default())?;
+//! println!("skills {:?}", plan.skills);
+//! # Ok::<(), Box<dyn std::error::Error>>(())
+//! ```
+
+mod checkpoint;
+mod mlp;
+mod model;
+mod policy;
+
+use std::path::Path;
+
+use seads_embodiment::{EnvConfig, EnvSpec, make_env};
+
+pub use checkpoint::{Tensors, checkpoint_dir};
+pub use mlp::{Dense, Mlp};
+pub use model::ForwardModel;
+pub use policy::Policy;
+
+/// Why an agent could not be loaded or asked.
+#[derive(Debug, thiserror::Error)]
+pub enum InferError {
+    /// A file could not be read.
+    #[error("{what}: {source}")]
+    Io {
+        /// What was being done.
+        what: String,
+        /// The cause.
+        #[source]
+        source: std::io::Error,
+    },
+    /// A checkpoint or run that is not there.
+    #[error("{0}")]
+    Missing(String),
+    /// A file that is not what it should be.
+    #[error("{path}: {reason}")]
+    Damaged {
+        /// The file.
+        path: String,
+        /// What is wrong.
+        reason: String,
+    },
+    /// Networks whose sizes do not fit each other or the environment.
+    #[error("{0}")]
+    Shape(String),
+    /// A question the agent cannot answer (wrong sizes, a skill it does not have, NaN).
+    #[error("{0}")]
+    Input(String),
+    /// The run's environment.
+    #[error("environment {env}: {reason}")]
+    Environment {
+        /// Its name.
+        env: String,
+        /// What is wrong.
+        reason: String,
+    },
+}
+
+/// The file of the forward model in a checkpoint.
+pub const MODEL_FILE: &str = "forward_model.safetensors";
+/// The file of the actor in a checkpoint.
+pub const ACTOR_FILE: &str = "sac_actor.safetensors";
+
+/// A SEADS agent of one checkpoint: its policy and its forward model.
+#[derive(Debug, Clone)]
+pub struct Agent {
+    /// The skill policy.
+    pub policy: Policy,
+    /// The forward model.
+    pub model: ForwardModel,
+    /// The environment it was trained on.
+    pub env: String,
+    /// The checkpoint's epoch.
+    pub epoch: u64,
+}
+
+/// What a checkpoint's `config.toml` says of its environment and learner.
+#[derive(serde::Deserialize)]
+struct SavedConfig {
+    env: String,
+    #[serde(default)]
+    algorithm: Option<String>,
+    #[serde(default)]
+    env_config: EnvConfig,
+}
+
+impl Agent {
+    /// The agent of the run in `run` at the checkpoint of `epoch`, or the latest; its
+    /// environment from the registry (the Cursor and Reacher environments; a Jaco or robot run
+    /// needs [`Agent::load_for`] with its environment's spec).
+    pub fn load(run: &Path, epoch: Option<u64>) -> Result<Self, InferError> {
+        let dir = checkpoint_dir(run, epoch)?;
+        let config = saved_config(&dir)?;
+        let env =
+            make_env(&config.env, &config.env_config).map_err(|e| InferError::Environment {
+                env: config.env.clone(),
+                reason: e.to_string(),
+            })?;
+        Self::load_for(run, epoch, env.spec())
+    }
+
+    /// The agent of the run in `run` at the checkpoint of `epoch`, or the latest, for an
+    /// environment of `spec` (its observation size and action box).
+    pub fn load_for(run: &Path, epoch: Option<u64>, spec: &EnvSpec) -> Result<Self, InferError> {
+        let dir = checkpoint_dir(run, epoch)?;
+        let config = saved_config(&dir)?;
+        if config.algorithm.as_deref().is_some_and(|a| a != "seads") {
+            return Err(InferError::Environment {
+                env: config.env,
+                reason: format!(
+                    "a {} run has no forward model to plan with",
+                    config.algorithm.unwrap_or_default()
+                ),
+            });
+        }
+        if config.env != spec.name {
+            return Err(InferError::Environment {
+                env: config.env,
+                reason: format!("the spec given is of {}", spec.name),
+            });
+        }
+        let model = ForwardModel::new(Tensors::read(&dir.join(MODEL_FILE))?.mlp("forward_model")?)?;
+        let actor = Tensors::read(&dir.join(ACTOR_FILE))?;
+        let policy = Policy::new(
+            actor.mlp("actor")?,
+            actor.dense("actor_log_std")?,
+            spec.obs_dim,
+            &spec.action_low,
+            &spec.action_high,
+        )?;
+        use seads_embodiment::SkillPolicy as _;
+        use seads_games::Successor as _;
+        if model.symbolic_len() != spec.symbolic_len || model.num_skills() != policy.num_skills() {
+            return Err(InferError::Shape(format!(
+                "{}: a forward model of {} skills on {} fields and a policy of {} skills, for an \
+                 environment of {} fields",
+                dir.display(),
+                model.num_skills(),
+                model.symbolic_len(),
+                policy.num_skills(),
+                spec.symbolic_len
+            )));
+        }
+        let epoch = dir
+            .file_name()
+            .and_then(|n| n.to_str())
+            .and_then(|n| n.strip_prefix("epoch-"))
+            .and_then(|n| n.parse().ok())
+            .unwrap_or(0);
+        Ok(Self {
+            policy,
+            model,
+            env: config.env,
+            epoch,
+        })
+    }
+}
+
+/// The config a checkpoint was saved with.
+fn saved_config(dir: &Path) -> Result<SavedConfig, InferError> {
+    let path = dir.join("config.toml");
+    let text = std::fs::read_to_string(&path).map_err(|e| InferError::Io {
+        what: format!("reading {}", path.display()),
+        source: e,
+    })?;
+    // Only the fields this crate needs; the trainer validates the rest.
+    let table: toml::Table = toml::from_str(&text).map_err(|e| InferError::Damaged {
+        path: path.display().to_string(),
+        reason: e.message().to_owned(),
+    })?;
+    let pick = |key: &str| table.get(key).cloned();
+    let mut wanted = toml::Table::new();
+    for key in ["env", "algorithm", "env_config"] {
+        if let Some(value) = pick(key) {
+            wanted.insert(key.to_owned(), value);
+        }
+    }
+    wanted
+        .try_into()
+        .map_err(|e: toml::de::Error| InferError::Damaged {
+            path: path.display().to_string(),
+            reason: e.message().to_owned(),
+        })
+}
