@@ -131,7 +131,12 @@ fn crate_dependencies_point_one_way_and_only_five_crates_link_libtorch() {
         ("seads-uarm", &["seads-embodiment", "seads-games"]),
         (
             "seads-py",
-            &["seads-embodiment", "seads-games", "seads-planner"],
+            &[
+                "seads-embodiment",
+                "seads-games",
+                "seads-infer",
+                "seads-planner",
+            ],
         ),
         (
             "seads-study",

@@ -134,6 +134,16 @@ pub struct Env {
     game: Box<dyn BoardGame>,
 }
 
+impl Env {
+    /// The environment in skill mode, for executing skills (`None` in task mode).
+    pub(crate) fn skill_env(&mut self) -> Option<&mut dyn Environment> {
+        match &mut self.core {
+            Core::Skill(env) => Some(env.as_mut()),
+            Core::Task(_) => None,
+        }
+    }
+}
+
 #[pymethods]
 impl Env {
     /// `Env(name, options=None, task=False)`: the environment `name` (see `env_names()`),

@@ -4,13 +4,15 @@
 //! (`games.rs`), and a top-view rasteriser for `render()` (`render.rs`). The Python half
 //! (`python/seads`) wraps them as Gymnasium environments and registers them.
 //!
-//! Architecture invariant: no libtorch. A trained agent is used from Python through the
-//! `seads` command and its run directories, never by loading a second libtorch into a process
-//! that already has PyTorch's.
+//! A trained agent (`agent.rs`) is loaded with `seads-infer`, which reads its checkpoint and
+//! evaluates its networks without libtorch.
+//!
+//! Architecture invariant: no libtorch, never a second one beside PyTorch's in a process.
 
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 
+mod agent;
 mod env;
 mod games;
 mod render;
@@ -36,6 +38,7 @@ fn _seads(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<env::Env>()?;
     m.add_class::<vector::VecEnv>()?;
     m.add_class::<games::Game>()?;
+    m.add_class::<agent::Agent>()?;
     m.add_function(wrap_pyfunction!(games::plan, m)?)?;
     Ok(())
 }

@@ -4,19 +4,19 @@ The environments of the Rust workspace ``seads`` (LightsOut and TileSwap under a
 planar Reacher arm or a Kinova Jaco arm) as Gymnasium environments, registered as
 ``seads/<Name>-v0`` (for example ``gymnasium.make("seads/LightsOutCursor-v0")``), with a vector
 environment that steps many of them in parallel in Rust (``gymnasium.make_vec``); the board
-games (:class:`Game`) and breadth-first planning with the true game model (:func:`plan`).
-
-Trained SEADS agents are not loaded into Python (that would put a second libtorch beside
-PyTorch's in one process): train, evaluate and solve with the ``seads`` command, and read its
-run directories and episode files from Python.
+games (:class:`Game`) and breadth-first planning with the true game model (:func:`plan`); and
+trained agents (:class:`Agent`): load a run directory that the ``seads`` command trained, act
+with its skills, plan with its forward model and solve boards in an environment. Agents are
+evaluated in Rust without libtorch, so they sit safely beside PyTorch in one process.
 """
 
 import gymnasium
 
-from ._seads import Env, Game, VecEnv, __version__, env_names, plan
+from ._seads import Agent, Env, Game, VecEnv, __version__, env_names, plan
 from .gym import SeadsEnv, SeadsVectorEnv, gym_id
 
 __all__ = [
+    "Agent",
     "Env",
     "Game",
     "SeadsEnv",

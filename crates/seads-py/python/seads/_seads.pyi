@@ -101,3 +101,55 @@ def plan(
     max_depth: int = 20,
 ) -> list[int]:
     """Breadth-first search with the true game model: a shortest move sequence."""
+
+class Agent:
+    """A trained SEADS agent from its run directory: the skill policy and the forward model,
+    evaluated in Rust without libtorch."""
+
+    @staticmethod
+    def load(run_dir: str, checkpoint: int | None = None) -> "Agent":
+        """The agent of ``run_dir`` at its latest checkpoint or the one of epoch ``checkpoint``;
+        ``ValueError`` for a missing or damaged run."""
+    @property
+    def env(self) -> str:
+        """The environment it was trained on."""
+    @property
+    def epoch(self) -> int:
+        """The checkpoint's epoch."""
+    @property
+    def num_skills(self) -> int:
+        """The number of skills K."""
+    def act(
+        self,
+        obs: npt.NDArray[np.float32],
+        skill: int | Sequence[int],
+        deterministic: bool = True,
+        seed: int | None = None,
+    ) -> npt.NDArray[np.float32]:
+        """Actions for one observation or rows of observations, executing ``skill`` (one, or
+        one per row): the deterministic action, or a sample drawn from ``seed``."""
+    def successors(self, board: npt.NDArray[np.uint8] | Sequence[int]) -> npt.NDArray[np.uint8]:
+        """The board the forward model predicts after each skill (K rows)."""
+    def plan(
+        self,
+        board: npt.NDArray[np.uint8] | Sequence[int],
+        goal: npt.NDArray[np.uint8] | Sequence[int] | None = None,
+        max_depth: int = 20,
+        max_expanded: int | None = 4194304,
+        search: str = "breadth",
+        choice: str = "most-likely",
+    ) -> list[int]:
+        """The skills of a plan the forward model predicts to reach ``goal`` (the solved board);
+        ``ValueError`` if there is none within the limits."""
+    def solve(
+        self,
+        env: Any,
+        board: npt.NDArray[np.uint8] | Sequence[int] | None = None,
+        replan: bool = True,
+        max_expanded: int | None = 4194304,
+        search: str = "breadth",
+        choice: str = "most-likely",
+    ) -> dict[str, Any]:
+        """Plans from the environment's board (or ``board``) and executes the skills in ``env``
+        (a ``seads`` Gymnasium environment or ``Env`` of the agent's kind, skill mode),
+        re-planning after a deviation: solved, skills, moves, path, steps, plans, failure."""

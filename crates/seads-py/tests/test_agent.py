@@ -1,0 +1,122 @@
+"""A trained agent in Python (``seads.Agent``, no libtorch) against the ``seads`` binary
+(libtorch) on the same checkpoint: the first plan of every task and the outcome of every task of
+``seads evaluate`` with re-planning, executed step by step in a Python environment; and bad input
+as exceptions."""
+
+import json
+import pathlib
+import shutil
+
+import gymnasium
+import numpy as np
+import pytest
+
+import seads
+
+DATA = pathlib.Path(__file__).with_name("data")
+RUN = DATA / "agent-run"
+TASKS = [json.loads(line) for line in open(RUN / "evaluation-replan-tasks.jsonl")]
+
+
+@pytest.fixture(scope="module")
+def agent():
+    return seads.Agent.load(str(RUN))
+
+
+def board(task):
+    return np.array([int(v) for v in task["board"].split(",")], dtype=np.uint8)
+
+
+def test_the_agent_names_its_run(agent):
+    assert (agent.env, agent.epoch, agent.num_skills) == ("lightsout-cursor", 510, 25)
+
+
+def test_plans_are_the_binarys_first_plans(agent):
+    for task in TASKS:
+        if task["plan_found"]:
+            assert agent.plan(board(task), max_expanded=20000) == task["first_plan"], task
+        else:
+            with pytest.raises(ValueError):
+                agent.plan(board(task), max_expanded=20000)
+
+
+def test_tasks_end_as_the_binarys_evaluation_task_for_task(agent):
+    solved = 0
+    for task in TASKS:
+        options = {"reset_split": "test", "max_solution_depth": task["depth"], "random_solution_depth": False}
+        env = seads.Env("lightsout-cursor", json.dumps(options))
+        env.seed(task["seed"])
+        env.reset()
+        assert list(env.board()) == list(board(task))
+        result = agent.solve(env, max_expanded=20000)
+        assert result["solved"] == task["solved"], task
+        assert result["skills"] == task["executed"], task
+        assert result["steps"] == sum(task["skill_steps"]), task
+        solved += result["solved"]
+    assert solved == sum(t["solved"] for t in TASKS) > 0
+
+
+def test_a_gymnasium_environment_is_solved_in_place(agent):
+    task = next(t for t in TASKS if t["solved"] and t["depth"] >= 2)
+    env = gymnasium.make("seads/LightsOutCursor-v0")
+    env.reset(seed=1)
+    result = agent.solve(env, board=board(task), max_expanded=20000)
+    assert result["solved"]
+    assert len(result["moves"]) == len(result["skills"]) >= task["depth"]
+    assert env.unwrapped._core.board().sum() == 0, "the environment's board is solved"
+    assert len(result["path"]) > len(result["skills"])
+
+
+def test_actions_and_successors(agent):
+    env = seads.Env("lightsout-cursor")
+    env.seed(3)
+    obs = env.reset()
+    one = agent.act(obs, 4)
+    assert one.shape == (3,) and one.dtype == np.float32
+    rows = agent.act(np.stack([obs, obs]), [4, 5])
+    assert rows.shape == (2, 3)
+    np.testing.assert_array_equal(rows[0], one)
+    sampled = agent.act(obs, 4, deterministic=False, seed=7)
+    np.testing.assert_array_equal(sampled, agent.act(obs, 4, deterministic=False, seed=7))
+    assert not np.array_equal(sampled, one)
+    # Each skill's predicted board differs from the board by the move the model thinks it makes.
+    start = env.board()
+    succ = agent.successors(start)
+    assert succ.shape == (25, 25) and succ.dtype == np.uint8
+    task = next(t for t in TASKS if t["depth"] == 1 and t["solved"])
+    after = agent.successors(board(task))[task["executed"][0]]
+    assert after.sum() == 0, "the skill that solved the depth-1 board is predicted to solve it"
+
+
+def test_bad_input_raises_value_errors(agent, tmp_path):
+    with pytest.raises(ValueError, match="reading"):
+        seads.Agent.load(str(tmp_path / "none"))
+    with pytest.raises(ValueError, match="no checkpoint of epoch 7"):
+        seads.Agent.load(str(RUN), checkpoint=7)
+    damaged = tmp_path / "damaged"
+    shutil.copytree(RUN, damaged)
+    model = next(damaged.glob("checkpoints/*/forward_model.safetensors"))
+    model.write_bytes(model.read_bytes()[:100])
+    with pytest.raises(ValueError, match="forward_model"):
+        seads.Agent.load(str(damaged))
+    with pytest.raises(ValueError, match="values"):
+        agent.plan(np.zeros(9, dtype=np.uint8))
+    with pytest.raises(ValueError):
+        agent.plan(np.full(25, 2, dtype=np.uint8))
+    obs = np.zeros(28, dtype=np.float32)
+    with pytest.raises(ValueError, match="skill 25"):
+        agent.act(obs, 25)
+    with pytest.raises(ValueError, match="shape"):
+        agent.act(np.zeros(5, dtype=np.float32), 0)
+    with pytest.raises(ValueError, match="NaN"):
+        agent.act(np.full(28, np.nan, dtype=np.float32), 0)
+    with pytest.raises(ValueError, match="seed"):
+        agent.act(obs, 0, deterministic=False)
+    with pytest.raises(ValueError, match="search"):
+        agent.plan(np.ones(25, dtype=np.uint8), search="sideways")
+    with pytest.raises(ValueError, match="tileswap-cursor"):
+        agent.solve(seads.Env("tileswap-cursor"))
+    with pytest.raises(ValueError, match="task mode"):
+        agent.solve(seads.Env("lightsout-cursor", task=True))
+    with pytest.raises(ValueError, match="seads environment"):
+        agent.solve(object())
