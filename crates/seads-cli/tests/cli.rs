@@ -441,6 +441,36 @@ fn solve_evaluate_and_plot_a_trained_run() {
         "--json",
     ]);
     assert_eq!(v["board"], board);
+    // The same solution as an animation: the start, a frame per manipulator step, the last held.
+    let dir = tempfile::tempdir().unwrap();
+    let gif_path = dir.path().join("solution.gif");
+    let animated = json(&[
+        "solve",
+        "--run",
+        run,
+        "--board",
+        board,
+        "--replan",
+        "--max-expanded",
+        "2000",
+        "--json",
+        "--render",
+        s(&gif_path),
+    ]);
+    let steps = animated["manipulator_steps"].as_u64().unwrap() as usize;
+    let mut decoder = gif::DecodeOptions::new()
+        .read_info(std::fs::File::open(&gif_path).unwrap())
+        .unwrap();
+    let mut frames = 0;
+    while decoder.read_next_frame().unwrap().is_some() {
+        frames += 1;
+    }
+    assert_eq!(frames, 1 + steps + 9, "{animated}");
+    assert!(
+        !std::fs::read_dir(dir.path())
+            .unwrap()
+            .any(|e| { e.unwrap().file_name().to_string_lossy().contains("tmp") })
+    );
     for key in [
         "solved",
         "plan_found",

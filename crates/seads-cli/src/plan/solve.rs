@@ -31,7 +31,9 @@ pub struct SolveArgs {
     seed: u64,
     #[command(flatten)]
     search: super::SearchArgs,
-    /// Draw the board and the executed skills' paths into this image (.png or .svg).
+    /// Draw the board and the executed skills' paths into this image (.png or .svg), or an
+    /// animation of the whole solution (.gif): the manipulator moving step by step, the board
+    /// changing, and the skill being executed with the skills executed so far.
     #[arg(long)]
     render: Option<PathBuf>,
     /// Where the networks run: cpu, cuda (the first GPU) or cuda:N.
@@ -60,6 +62,18 @@ pub fn solve_board(args: SolveArgs) -> Result<()> {
         ..SolveConfig::default()
     };
     let (policy, model) = agent.parts()?;
+    let animate = args
+        .render
+        .as_deref()
+        .filter(|p| p.extension().is_some_and(|e| e.eq_ignore_ascii_case("gif")));
+    if let Some(out) = animate {
+        let mut filmed = seads_study::animation::Filmed::new(env);
+        let outcome = solve(&mut filmed, policy, model, game.goal(), &config)?;
+        let captions = captions(&agent.config.env, &outcome, filmed.frames.len());
+        let frames: Vec<_> = filmed.frames.into_iter().zip(captions).collect();
+        seads_study::animation::write_gif(&frames, 150, 1500, out)?;
+        return report(&args, &game.format(board), &agent.checkpoint, &outcome);
+    }
     let outcome = solve(env.as_mut(), policy, model, game.goal(), &config)?;
     if let Some(out) = &args.render {
         let status = if outcome.solved {
@@ -73,6 +87,51 @@ pub fn solve_board(args: SolveArgs) -> Result<()> {
         );
         seads_study::draw::render_solution(&before, &outcome.runs, &title, out)?;
     }
+    report(&args, &game.format(board), &agent.checkpoint, &outcome)
+}
+
+/// A caption per frame of a solution's animation (the start, then one per manipulator step):
+/// the skill being executed and those executed before it, and at the end the outcome.
+fn captions(env: &str, outcome: &seads_planner::SolveOutcome, frames: usize) -> Vec<String> {
+    let mut captions = vec![format!("{env}: the board to solve")];
+    for (i, (&skill, &steps)) in outcome
+        .executed
+        .iter()
+        .zip(&outcome.skill_steps)
+        .enumerate()
+    {
+        let done: Vec<String> = outcome.executed[..i]
+            .iter()
+            .map(|s| s.to_string())
+            .collect();
+        let before = if done.is_empty() {
+            String::new()
+        } else {
+            format!("{} → ", done.join(" "))
+        };
+        for step in 0..steps {
+            captions.push(format!("skills {before}[{skill}]   step {}", step + 1));
+        }
+    }
+    let end = match &outcome.failure {
+        None => format!("solved in {} steps", outcome.manipulator_steps),
+        Some(_) => "not solved".to_owned(),
+    };
+    let end = format!("{} skills: {end}", outcome.executed.len());
+    captions.resize(frames, end.clone());
+    if let Some(last) = captions.last_mut() {
+        *last = end;
+    }
+    captions
+}
+
+/// Prints what solving did.
+fn report(
+    args: &SolveArgs,
+    board: &str,
+    checkpoint: &std::path::Path,
+    outcome: &seads_planner::SolveOutcome,
+) -> Result<()> {
     if args.json {
         #[derive(Serialize)]
         struct Report<'a> {
@@ -82,9 +141,9 @@ pub fn solve_board(args: SolveArgs) -> Result<()> {
             outcome: &'a seads_planner::SolveOutcome,
         }
         let report = Report {
-            board: game.format(board),
-            checkpoint: agent.checkpoint.display().to_string(),
-            outcome: &outcome,
+            board: board.to_owned(),
+            checkpoint: checkpoint.display().to_string(),
+            outcome,
         };
         outln!("{}", serde_json::to_string(&report)?);
     } else {

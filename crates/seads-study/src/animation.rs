@@ -1,0 +1,136 @@
+//! Animations: an environment that films itself (a scene after every step) and a GIF of the
+//! frames, each a top view of the scene under a caption.
+
+use std::path::Path;
+
+use plotters::coord::Shift;
+use plotters::prelude::*;
+use seads_embodiment::{EnvError, EnvSpec, Environment, Scene, StepOutcome};
+use seads_games::SymbolicState;
+
+use crate::draw::{draw_scene, plot_err, register_font};
+use crate::{Result, StudyError};
+
+/// An environment that keeps its scene after every step (and at the start), for an animation.
+pub struct Filmed {
+    inner: Box<dyn Environment>,
+    /// The scenes: the first when filming started, then one per step.
+    pub frames: Vec<Scene>,
+}
+
+impl Filmed {
+    /// Films `inner` from now on.
+    pub fn new(inner: Box<dyn Environment>) -> Self {
+        let frames = vec![inner.scene()];
+        Self { inner, frames }
+    }
+}
+
+impl Environment for Filmed {
+    fn spec(&self) -> &EnvSpec {
+        self.inner.spec()
+    }
+    fn seed(&mut self, seed: u64) {
+        self.inner.seed(seed);
+    }
+    fn reset(&mut self) -> Result<(), EnvError> {
+        self.inner.reset()
+    }
+    fn step(&mut self, action: &[f32]) -> Result<StepOutcome, EnvError> {
+        let outcome = self.inner.step(action)?;
+        self.frames.push(self.inner.scene());
+        Ok(outcome)
+    }
+    fn observe(&self, out: &mut [f32]) {
+        self.inner.observe(out);
+    }
+    fn board(&self) -> SymbolicState {
+        self.inner.board()
+    }
+    fn set_board(&mut self, board: SymbolicState) -> Result<(), EnvError> {
+        self.inner.set_board(board)
+    }
+    fn reset_step_counter(&mut self) {
+        self.inner.reset_step_counter();
+    }
+    fn set_step_limit(&mut self, limit: Option<usize>) {
+        self.inner.set_step_limit(limit);
+    }
+    fn restore_manipulator(&mut self, state: &[f32]) -> Result<(), EnvError> {
+        self.inner.restore_manipulator(state)
+    }
+    fn scene(&self) -> Scene {
+        self.inner.scene()
+    }
+    fn end_effector(&self) -> [f64; 2] {
+        self.inner.end_effector()
+    }
+    fn move_point(&self) -> Option<[f64; 2]> {
+        self.inner.move_point()
+    }
+    /// A clone films nothing: only this environment's steps are frames.
+    fn box_clone(&self) -> Box<dyn Environment> {
+        self.inner.box_clone()
+    }
+}
+
+/// Frame size of the animations, pixels.
+const SIZE: (u32, u32) = (480, 520);
+/// The most frames one animation holds (a longer one keeps its first ones and says so).
+pub const MAX_FRAMES: usize = 2000;
+
+/// Writes `frames` (a scene and its caption each) as an animated GIF to `out`, each shown
+/// `delay_ms` and the last one `hold_ms`, atomically (a temporary file beside it, then renamed).
+pub fn write_gif(
+    frames: &[(Scene, String)],
+    delay_ms: u32,
+    hold_ms: u32,
+    out: &Path,
+) -> Result<()> {
+    if frames.is_empty() {
+        return Err(StudyError::invalid("an animation needs at least one frame"));
+    }
+    register_font();
+    let tmp = out.with_extension(format!("gif.tmp-{}", std::process::id()));
+    let written = (|| -> Result<()> {
+        let mut shown: Vec<(&(Scene, String), u32)> = frames
+            .iter()
+            .take(MAX_FRAMES)
+            .map(|f| (f, delay_ms))
+            .collect();
+        if let Some(last) = shown.last_mut() {
+            last.1 = hold_ms.max(delay_ms);
+        }
+        // plotters' GIF backend takes one delay for all frames: a held frame repeats.
+        let root = BitMapBackend::gif(&tmp, SIZE, delay_ms.max(10))
+            .map_err(|e| StudyError::Plot(e.to_string()))?
+            .into_drawing_area();
+        for ((scene, caption), ms) in shown {
+            for _ in 0..(ms / delay_ms.max(10)).max(1) {
+                draw_frame(&root, scene, caption)?;
+                root.present().map_err(plot_err)?;
+            }
+        }
+        Ok(())
+    })();
+    if let Err(e) = written {
+        let _ = std::fs::remove_file(&tmp);
+        return Err(e);
+    }
+    let sync = std::fs::File::open(&tmp).and_then(|f| f.sync_all());
+    sync.and_then(|()| std::fs::rename(&tmp, out))
+        .map_err(|e| StudyError::file(format!("writing {}", out.display()), e))
+}
+
+fn draw_frame<DB: DrawingBackend>(
+    area: &DrawingArea<DB, Shift>,
+    scene: &Scene,
+    caption: &str,
+) -> Result<()>
+where
+    DB::ErrorType: 'static,
+{
+    area.fill(&WHITE).map_err(plot_err)?;
+    draw_scene(area, scene, caption, 16, true)?;
+    Ok(())
+}
