@@ -69,6 +69,47 @@ fn python_tests(totals: &mut Totals) -> Result<()> {
         ],
         &[("MATURIN_PEP517_ARGS", "--profile dev")],
     )?;
+    // The newest Gymnasium first, then the lowest the package supports (its pin).
+    step(
+        &python,
+        &[
+            "-m",
+            "pip",
+            "install",
+            "--quiet",
+            "--disable-pip-version-check",
+            "--upgrade",
+            "gymnasium",
+        ],
+    )?;
+    pytest(&python, totals)?;
+    let lowest = lowest_gymnasium()?;
+    step(
+        &python,
+        &[
+            "-m",
+            "pip",
+            "install",
+            "--quiet",
+            "--disable-pip-version-check",
+            &format!("gymnasium=={lowest}"),
+        ],
+    )?;
+    eprintln!("xtask: again with gymnasium {lowest}, the lowest the package supports");
+    pytest(&python, totals)
+}
+
+/// The lowest Gymnasium `crates/seads-py/pyproject.toml` asks for (`"gymnasium>=X"`).
+fn lowest_gymnasium() -> Result<String> {
+    let text = std::fs::read_to_string(root().join("crates/seads-py/pyproject.toml"))?;
+    text.split('"')
+        .find_map(|item| item.strip_prefix("gymnasium>="))
+        .map(str::to_owned)
+        .context("crates/seads-py/pyproject.toml pins no gymnasium>=X")
+}
+
+/// The package's pytest suite with `python`; its closing line is added to the totals.
+fn pytest(python: &str, totals: &mut Totals) -> Result<()> {
     eprintln!("xtask: $ {python} -m pytest crates/seads-py/tests");
     let output = Command::new(&python)
         .args([

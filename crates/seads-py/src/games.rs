@@ -178,7 +178,9 @@ impl Game {
             .map_err(value_error)
     }
 
-    /// `"train"` or `"test"`: the board's half of the CRC32 split (SPEC §1.5).
+    /// `"train"` or `"test"`: the board's part of the split, by the CRC-32 of its values written
+    /// as comma-separated text: `"train"` where it is 0 modulo 3 (a third of the boards), else
+    /// `"test"` (two thirds).
     fn split(&self, board: Vec<u8>) -> PyResult<&'static str> {
         let board = self.board(board)?;
         Ok(split_of(&self.game().values(board)).name())
@@ -236,6 +238,11 @@ pub fn plan(
     };
     if start == goal {
         return Ok(Vec::new());
+    }
+    // LightsOut's moves flip fields, so a plan to `goal` exists iff `start ^ goal` can be
+    // solved: the GF(2) solver says at once where the search would run to its limit.
+    if let Rules::LightsOut(_, solver) = &game.rules {
+        solver.depth(start ^ goal).map_err(value_error)?;
     }
     let config = PlannerConfig {
         max_layers: max_depth,

@@ -58,3 +58,26 @@ def test_planning_with_the_true_model_finds_optimal_plans():
                 board = game.apply(board, move)
             assert game.is_goal(board)
     assert seads.plan(game, game.goal()) == []
+
+
+def test_plan_on_an_unsolvable_board_says_so_at_once():
+    # One lit corner cannot be solved on 5×5 LightsOut (its moves span 23 of 25 dimensions):
+    # the solver's answer, not a search through every reachable board (no state budget here).
+    game = seads.Game("lightsout")
+    corner = np.zeros(25, dtype=np.uint8)
+    corner[0] = 1
+    with pytest.raises(ValueError) as solver_error:
+        game.solve(corner)
+    with pytest.raises(ValueError) as plan_error:
+        seads.plan(game, corner, max_expanded=None)
+    assert str(plan_error.value) == str(solver_error.value)
+    # A goal of its own: a plan to it exists iff the boards differ by a solvable board.
+    goal = np.zeros(25, dtype=np.uint8)
+    goal[1] = goal[5] = 1
+    start = goal.copy()
+    start[0] = 1  # differs from the goal by a corner: unsolvable
+    with pytest.raises(ValueError):
+        seads.plan(game, start, goal=goal, max_expanded=None)
+    move_0 = game.apply(np.zeros(25, dtype=np.uint8), 0)  # the corner and its two neighbours
+    start = np.bitwise_xor(goal, move_0)  # differs from the goal by move 0
+    assert seads.plan(game, start, goal=goal) == [0]
