@@ -111,7 +111,7 @@ fn lowest_gymnasium() -> Result<String> {
 /// The package's pytest suite with `python`; its closing line is added to the totals.
 fn pytest(python: &str, totals: &mut Totals) -> Result<()> {
     eprintln!("xtask: $ {python} -m pytest crates/seads-py/tests");
-    let output = Command::new(&python)
+    let output = Command::new(python)
         .args([
             "-m",
             "pytest",
