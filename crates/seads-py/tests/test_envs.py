@@ -125,3 +125,16 @@ def test_render_is_an_rgb_image_of_the_board():
     # Lit fields are drawn in amber, unlit ones in dark grey: both show on a board with lights.
     colours = {tuple(c) for c in image.reshape(-1, 3)}
     assert (245, 190, 40) in colours and (70, 70, 80) in colours
+
+
+def test_an_environment_pickles_as_a_new_one_with_its_settings():
+    import pickle
+
+    env = gymnasium.make("seads/LightsOutCursor-v0", max_solution_depth=3).unwrapped
+    copy = pickle.loads(pickle.dumps(env))
+    assert (copy.env_name, copy.task, copy._options) == (env.env_name, env.task, {"max_solution_depth": 3})
+    first, _ = env.reset(seed=5)
+    again, _ = copy.reset(seed=5)
+    np.testing.assert_array_equal(first, again)
+    action = np.array([0.1, -0.1, 1.0], dtype=np.float32)
+    np.testing.assert_array_equal(env.step(action)[0], copy.step(action)[0])

@@ -80,10 +80,20 @@ class SeadsEnv(gymnasium.Env):
         self.env_name = env_name
         self.task = task
         self.render_mode = render_mode
+        self._options = dict(options)
         self._core = _seads.Env(env_name, _options(options), task)
         self.spec_dict = self._core.spec()
         self.observation_space, self.action_space = _spaces(self.spec_dict)
         self._seeded = False
+
+    def __getstate__(self) -> dict[str, Any]:
+        # The Rust environment is rebuilt from its arguments: a pickled environment (sent to a
+        # worker process, say) arrives as a new one, to be reset before its first step.
+        return {"env_name": self.env_name, "render_mode": self.render_mode, "task": self.task,
+                "options": self._options}
+
+    def __setstate__(self, state: dict[str, Any]) -> None:
+        self.__init__(state["env_name"], state["render_mode"], state["task"], **state["options"])
 
     def reset(self, *, seed: int | None = None, options: dict[str, Any] | None = None):
         super().reset(seed=seed)
