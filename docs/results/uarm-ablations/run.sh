@@ -1,0 +1,44 @@
+#!/usr/bin/env bash
+# The robot's absolute pushes on the twin (issue 44 item 3): one setting changed at a time from
+# the paper's robot protocol (4 one-press episodes per epoch, 16 SAC updates, alpha 0.1, board and
+# pen seen, a perfect twin), 2 seeds each, 5000 interactions, on the frozen binary of one clean
+# commit. Resumable: a run with its evaluation is skipped, a started one resumed. Each final
+# evaluation (20 boards per depth 1-5, re-planning) bounds its searches by 2^20 expanded states:
+# an agent that lacks a move fails many searches, and each failed one costs the whole bound.
+set -u
+B=${SEADS:-/root/seads-frozen/13631e6/bin/seads}
+here=$(cd "$(dirname "$0")" && pwd)
+settings=(
+  "paper|"
+  "observe-board|--observe board"
+  "observe-pen|--observe pen"
+  "observe-nothing|--observe nothing"
+  "alpha-0.01|--alpha 0.01"
+  "tap-sd-5mm|--tap-sd-mm 5"
+  "late-reports-0.1|--late-reports 0.1"
+  "updates-4|--updates-per-epoch 4"
+  "episodes-16|--episodes-per-epoch 16"
+  "alpha-0.3|--alpha 0.3"
+  "updates-64|--updates-per-epoch 64"
+  "episodes-1|--episodes-per-epoch 1"
+)
+jobs=()
+for setting in "${settings[@]}"; do
+  for seed in 1 2; do
+    jobs+=("${setting%%|*}|${setting#*|}|$seed")
+  done
+done
+mkdir -p "$here/runs" "$here/logs"
+printf '%s\n' "${jobs[@]}" | xargs -P "${JOBS:-2}" -I{} bash -c '
+  IFS="|" read -r name opts seed <<< "{}"
+  run='"$here"'/runs/$name-$seed
+  log='"$here"'/logs/$name-$seed.log
+  [[ -f $run/evaluation-replan.json ]] && exit 0
+  if [[ -f $run/config.toml ]]; then
+    '"$B"' uarm train --port sim:$seed --resume --out $run --cores 1 --quiet --max-expanded 1048576 >> $log 2>&1
+  else
+    rm -rf $run
+    '"$B"' uarm train --port sim:$seed --seed $seed $opts --out $run --cores 1 --quiet --max-expanded 1048576 >> $log 2>&1
+  fi
+  echo "$(date +%H:%M) $name-$seed exit $?" >> '"$here"'/done.log
+'
