@@ -24,8 +24,15 @@ pub struct PlotArgs {
     #[arg(long)]
     run: PathBuf,
     /// Folder for the figures (PNG and SVG of each).
-    #[arg(long)]
-    out: PathBuf,
+    #[arg(long, required_unless_present = "animate")]
+    out: Option<PathBuf>,
+    /// Instead of the figures, write an animation (.gif) of every skill: one short clip per skill
+    /// from each of `--starts` initialisations (the first of the coverage evaluation's).
+    #[arg(long, value_name = "GIF")]
+    animate: Option<PathBuf>,
+    /// Initialisations per skill in `--animate`'s clips.
+    #[arg(long, default_value_t = 2, value_parser = clap::value_parser!(u64).range(1..=20))]
+    starts: u64,
     /// Use the checkpoint of this epoch instead of the latest.
     #[arg(long)]
     checkpoint: Option<u64>,
@@ -40,12 +47,19 @@ pub struct PlotArgs {
 /// `seads plot`: writes every figure of the run into `out`; returns the files written.
 pub fn plot(args: PlotArgs) -> Result<()> {
     crate::plan::check_boards(args.boards)?;
+    if let Some(gif) = &args.animate {
+        return animate(&args.run, args.checkpoint, args.starts, gif);
+    }
+    let out = args
+        .out
+        .as_ref()
+        .expect("clap requires --out without --animate");
     // Plotting may evaluate the run and save that evaluation into it.
     crate::run_config(&args.run)?;
     let _lock = crate::lock_run(&args.run)?;
     let written = write_figures(
         &args.run,
-        &args.out,
+        out,
         args.checkpoint,
         args.boards,
         args.search.limits(),
@@ -54,6 +68,48 @@ pub fn plot(args: PlotArgs) -> Result<()> {
     for path in written {
         outln!("wrote {}", path.display());
     }
+    Ok(())
+}
+
+/// `seads plot --animate GIF`: a clip per skill, from `starts` coverage initialisations.
+fn animate(run: &Path, checkpoint: Option<u64>, starts: u64, gif: &Path) -> Result<()> {
+    if !gif
+        .extension()
+        .is_some_and(|e| e.eq_ignore_ascii_case("gif"))
+    {
+        return Err(crate::BadInput(anyhow::anyhow!(
+            "--animate {}: the animation is a .gif file",
+            gif.display()
+        ))
+        .into());
+    }
+    let config = seads_rl::load_config(run)?;
+    let (env, agent) = match crate::uarm::twin_for_figures(run, &config)? {
+        Some(twin) => {
+            let spec = twin.spec().clone();
+            let on_cpu = seads_rl::TrainConfig {
+                device: seads_rl::ComputeDevice::Cpu,
+                ..config
+            };
+            let agent = Agent::load_for(on_cpu, spec, &find_checkpoint(run, checkpoint)?)?;
+            (twin.box_clone(), agent)
+        }
+        None => {
+            let agent = load_agent(run, checkpoint, seads_rl::ComputeDevice::Cpu)?;
+            let env = build_env(
+                &agent.config.env,
+                &EnvConfig {
+                    reset_split: Split::Test,
+                    ..agent.config.env_config.clone()
+                },
+            )?;
+            (env, agent)
+        }
+    };
+    let frames =
+        seads_study::animation::skill_clips(env, &agent.policy, starts, seads_rl::COVERAGE_SEED)?;
+    seads_study::animation::write_gif(&frames, 150, 150, gif)?;
+    outln!("wrote {} ({} frames)", gif.display(), frames.len());
     Ok(())
 }
 

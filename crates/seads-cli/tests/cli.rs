@@ -466,6 +466,29 @@ fn solve_evaluate_and_plot_a_trained_run() {
         frames += 1;
     }
     assert_eq!(frames, 1 + steps + 9, "{animated}");
+    // Every skill as a clip: from each start, its first scene, a frame per step, the end twice.
+    let skills_gif = dir.path().join("skills.gif");
+    let out = seads_ok(&[
+        "plot",
+        "--run",
+        run,
+        "--animate",
+        s(&skills_gif),
+        "--starts",
+        "2",
+    ]);
+    let mut decoder = gif::DecodeOptions::new()
+        .read_info(std::fs::File::open(&skills_gif).unwrap())
+        .unwrap();
+    let mut clips = 0;
+    while decoder.read_next_frame().unwrap().is_some() {
+        clips += 1;
+    }
+    let k = 25;
+    assert!(clips >= k * 2 * 4, "{clips} frames");
+    assert!(String::from_utf8_lossy(&out.stdout).contains(&format!("({clips} frames)")));
+    check_bad_input(&["plot", "--run", run, "--animate", "skills.png"], ".gif");
+    check_bad_input(&["plot", "--run", run], "--out");
     assert!(
         !std::fs::read_dir(dir.path())
             .unwrap()

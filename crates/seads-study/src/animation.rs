@@ -5,7 +5,9 @@ use std::path::Path;
 
 use plotters::coord::Shift;
 use plotters::prelude::*;
-use seads_embodiment::{EnvError, EnvSpec, Environment, Scene, StepOutcome};
+use seads_embodiment::{
+    EnvError, EnvSpec, Environment, Scene, SkillPolicy, StepOutcome, execute_skill,
+};
 use seads_games::SymbolicState;
 
 use crate::draw::{draw_scene, plot_err, register_font};
@@ -72,6 +74,47 @@ impl Environment for Filmed {
     fn box_clone(&self) -> Box<dyn Environment> {
         self.inner.box_clone()
     }
+}
+
+/// One short clip per skill: each executed from `starts` of the coverage initialisations of `env`
+/// (seeds `seed`, `seed + 1`, …), a frame per step under "skill k · start i · step t", the last
+/// frame of each clip shown twice more.
+pub fn skill_clips(
+    env: Box<dyn Environment>,
+    policy: &dyn SkillPolicy,
+    starts: u64,
+    seed: u64,
+) -> Result<Vec<(Scene, String)>> {
+    let mut filmed = Filmed::new(env);
+    let mut frames = Vec::new();
+    for skill in 0..policy.num_skills() {
+        for start in 0..starts {
+            filmed.seed(seed + start);
+            filmed
+                .reset()
+                .map_err(|e| StudyError::file("resetting the environment", e))?;
+            filmed.frames = vec![filmed.scene()];
+            let run = execute_skill(&mut filmed, policy, skill)
+                .map_err(|e| StudyError::file("executing a skill", e))?;
+            let caption = |t: usize| format!("skill {skill} · start {} · step {t}", start + 1);
+            for (t, scene) in filmed.frames.drain(..).enumerate() {
+                frames.push((scene, caption(t)));
+            }
+            let moved = if run.outcome.moved() {
+                "a move"
+            } else {
+                "no move"
+            };
+            let end = frames[frames.len() - 1].0.clone();
+            for _ in 0..2 {
+                frames.push((
+                    end.clone(),
+                    format!("skill {skill} · start {}: {moved}", start + 1),
+                ));
+            }
+        }
+    }
+    Ok(frames)
 }
 
 /// Frame size of the animations, pixels.
