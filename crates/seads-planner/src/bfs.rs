@@ -23,6 +23,19 @@ pub enum PlanChoice {
     FirstFound,
 }
 
+impl std::str::FromStr for PlanChoice {
+    type Err = String;
+
+    /// `most-likely` or `first-found`, the names records use.
+    fn from_str(text: &str) -> Result<Self, String> {
+        match text {
+            "most-likely" => Ok(Self::MostLikely),
+            "first-found" => Ok(Self::FirstFound),
+            other => Err(format!("{other:?} is not one of most-likely, first-found")),
+        }
+    }
+}
+
 impl PlanChoice {
     /// The choice that evaluation records without one were made with.
     pub fn paper() -> Self {
@@ -40,6 +53,19 @@ pub enum Search {
     /// From both ends where the model's skills act as masks, every joined plan verified with
     /// the forward model ([`meet_plan`](crate::meet_plan)); breadth-first elsewhere.
     BothEnds,
+}
+
+impl std::str::FromStr for Search {
+    type Err = String;
+
+    /// `breadth` or `both-ends`, the names records use.
+    fn from_str(text: &str) -> Result<Self, String> {
+        match text {
+            "breadth" => Ok(Self::Breadth),
+            "both-ends" => Ok(Self::BothEnds),
+            other => Err(format!("{other:?} is not one of breadth, both-ends")),
+        }
+    }
 }
 
 impl Search {
@@ -292,12 +318,7 @@ fn search<K: Key>(
     config: &PlannerConfig,
 ) -> Result<Plan, PlanError> {
     let began = Instant::now();
-    // Any number is a limit: NaN and negative ones leave no time, and one too large for the
-    // clock (infinity included) none at all.
-    let deadline = config.timeout_s.and_then(|s| {
-        let limit = Duration::try_from_secs_f64(s.max(0.0)).ok()?;
-        began.checked_add(limit)
-    });
+    let deadline = deadline(config, began);
     let k = successor.num_skills();
     let chunk_len = config.batch_size.max(1);
     let group_len = successor.preferred_batch().max(chunk_len);
@@ -406,6 +427,16 @@ fn search<K: Key>(
     Err(PlanError::NotFound {
         layers: config.max_layers,
         discovered: visited.len,
+    })
+}
+
+/// When a search begun at `began` must stop by the clock (`None`: never). Any number is a limit:
+/// NaN and negative ones leave no time, and one too large for the clock (infinity included)
+/// none at all.
+pub(crate) fn deadline(config: &PlannerConfig, began: Instant) -> Option<Instant> {
+    config.timeout_s.and_then(|s| {
+        let limit = Duration::try_from_secs_f64(s.max(0.0)).ok()?;
+        began.checked_add(limit)
     })
 }
 

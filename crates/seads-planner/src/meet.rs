@@ -19,7 +19,7 @@
 //! found by the forward side alone, and may then be longer than breadth-first search's.
 
 use std::ops::Range;
-use std::time::{Duration, Instant};
+use std::time::Instant;
 
 use rustc_hash::FxHashMap;
 use seads_games::{Successor, SymbolicState};
@@ -151,10 +151,7 @@ pub fn meet_plan(
     config: &PlannerConfig,
 ) -> Result<Plan, PlanError> {
     let began = Instant::now();
-    let deadline = config.timeout_s.and_then(|s| {
-        let limit = Duration::try_from_secs_f64(s.max(0.0)).ok()?;
-        began.checked_add(limit)
-    });
+    let deadline = crate::bfs::deadline(config, began);
     let mut limits = Limits {
         config,
         deadline,

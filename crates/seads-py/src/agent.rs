@@ -31,24 +31,12 @@ fn planner(
     search: &str,
     choice: &str,
 ) -> PyResult<PlannerConfig> {
-    let search = match search {
-        "breadth" => Search::Breadth,
-        "both-ends" => Search::BothEnds,
-        other => {
-            return Err(value_error(format!(
-                "search {other:?}: breadth or both-ends"
-            )));
-        }
-    };
-    let plan = match choice {
-        "most-likely" => PlanChoice::MostLikely,
-        "first-found" => PlanChoice::FirstFound,
-        other => {
-            return Err(value_error(format!(
-                "choice {other:?}: most-likely or first-found"
-            )));
-        }
-    };
+    let search: Search = search
+        .parse()
+        .map_err(|e| value_error(format!("search {e}")))?;
+    let plan: PlanChoice = choice
+        .parse()
+        .map_err(|e| value_error(format!("choice {e}")))?;
     Ok(PlannerConfig {
         max_layers: max_depth,
         max_expanded,

@@ -33,11 +33,11 @@ pub struct PlanBenchArgs {
     float32: bool,
     /// Which plan each search returns: most-likely (default) or first-found (the paper's), to
     /// compare the two choices' cost with one binary.
-    #[arg(long, value_name = "CHOICE", default_value = "most-likely", value_parser = super::plan_choice)]
+    #[arg(long, value_name = "CHOICE", default_value = "most-likely")]
     plan: seads_planner::PlanChoice,
     /// How each search goes: breadth (default, the paper's) or both-ends, to compare the two
     /// searches' cost with one binary.
-    #[arg(long, value_name = "SEARCH", default_value = "breadth", value_parser = super::search_kind)]
+    #[arg(long, value_name = "SEARCH", default_value = "breadth")]
     search: seads_planner::Search,
     /// Print JSON.
     #[arg(long)]

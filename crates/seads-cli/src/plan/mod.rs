@@ -41,36 +41,18 @@ pub struct SearchArgs {
     /// Which of the shortest plans to take: `most-likely` (the plan the forward model gives the
     /// highest probability, each step by the skill likeliest to make it; re-planning avoids a
     /// skill that just failed from the same board) or `first-found` (the paper's search).
-    #[arg(long, value_name = "CHOICE", default_value = "most-likely", value_parser = plan_choice)]
+    #[arg(long, value_name = "CHOICE", default_value = "most-likely")]
     plan: PlanChoice,
     /// How each search goes: `breadth` (breadth-first from the board, the paper's) or
     /// `both-ends` (also backwards from the goal where the model's skills act the same on every
     /// board, as on LightsOut; every joined plan is checked with the forward model; far fewer
     /// states for deep boards, breadth-first where the skills do not allow it).
-    #[arg(long, value_name = "SEARCH", default_value = "breadth", value_parser = search_kind)]
+    #[arg(long, value_name = "SEARCH", default_value = "breadth")]
     search: Search,
     /// Stop each search when its structures outgrow this many GiB (default 4; the paper's
     /// deeper search stopped at about 16 GB).
     #[arg(long, value_name = "GIB", value_parser = clap::value_parser!(u32).range(1..=4096))]
     memory_limit: Option<u32>,
-}
-
-/// `breadth` or `both-ends`.
-fn search_kind(text: &str) -> Result<Search, String> {
-    match text {
-        "breadth" => Ok(Search::Breadth),
-        "both-ends" => Ok(Search::BothEnds),
-        other => Err(format!("{other:?} is not one of breadth, both-ends")),
-    }
-}
-
-/// `most-likely` or `first-found`.
-fn plan_choice(text: &str) -> Result<PlanChoice, String> {
-    match text {
-        "most-likely" => Ok(PlanChoice::MostLikely),
-        "first-found" => Ok(PlanChoice::FirstFound),
-        other => Err(format!("{other:?} is not one of most-likely, first-found")),
-    }
 }
 
 impl SearchArgs {
