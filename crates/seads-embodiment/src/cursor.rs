@@ -31,6 +31,11 @@ impl Manipulator for Cursor {
         )
     }
 
+    /// The cursor stays on the board: its position lies in [0, 1]².
+    fn state_bounds(&self) -> (Vec<f32>, Vec<f32>) {
+        (vec![0.0, 0.0], vec![1.0, 1.0])
+    }
+
     fn default_step_limit(&self) -> usize {
         10
     }

@@ -85,6 +85,12 @@ pub trait Manipulator: Clone + Send + Sync + 'static {
     fn state_dim(&self) -> usize;
     /// Lower and upper action bounds.
     fn action_bounds(&self) -> (Vec<f32>, Vec<f32>);
+    /// Lower and upper bounds of the observed state (M values each): unbounded unless the
+    /// manipulator says otherwise.
+    fn state_bounds(&self) -> (Vec<f32>, Vec<f32>) {
+        let m = self.state_dim();
+        (vec![f32::NEG_INFINITY; m], vec![f32::INFINITY; m])
+    }
     /// Default steps per skill T_max.
     fn default_step_limit(&self) -> usize;
     /// Draws a random initial state. It depends on nothing but `rng`: no state of earlier
@@ -145,11 +151,14 @@ impl<M: Manipulator> Embodied<M> {
     ) -> Self {
         let game = board.game();
         let (action_low, action_high) = manipulator.action_bounds();
+        let (state_low, state_high) = manipulator.state_bounds();
         let spec = EnvSpec {
             name: name.to_owned(),
             game: game.kind(),
             board_size: game.size(),
             manipulator_dim: manipulator.state_dim(),
+            state_low,
+            state_high,
             symbolic_len: game.symbolic_len(),
             obs_dim: manipulator.state_dim() + game.symbolic_len() + 1,
             action_dim: action_low.len(),

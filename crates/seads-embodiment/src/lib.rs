@@ -49,6 +49,7 @@ mod config;
 mod cursor;
 mod embodied;
 mod error;
+mod filmed;
 #[cfg(feature = "jaco")]
 mod jaco;
 mod layout;
@@ -67,6 +68,7 @@ pub use config::EnvConfig;
 pub use cursor::Cursor;
 pub use embodied::{Embodied, Environment, Manipulator, Touch};
 pub use error::EnvError;
+pub use filmed::Filmed;
 #[cfg(feature = "jaco")]
 pub use jaco::{DEFAULT_SUBSTEPS as JACO_DEFAULT_SUBSTEPS, Jaco, JacoBoard};
 pub use layout::Layout;

@@ -16,6 +16,10 @@ pub struct EnvSpec {
     pub board_size: usize,
     /// Length M of the manipulator part of the observation.
     pub manipulator_dim: usize,
+    /// Lower bounds of the manipulator part of the observation (−∞ where unbounded).
+    pub state_low: Vec<f32>,
+    /// Upper bounds of the manipulator part of the observation (+∞ where unbounded).
+    pub state_high: Vec<f32>,
     /// Length D of the symbolic state.
     pub symbolic_len: usize,
     /// Length of the observation, M + D + 1.

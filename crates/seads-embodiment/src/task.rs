@@ -31,10 +31,10 @@ pub struct TaskStep {
 /// remaining share of the step limit) counts down over T_lim.
 pub struct TaskEnv {
     env: Box<dyn Environment>,
+    game: Box<dyn BoardGame>,
     goal: SymbolicState,
-    /// Solution depth of every board up to the environment's largest reset depth (shared by
-    /// every task environment of the same game, size and depth).
-    depths: Arc<BTreeMap<SymbolicState, usize>>,
+    /// Where the reset boards' solution depths come from.
+    depths: Depths,
     steps_per_depth: usize,
     max_depth: usize,
     depth: usize,
@@ -66,9 +66,10 @@ impl TaskEnv {
         })?;
         let game = spec.game.build(spec.board_size)?;
         let goal = game.goal();
-        let depths = depth_map(spec.game, spec.board_size, max_depth, game.as_ref());
+        let depths = Depths::of(spec.game, spec.board_size, max_depth, game.as_ref());
         Ok(Self {
             env,
+            game,
             goal,
             depths,
             steps_per_depth,
@@ -94,13 +95,17 @@ impl TaskEnv {
     pub fn reset(&mut self) -> Result<usize, EnvError> {
         self.env.reset()?;
         let board = self.env.board();
-        self.depth = *self.depths.get(&board).ok_or_else(|| {
-            EnvError::InvalidConfig(format!(
-                "{}: a reset board lies deeper than the task's largest depth {}",
-                self.env.spec().name,
-                self.max_depth
-            ))
-        })?;
+        self.depth = self
+            .depths
+            .depth(self.game.as_ref(), board)
+            .filter(|&d| d <= self.max_depth)
+            .ok_or_else(|| {
+                EnvError::InvalidConfig(format!(
+                    "{}: a reset board lies deeper than the task's largest depth {}",
+                    self.env.spec().name,
+                    self.max_depth
+                ))
+            })?;
         self.limit = self.steps_per_depth * self.depth.max(1);
         self.env.set_step_limit(Some(self.limit));
         self.env.reset_step_counter();
@@ -154,10 +159,39 @@ impl TaskEnv {
     }
 }
 
+/// Where a task's solution depths come from.
+enum Depths {
+    /// The game's own optimal solver (LightsOut by GF(2) algebra, TileSwap by its depth table):
+    /// nothing to build, whatever the task's largest depth.
+    Solver,
+    /// A game without a solver: every board up to the task's largest depth, mapped once by
+    /// breadth-first search from the goal.
+    Map(Arc<BTreeMap<SymbolicState, usize>>),
+}
+
+impl Depths {
+    /// The depth source of `game`'s tasks up to `max_depth`.
+    fn of(kind: GameKind, size: usize, max_depth: usize, game: &dyn BoardGame) -> Self {
+        if game.solution_depth(game.goal()).is_some() {
+            Depths::Solver
+        } else {
+            Depths::Map(depth_map(kind, size, max_depth, game))
+        }
+    }
+
+    /// The solution depth of `board`, `None` if it has none up to the mapped depth.
+    fn depth(&self, game: &dyn BoardGame, board: SymbolicState) -> Option<usize> {
+        match self {
+            Depths::Solver => game.solution_depth(board).and_then(Result::ok),
+            Depths::Map(map) => map.get(&board).copied(),
+        }
+    }
+}
+
 /// The solution depth of every board of `game` up to `max_depth`, by breadth-first search from
-/// the goal (both games' moves undo themselves, so the distance from the goal is the distance
-/// to it). Computed once per game, size and depth and shared, so that many task environments
-/// (a vector of them) cost one map.
+/// the goal (moves that undo themselves make the distance from the goal the distance to it).
+/// Computed once per game, size and depth and shared, so that many task environments (a vector
+/// of them) cost one map.
 fn depth_map(
     kind: GameKind,
     size: usize,

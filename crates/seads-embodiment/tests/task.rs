@@ -133,3 +133,74 @@ fn solving_the_board_pays_one_and_ends_the_episode() {
         assert_eq!(rewards.iter().sum::<f32>(), 1.0);
     }
 }
+
+/// The deepest tasks: 5×5 LightsOut boards of depth 15 (its largest), TileSwap boards of depth 10,
+/// and 7×7 boards of four random presses. The depth a reset reports is the one breadth-first
+/// search finds (the games' enumerations; 7×7 by the layers of a search from the goal), with no
+/// map of every board built first (that took minutes and half a gigabyte at depth 10).
+#[test]
+fn the_deepest_tasks_report_the_breadth_first_depth() {
+    let lightsout = seads_games::enumerate(&LightsOut::new(5).unwrap(), None).unwrap();
+    let tileswap = seads_games::enumerate(&TileSwap::new(), None).unwrap();
+    for (name, depth, e, size) in [
+        ("lightsout-cursor", 15, &lightsout, 5),
+        ("tileswap-cursor", 10, &tileswap, 3),
+    ] {
+        let config = EnvConfig {
+            reset_split: Split::Test,
+            max_solution_depth: depth,
+            random_solution_depth: false,
+            ..EnvConfig::default()
+        };
+        let mut env = task(name, &config);
+        let layer: std::collections::BTreeSet<u32> = e.layer(depth).iter().copied().collect();
+        for seed in 0..10 {
+            env.seed(seed);
+            assert_eq!(env.reset().unwrap(), depth, "{name}");
+            let board = env.env().board();
+            let index = if size == 5 {
+                seads_games::Enumerable::index_of(&LightsOut::new(5).unwrap(), board)
+            } else {
+                seads_games::Enumerable::index_of(&TileSwap::new(), board)
+            };
+            assert!(
+                layer.contains(&index),
+                "{name}: a board of the depth-{depth} layer"
+            );
+        }
+    }
+    // 7×7: boards made by 4 distinct presses; their true depth by breadth-first search from the
+    // goal, layer by layer.
+    let game = LightsOut::new(7).unwrap();
+    let mut layers = vec![std::collections::BTreeSet::from([
+        seads_games::BoardGame::goal(&game),
+    ])];
+    let mut seen = layers[0].clone();
+    for _ in 0..4 {
+        let mut next = std::collections::BTreeSet::new();
+        for &b in layers.last().unwrap() {
+            for mv in 0..49 {
+                let after = seads_games::BoardGame::apply(&game, b, mv);
+                if seen.insert(after) {
+                    next.insert(after);
+                }
+            }
+        }
+        layers.push(next);
+    }
+    let config = EnvConfig {
+        board_size: Some(7),
+        max_solution_depth: 4,
+        random_solution_depth: false,
+        ..EnvConfig::default()
+    };
+    let mut env = task("lightsout-cursor", &config);
+    for seed in 0..10 {
+        env.seed(seed);
+        let depth = env.reset().unwrap();
+        assert!(
+            layers[depth].contains(&env.env().board()),
+            "7×7 seed {seed}"
+        );
+    }
+}

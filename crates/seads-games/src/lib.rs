@@ -214,6 +214,19 @@ pub trait BoardGame: Send + Sync {
     /// Whether `z` encodes a board of this game (TileSwap: a one-hot permutation matrix).
     fn is_valid(&self, z: SymbolicState) -> bool;
 
+    /// A shortest move sequence from `board` to the goal by the game's own solver, `None` where
+    /// the game has none (then only a search finds one). An error if `board` cannot reach the
+    /// goal.
+    fn solve(&self, _board: SymbolicState) -> Option<Result<Vec<MoveId>, GameError>> {
+        None
+    }
+
+    /// The solution depth of `board` (the length of a shortest solution) by the game's own
+    /// solver, `None` where the game has none.
+    fn solution_depth(&self, board: SymbolicState) -> Option<Result<usize, GameError>> {
+        self.solve(board).map(|moves| moves.map(|m| m.len()))
+    }
+
     /// Whether `board` is the goal.
     fn is_goal(&self, board: SymbolicState) -> bool {
         board == self.goal()

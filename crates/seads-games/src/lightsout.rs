@@ -1,6 +1,8 @@
 //! LightsOut N×N (SPEC §1.1): pressing a field toggles it and its edge neighbours.
 
-use crate::{BoardGame, GameError, GameKind, MoveId, SymbolicState};
+use std::sync::OnceLock;
+
+use crate::{BoardGame, GameError, GameKind, Gf2Solver, MoveId, SymbolicState};
 
 /// LightsOut on an N×N board, 3 ≤ N ≤ 13. Bit `row·N + col` of a board is 1 iff that light is on.
 #[derive(Debug, Clone)]
@@ -9,6 +11,8 @@ pub struct LightsOut {
     masks: Vec<SymbolicState>,
     /// The low 32 bits of every mask: the whole mask when N ≤ 5 (used by the enumeration).
     masks_low: Vec<u32>,
+    /// The optimal solver, eliminated on first use.
+    solver: OnceLock<Gf2Solver>,
 }
 
 impl LightsOut {
@@ -51,12 +55,18 @@ impl LightsOut {
             n,
             masks,
             masks_low,
+            solver: OnceLock::new(),
         })
     }
 
     /// The set of fields toggled by move `mv`.
     pub fn mask(&self, mv: MoveId) -> SymbolicState {
         self.masks[mv]
+    }
+
+    /// The GF(2) solver of this size, eliminated on first use.
+    pub fn solver(&self) -> &Gf2Solver {
+        self.solver.get_or_init(|| Gf2Solver::new(self))
     }
 
     /// The move masks as 32-bit words; complete only for N ≤ 5, where a board fits 25 bits.
@@ -116,6 +126,13 @@ impl BoardGame for LightsOut {
     }
     fn is_valid(&self, z: SymbolicState) -> bool {
         z.ones().all(|d| d < self.n * self.n)
+    }
+    /// By linear algebra over GF(2) ([`Gf2Solver`]).
+    fn solve(&self, board: SymbolicState) -> Option<Result<Vec<MoveId>, GameError>> {
+        Some(self.solver().solve(board))
+    }
+    fn solution_depth(&self, board: SymbolicState) -> Option<Result<usize, GameError>> {
+        Some(self.solver().depth(board))
     }
 }
 

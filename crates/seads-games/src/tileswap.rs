@@ -1,6 +1,8 @@
 //! TileSwap 3×3 (SPEC §1.2): swap two edge-adjacent tiles; z is the 81-bit one-hot matrix.
 
-use crate::{BoardGame, GameError, GameKind, MoveId, SymbolicState};
+use std::sync::OnceLock;
+
+use crate::{BoardGame, DepthTable, GameError, GameKind, MoveId, SymbolicState};
 
 /// Number of cells (and tiles) of the 3×3 board.
 const CELLS: usize = 9;
@@ -139,6 +141,30 @@ impl BoardGame for TileSwap {
         }
         seen == 0x1ff
     }
+    /// Through the complete depth table (9! boards, built on first use).
+    fn solve(&self, board: SymbolicState) -> Option<Result<Vec<MoveId>, GameError>> {
+        if !self.is_valid(board) {
+            return Some(Err(GameError::Unsolvable { game: "tileswap" }));
+        }
+        Some(depth_table().solve(self, board))
+    }
+    fn solution_depth(&self, board: SymbolicState) -> Option<Result<usize, GameError>> {
+        if !self.is_valid(board) {
+            return Some(Err(GameError::Unsolvable { game: "tileswap" }));
+        }
+        Some(
+            depth_table()
+                .depth(self, board)
+                .map(usize::from)
+                .ok_or(GameError::Unsolvable { game: "tileswap" }),
+        )
+    }
+}
+
+/// TileSwap's complete depth table, shared by the process.
+fn depth_table() -> &'static DepthTable {
+    static TABLE: OnceLock<DepthTable> = OnceLock::new();
+    TABLE.get_or_init(|| DepthTable::build(&TileSwap).expect("TileSwap 3×3 enumerates"))
 }
 
 #[cfg(test)]

@@ -8,12 +8,14 @@ use pyo3::prelude::*;
 use pyo3::types::PyDict;
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
-use seads_embodiment::{EnvConfig, Push, make_env};
+use seads_embodiment::{
+    EnvConfig, Environment, Filmed, Push, SkillPolicy, execute_skill, make_env,
+};
 use seads_games::{BoardGame, Successor, SymbolicState};
 use seads_planner::{PlanChoice, PlannerConfig, Search, SolveConfig, find_plan};
 
 use crate::env::Env;
-use crate::value_error;
+use crate::{Values, value_error};
 
 /// A trained agent: its skill policy and forward model.
 #[pyclass(module = "seads._seads")]
@@ -46,16 +48,43 @@ fn planner(
     })
 }
 
+/// The `_seads.Env` of a ``seads`` Gymnasium environment (or the `Env` itself).
+fn env_core<'py>(env: &Bound<'py, PyAny>) -> PyResult<Bound<'py, Env>> {
+    match env.cast::<Env>() {
+        Ok(core) => Ok(core.clone()),
+        Err(_) => env
+            .getattr("unwrapped")
+            .and_then(|u| u.getattr("_core"))
+            .and_then(|c| Ok(c.cast_into::<Env>()?))
+            .map_err(|_| value_error("env: a seads environment (gymnasium.make(\"seads/…\"))")),
+    }
+}
+
 impl Agent {
-    fn board(&self, values: &[u8]) -> PyResult<SymbolicState> {
-        if values.len() != self.game.symbolic_len() {
+    /// The environment of `core` if it is in skill mode and of this agent's kind.
+    fn own_env<'a>(&self, core: &'a mut Env) -> PyResult<&'a mut Box<dyn Environment>> {
+        let environment = core.skill_env().ok_or_else(|| {
+            value_error("env: an environment in task mode; the agent needs skill mode")
+        })?;
+        if environment.spec().name != self.inner.env {
             return Err(value_error(format!(
-                "a board of {} values; this agent's game has {}",
-                values.len(),
-                self.game.symbolic_len()
+                "env: a {} environment; the agent was trained on {}",
+                environment.spec().name,
+                self.inner.env
             )));
         }
-        self.game.board_from_values(values).map_err(value_error)
+        Ok(environment)
+    }
+
+    fn board(&self, values: &Values) -> PyResult<SymbolicState> {
+        let fields = self.game.size() * self.game.size();
+        if values.0.len() != fields {
+            return Err(value_error(format!(
+                "a board of {} values; this agent's game has {fields}",
+                values.0.len(),
+            )));
+        }
+        self.game.board_from_values(&values.0).map_err(value_error)
     }
 }
 
@@ -160,7 +189,7 @@ impl Agent {
     fn successors<'py>(
         &mut self,
         py: Python<'py>,
-        board: Vec<u8>,
+        board: Values,
     ) -> PyResult<Bound<'py, PyArray2<u8>>> {
         let z = self.board(&board)?;
         let mut next = Vec::new();
@@ -177,8 +206,8 @@ impl Agent {
     fn plan(
         &mut self,
         py: Python<'_>,
-        board: Vec<u8>,
-        goal: Option<Vec<u8>>,
+        board: Values,
+        goal: Option<Values>,
         max_depth: usize,
         max_expanded: Option<usize>,
         search: &str,
@@ -204,29 +233,24 @@ impl Agent {
     /// executes the plan's skills in it, re-planning after a skill that left another board than
     /// predicted. `env` is a ``seads`` Gymnasium environment (or its ``_seads.Env``) of the
     /// agent's kind, in skill mode. Returns a dict: solved, skills (executed), moves (the game
-    /// move each made, −1 for none), path (the manipulator's positions), steps, plans, failure.
-    #[pyo3(signature = (env, board=None, replan=true, max_expanded=Some(seads_planner::DEFAULT_MAX_EXPANDED), search="breadth", choice="most-likely"))]
+    /// move each made, −1 for none), path (the manipulator's positions), steps, plans, failure;
+    /// with `render=True` also frames, the top view (`size` × `size` RGB) at the start and
+    /// after every manipulator step.
+    #[pyo3(signature = (env, board=None, replan=true, max_expanded=Some(seads_planner::DEFAULT_MAX_EXPANDED), search="breadth", choice="most-likely", render=false, size=256))]
     #[allow(clippy::too_many_arguments)]
     fn solve<'py>(
         &mut self,
         py: Python<'py>,
         env: &Bound<'py, PyAny>,
-        board: Option<Vec<u8>>,
+        board: Option<Values>,
         replan: bool,
         max_expanded: Option<usize>,
         search: &str,
         choice: &str,
+        render: bool,
+        size: usize,
     ) -> PyResult<Bound<'py, PyDict>> {
-        let core = match env.cast::<Env>() {
-            Ok(core) => core.clone(),
-            Err(_) => env
-                .getattr("unwrapped")
-                .and_then(|u| u.getattr("_core"))
-                .and_then(|c| Ok(c.cast_into::<Env>()?))
-                .map_err(|_| {
-                    value_error("env: a seads environment (gymnasium.make(\"seads/…\"))")
-                })?,
-        };
+        let core = env_core(env)?;
         let mut core = core.borrow_mut();
         let start = match board {
             Some(values) => Some(self.board(&values)?),
@@ -237,24 +261,34 @@ impl Agent {
             planner: planner(20, max_expanded, search, choice)?,
             ..SolveConfig::default()
         };
-        let agent_env = self.inner.env.clone();
         let goal = self.game.goal();
-        let environment = core.skill_env().ok_or_else(|| {
-            value_error("env: an environment in task mode; the agent needs skill mode")
-        })?;
-        if environment.spec().name != agent_env {
-            return Err(value_error(format!(
-                "env: a {} environment; the agent was trained on {agent_env}",
-                environment.spec().name
-            )));
-        }
+        let environment = self.own_env(&mut core)?;
         if let Some(start) = start {
             environment.set_board(start).map_err(value_error)?;
         }
         let (policy, model) = (&self.inner.policy, &mut self.inner.model);
-        let outcome =
-            seads_planner::solve(environment, policy, model, goal, &config).map_err(value_error)?;
+        let (outcome, scenes) = if render {
+            crate::render::check_size(size)?;
+            // A copy (same state, same random streams) is filmed and then takes the
+            // environment's place: the environment ends as an unfilmed solve leaves it.
+            let mut filmed = Filmed::new(environment.box_clone());
+            let outcome = seads_planner::solve(&mut filmed, policy, model, goal, &config);
+            let scenes = std::mem::take(&mut filmed.frames);
+            *environment = filmed.into_inner();
+            (outcome, scenes)
+        } else {
+            let outcome = seads_planner::solve(environment.as_mut(), policy, model, goal, &config);
+            (outcome, Vec::new())
+        };
+        let outcome = outcome.map_err(value_error)?;
         let result = PyDict::new(py);
+        if render {
+            let frames = scenes
+                .iter()
+                .map(|scene| crate::render::frame(py, scene, size))
+                .collect::<PyResult<Vec<_>>>()?;
+            result.set_item("frames", frames)?;
+        }
         result.set_item("solved", outcome.solved)?;
         result.set_item("skills", outcome.executed.clone())?;
         let moves: Vec<i64> = outcome
@@ -271,6 +305,46 @@ impl Agent {
         result.set_item("steps", outcome.manipulator_steps)?;
         result.set_item("plans", outcome.plans)?;
         result.set_item("failure", outcome.failure.clone())?;
+        Ok(result)
+    }
+    /// `clip(env, skill, size=256)`: executes `skill` once from where the environment stands
+    /// (reset it first, e.g. ``env.reset(seed=s)``) and returns a dict: frames (the top view,
+    /// `size` × `size` RGB, at the start and after every step), move (the game move the skill
+    /// made, −1 for none) and steps.
+    #[pyo3(signature = (env, skill, size=256))]
+    fn clip<'py>(
+        &self,
+        py: Python<'py>,
+        env: &Bound<'py, PyAny>,
+        skill: i64,
+        size: usize,
+    ) -> PyResult<Bound<'py, PyDict>> {
+        crate::render::check_size(size)?;
+        let skill = usize::try_from(skill)
+            .ok()
+            .filter(|&k| k < self.inner.policy.num_skills())
+            .ok_or_else(|| {
+                value_error(format!(
+                    "skill {skill}: the agent has skills 0 to {}",
+                    self.inner.policy.num_skills() - 1
+                ))
+            })?;
+        let core = env_core(env)?;
+        let mut core = core.borrow_mut();
+        let environment = self.own_env(&mut core)?;
+        let mut filmed = Filmed::new(environment.box_clone());
+        let run = execute_skill(&mut filmed, &self.inner.policy, skill);
+        let scenes = std::mem::take(&mut filmed.frames);
+        *environment = filmed.into_inner();
+        let run = run.map_err(value_error)?;
+        let frames = scenes
+            .iter()
+            .map(|scene| crate::render::frame(py, scene, size))
+            .collect::<PyResult<Vec<_>>>()?;
+        let result = PyDict::new(py);
+        result.set_item("frames", frames)?;
+        result.set_item("move", run.outcome.game_move().map_or(-1, |m| m as i64))?;
+        result.set_item("steps", run.steps)?;
         Ok(result)
     }
 }

@@ -136,9 +136,9 @@ pub struct Env {
 
 impl Env {
     /// The environment in skill mode, for executing skills (`None` in task mode).
-    pub(crate) fn skill_env(&mut self) -> Option<&mut dyn Environment> {
+    pub(crate) fn skill_env(&mut self) -> Option<&mut Box<dyn Environment>> {
         match &mut self.core {
-            Core::Skill(env) => Some(env.as_mut()),
+            Core::Skill(env) => Some(env),
             Core::Task(_) => None,
         }
     }
@@ -159,7 +159,8 @@ impl Env {
     }
 
     /// The environment's specification as a dict (name, game, board_size, obs_dim, action_dim,
-    /// action_low, action_high, symbolic_len, manipulator_dim, num_moves, step_limit).
+    /// action_low, action_high, symbolic_len, manipulator_dim, state_low, state_high (the
+    /// manipulator state's bounds, ±inf where unbounded), num_moves, step_limit).
     fn spec<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, pyo3::types::PyDict>> {
         spec_dict(py, self.core.spec())
     }
@@ -244,6 +245,8 @@ pub(crate) fn spec_dict<'py>(
     d.set_item("action_low", spec.action_low.clone())?;
     d.set_item("action_high", spec.action_high.clone())?;
     d.set_item("manipulator_dim", spec.manipulator_dim)?;
+    d.set_item("state_low", spec.state_low.clone())?;
+    d.set_item("state_high", spec.state_high.clone())?;
     d.set_item("symbolic_len", spec.symbolic_len)?;
     d.set_item("num_moves", spec.num_skills)?;
     d.set_item("step_limit", spec.step_limit)?;

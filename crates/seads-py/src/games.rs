@@ -2,21 +2,19 @@
 //! out: a board is its values, row-major (LightsOut: 0/1 per field; TileSwap: the tile on each
 //! field).
 
-use std::sync::OnceLock;
-
 use numpy::{PyArray1, PyArray2};
 use pyo3::prelude::*;
 use seads_games::{
-    BoardDataset, BoardGame, DepthTable, Enumerable, GameSuccessor, Gf2Solver, LightsOut, Split,
-    SymbolicState, TileSwap, enumerate, split_of,
+    BoardDataset, BoardGame, Enumerable, GameSuccessor, LightsOut, Split, SymbolicState, TileSwap,
+    enumerate, split_of,
 };
 use seads_planner::{PlannerConfig, bfs_plan};
 
-use crate::value_error;
+use crate::{Values, move_arg, value_error};
 
 /// One of the two games.
 enum Rules {
-    LightsOut(LightsOut, Gf2Solver),
+    LightsOut(LightsOut),
     TileSwap(TileSwap),
 }
 
@@ -24,40 +22,32 @@ enum Rules {
 #[pyclass(module = "seads._seads", frozen)]
 pub struct Game {
     rules: Rules,
-    /// TileSwap's depth table, built on first use.
-    table: OnceLock<DepthTable>,
 }
 
 impl Game {
     fn game(&self) -> &dyn BoardGame {
         match &self.rules {
-            Rules::LightsOut(g, _) => g,
+            Rules::LightsOut(g) => g,
             Rules::TileSwap(g) => g,
         }
     }
 
     fn enumerable(&self) -> &dyn Enumerable {
         match &self.rules {
-            Rules::LightsOut(g, _) => g,
+            Rules::LightsOut(g) => g,
             Rules::TileSwap(g) => g,
         }
     }
 
     /// `values` as a board of this game, or a `ValueError` saying what is wrong.
-    fn board(&self, values: Vec<u8>) -> PyResult<SymbolicState> {
-        self.game().board_from_values(&values).map_err(value_error)
+    fn board(&self, values: Values) -> PyResult<SymbolicState> {
+        self.game()
+            .board_from_values(&values.0)
+            .map_err(value_error)
     }
 
     fn array<'py>(&self, py: Python<'py>, board: SymbolicState) -> Bound<'py, PyArray1<u8>> {
         PyArray1::from_vec(py, self.game().values(board))
-    }
-
-    fn depth_table(&self) -> PyResult<&DepthTable> {
-        if let Some(table) = self.table.get() {
-            return Ok(table);
-        }
-        let table = DepthTable::build(self.enumerable()).map_err(value_error)?;
-        Ok(self.table.get_or_init(|| table))
     }
 }
 
@@ -81,9 +71,7 @@ impl Game {
     fn new(name: &str, size: Option<usize>) -> PyResult<Self> {
         let rules = match name {
             "lightsout" => {
-                let game = LightsOut::new(size.unwrap_or(5)).map_err(value_error)?;
-                let solver = Gf2Solver::new(&game);
-                Rules::LightsOut(game, solver)
+                Rules::LightsOut(LightsOut::new(size.unwrap_or(5)).map_err(value_error)?)
             }
             "tileswap" => {
                 Rules::TileSwap(TileSwap::with_size(size.unwrap_or(3)).map_err(value_error)?)
@@ -94,10 +82,7 @@ impl Game {
                 )));
             }
         };
-        Ok(Self {
-            rules,
-            table: OnceLock::new(),
-        })
+        Ok(Self { rules })
     }
 
     /// `"lightsout"` or `"tileswap"`.
@@ -127,45 +112,35 @@ impl Game {
     fn apply<'py>(
         &self,
         py: Python<'py>,
-        board: Vec<u8>,
-        r#move: usize,
+        board: Values,
+        r#move: i64,
     ) -> PyResult<Bound<'py, PyArray1<u8>>> {
         let board = self.board(board)?;
-        if r#move >= self.game().num_moves() {
-            return Err(value_error(format!(
-                "move {}: the game has moves 0 to {}",
-                r#move,
-                self.game().num_moves() - 1
-            )));
-        }
-        Ok(self.array(py, self.game().apply(board, r#move)))
+        let mv = move_arg(r#move, self.game().num_moves())?;
+        Ok(self.array(py, self.game().apply(board, mv)))
     }
 
     /// Whether `board` is solved.
-    fn is_goal(&self, board: Vec<u8>) -> PyResult<bool> {
+    fn is_goal(&self, board: Values) -> PyResult<bool> {
         Ok(self.game().is_goal(self.board(board)?))
     }
 
     /// An optimal (shortest) move sequence that solves `board`; a `ValueError` if none does.
-    fn solve(&self, board: Vec<u8>) -> PyResult<Vec<usize>> {
+    fn solve(&self, board: Values) -> PyResult<Vec<usize>> {
         let board = self.board(board)?;
-        match &self.rules {
-            Rules::LightsOut(_, solver) => solver.solve(board).map_err(value_error),
-            Rules::TileSwap(game) => self.depth_table()?.solve(game, board).map_err(value_error),
+        match self.game().solve(board) {
+            Some(moves) => moves.map_err(value_error),
+            None => Err(value_error("this game has no solver")),
         }
     }
 
     /// The board's solution depth (length of an optimal solution); a `ValueError` if it has
     /// none.
-    fn depth(&self, board: Vec<u8>) -> PyResult<usize> {
+    fn depth(&self, board: Values) -> PyResult<usize> {
         let board = self.board(board)?;
-        match &self.rules {
-            Rules::LightsOut(_, solver) => solver.depth(board).map_err(value_error),
-            Rules::TileSwap(game) => self
-                .depth_table()?
-                .depth(game, board)
-                .map(usize::from)
-                .ok_or_else(|| value_error("the board cannot be solved")),
+        match self.game().solution_depth(board) {
+            Some(depth) => depth.map_err(value_error),
+            None => Err(value_error("this game has no solver")),
         }
     }
 
@@ -181,7 +156,7 @@ impl Game {
     /// `"train"` or `"test"`: the board's part of the split, by the CRC-32 of its values written
     /// as comma-separated text: `"train"` where it is 0 modulo 3 (a third of the boards), else
     /// `"test"` (two thirds).
-    fn split(&self, board: Vec<u8>) -> PyResult<&'static str> {
+    fn split(&self, board: Values) -> PyResult<&'static str> {
         let board = self.board(board)?;
         Ok(split_of(&self.game().values(board)).name())
     }
@@ -225,8 +200,8 @@ impl Game {
 pub fn plan(
     py: Python<'_>,
     game: &Game,
-    board: Vec<u8>,
-    goal: Option<Vec<u8>>,
+    board: Values,
+    goal: Option<Values>,
     timeout_s: Option<f64>,
     max_expanded: Option<usize>,
     max_depth: usize,
@@ -241,8 +216,11 @@ pub fn plan(
     }
     // LightsOut's moves flip fields, so a plan to `goal` exists iff `start ^ goal` can be
     // solved: the GF(2) solver says at once where the search would run to its limit.
-    if let Rules::LightsOut(_, solver) = &game.rules {
-        solver.depth(start ^ goal).map_err(value_error)?;
+    if let Rules::LightsOut(lightsout) = &game.rules {
+        lightsout
+            .solver()
+            .depth(start ^ goal)
+            .map_err(value_error)?;
     }
     let config = PlannerConfig {
         max_layers: max_depth,

@@ -23,6 +23,72 @@ fn value_error(e: impl std::fmt::Display) -> PyErr {
     PyValueError::new_err(e.to_string())
 }
 
+/// A board's values as Python gives them: any array-like (a list, a tuple, a NumPy array of
+/// integers, bools or integral floats), 1-D (row-major) or square (N × N), each value a whole
+/// number 0 to 255; anything else is a `ValueError` saying what is wrong. The game then checks
+/// the values themselves.
+pub(crate) struct Values(pub Vec<u8>);
+
+impl<'a, 'py> FromPyObject<'a, 'py> for Values {
+    type Error = PyErr;
+
+    fn extract(obj: Borrowed<'a, 'py, PyAny>) -> PyResult<Self> {
+        let numpy = obj.py().import("numpy")?;
+        let not_a_board =
+            |_| value_error("a board: a sequence of its field values (whole numbers)");
+        let array = numpy.call_method1("asarray", (obj,)).map_err(not_a_board)?;
+        let dtype = array.getattr("dtype")?;
+        let kind: String = dtype.getattr("kind")?.extract()?;
+        if !matches!(kind.as_str(), "b" | "i" | "u" | "f") {
+            return Err(value_error(format!(
+                "a board holds whole numbers, not values of type {}",
+                dtype.str()?
+            )));
+        }
+        let shape: Vec<usize> = array.getattr("shape")?.extract()?;
+        let flat = match shape.as_slice() {
+            [_] => array,
+            [rows, cols] if rows == cols => array.call_method0("ravel")?,
+            _ => {
+                return Err(value_error(format!(
+                    "a board is 1-D (its values, row-major) or square (N × N), not of shape {shape:?}"
+                )));
+            }
+        };
+        let values: Vec<f64> = flat
+            .call_method1("astype", ("float64",))?
+            .call_method0("tolist")?
+            .extract()?;
+        values
+            .iter()
+            .enumerate()
+            .map(|(i, &v)| {
+                if v.fract() == 0.0 && (0.0..=255.0).contains(&v) {
+                    Ok(v as u8)
+                } else {
+                    Err(value_error(format!(
+                        "board value {v} at field {i}: not a field value (a whole number 0 to 255)"
+                    )))
+                }
+            })
+            .collect::<PyResult<Vec<u8>>>()
+            .map(Values)
+    }
+}
+
+/// A move given from Python, checked against the game's `num_moves` (negative ones included).
+pub(crate) fn move_arg(mv: i64, num_moves: usize) -> PyResult<usize> {
+    usize::try_from(mv)
+        .ok()
+        .filter(|&m| m < num_moves)
+        .ok_or_else(|| {
+            value_error(format!(
+                "move {mv}: the game has moves 0 to {}",
+                num_moves.saturating_sub(1)
+            ))
+        })
+}
+
 /// The names of the registered environments (`lightsout-cursor`, …), as `seads envs` lists
 /// them.
 #[pyfunction]

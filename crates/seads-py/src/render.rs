@@ -16,13 +16,28 @@ pub fn image<'py>(
     env: &dyn Environment,
     size: usize,
 ) -> PyResult<Bound<'py, PyArray3<u8>>> {
+    frame(py, &env.scene(), size)
+}
+
+/// `scene` as a `size` × `size` × 3 NumPy array (see [`image`]).
+pub fn frame<'py>(
+    py: Python<'py>,
+    scene: &Scene,
+    size: usize,
+) -> PyResult<Bound<'py, PyArray3<u8>>> {
+    check_size(size)?;
+    let pixels = rgb(scene, size).map_err(value_error)?;
+    PyArray1::from_vec(py, pixels).reshape([size, size, 3])
+}
+
+/// A `ValueError` for an image size outside 16 to 4096 pixels.
+pub fn check_size(size: usize) -> PyResult<()> {
     if !(16..=4096).contains(&size) {
         return Err(value_error(format!(
             "render size {size}: must be 16 to 4096 pixels"
         )));
     }
-    let pixels = rgb(&env.scene(), size).map_err(value_error)?;
-    PyArray1::from_vec(py, pixels).reshape([size, size, 3])
+    Ok(())
 }
 
 /// A lit LightsOut field.

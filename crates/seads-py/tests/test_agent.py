@@ -63,7 +63,7 @@ def test_a_gymnasium_environment_is_solved_in_place(agent):
     result = agent.solve(env, board=board(task), max_expanded=20000)
     assert result["solved"]
     assert len(result["moves"]) == len(result["skills"]) >= task["depth"]
-    assert env.unwrapped._core.board().sum() == 0, "the environment's board is solved"
+    assert env.unwrapped.board().sum() == 0, "the environment's board is solved"
     assert len(result["path"]) > len(result["skills"])
 
 
@@ -120,3 +120,46 @@ def test_bad_input_raises_value_errors(agent, tmp_path):
         agent.solve(seads.Env("lightsout-cursor", task=True))
     with pytest.raises(ValueError, match="seads environment"):
         agent.solve(object())
+
+
+def test_a_rendered_solution_is_the_same_solution_filmed(agent):
+    """``solve(render=True)`` plays exactly the unfilmed solution (same skills, steps and end
+    state) and returns a frame before the first step and one after each: the first is the
+    environment's view before, the last its view after."""
+    task = next(t for t in TASKS if t["solved"] and t["depth"] >= 2)
+    plain, filmed = (seads.SeadsEnv("lightsout-cursor", render_mode="rgb_array") for _ in range(2))
+    for env in (plain, filmed):
+        env.reset(seed=4)
+    before = filmed.render()
+    a = agent.solve(plain, board=board(task), max_expanded=20000)
+    b = agent.solve(filmed, board=board(task), max_expanded=20000, render=True)
+    assert (a["skills"], a["steps"], a["solved"]) == (b["skills"], b["steps"], b["solved"])
+    assert "frames" not in a and len(b["frames"]) == b["steps"] + 1
+    assert all(f.shape == (256, 256, 3) and f.dtype == np.uint8 for f in b["frames"])
+    assert not np.array_equal(b["frames"][0], before), "the board was set before the first frame"
+    assert np.array_equal(plain.unwrapped._core.observation(), filmed.unwrapped._core.observation())
+    assert np.array_equal(b["frames"][-1], filmed.render())
+
+
+def test_a_skill_clip_is_the_skill_executed_step_by_step_in_python(agent):
+    """``clip(env, k)`` against the skill run by hand: ``act`` for the observation, one step at a
+    time, until the episode ends: the same move, the same number of steps, and a frame for the
+    start and for each step, the last one the environment's view at the end."""
+    for skill in (0, 7, 24):
+        by_hand = seads.SeadsEnv("lightsout-cursor", render_mode="rgb_array")
+        obs, _ = by_hand.reset(seed=skill)
+        frames = [by_hand.render()]
+        while True:
+            obs, _, terminated, truncated, info = by_hand.step(agent.act(obs, skill))
+            frames.append(by_hand.render())
+            if terminated or truncated:
+                break
+        clipped = seads.SeadsEnv("lightsout-cursor", render_mode="rgb_array")
+        clipped.reset(seed=skill)
+        clip = agent.clip(clipped, skill)
+        assert (clip["move"], clip["steps"]) == (info["move"], len(frames) - 1), skill
+        assert all(np.array_equal(x, y) for x, y in zip(clip["frames"], frames)), skill
+    with pytest.raises(ValueError, match="skill 25"):
+        agent.clip(clipped, 25)
+    with pytest.raises(ValueError, match="skill -1"):
+        agent.clip(clipped, -1)

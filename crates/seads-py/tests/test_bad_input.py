@@ -63,3 +63,48 @@ def test_wrong_boards_and_moves_are_value_errors():
         seads.Game("chess")
     with pytest.raises(ValueError, match="bit"):
         seads.Env("lightsout-cursor").set_state(np.full(27, 0.5, dtype=np.float32))
+
+
+@pytest.mark.parametrize("shape", ["list", "uint8", "int64", "float32", "bool", "square", "tuple"])
+def test_a_board_may_come_in_any_whole_number_form(shape):
+    """A board is its values, row-major, in any array-like of whole numbers: a list, an integer,
+    float or bool array, a slice of an observation, or the 5 x 5 square."""
+    game = seads.Game("lightsout")
+    values = game.apply(game.apply(game.goal(), 3), 17)
+    form = {
+        "list": [int(v) for v in values],
+        "uint8": values,
+        "int64": values.astype(np.int64),
+        "float32": np.concatenate([[0.3, 0.7], values.astype(np.float32), [1.0]])[2:-1],
+        "bool": values.astype(bool),
+        "square": values.reshape(5, 5),
+        "tuple": tuple(int(v) for v in values),
+    }[shape]
+    assert game.depth(form) == 2
+    assert game.solve(form) == [3, 17]
+    assert seads.plan(game, form) == [3, 17]
+    assert np.array_equal(game.apply(form, 3), game.apply(game.goal(), 17))
+
+
+@pytest.mark.parametrize("bad,message", [
+    (np.full(25, 0.5), "board value 0.5 at field 0"),
+    (np.full(25, np.nan), "not a field value"),
+    (np.full(25, -1), "board value -1"),
+    (np.zeros((5, 4)), "shape"),
+    (np.zeros((2, 5, 5)), "shape"),
+    (np.array(["a"] * 25), "whole numbers"),
+    ([[0, 1], [0]], "a board"),
+    (np.zeros(24, dtype=np.uint8), "25"),
+    (np.full(25, 2), "0 or 1"),
+])
+def test_a_malformed_board_is_a_value_error_saying_what_is_wrong(bad, message):
+    game = seads.Game("lightsout")
+    with pytest.raises(ValueError, match=message):
+        game.depth(bad)
+
+
+def test_a_negative_or_too_large_move_is_a_value_error():
+    game = seads.Game("tileswap")
+    for mv in (-1, 12, 10**6):
+        with pytest.raises(ValueError, match=f"move {mv}: the game has moves 0 to 11"):
+            game.apply(game.goal(), mv)

@@ -42,7 +42,7 @@ def test_a_python_rollout_repeats_the_rust_episode_file_step_for_step(file):
         if "jaco" in file.name:
             assert np.array_equal(obs[:-1], initial), f"{file.name} episode {k}: reset"
         else:
-            env._core.set_state(initial)
+            env.set_state(initial)
         for t, step in enumerate(episode["steps"]):
             obs, reward, terminated, _, info = env.step(np.asarray(step["action"], dtype=np.float32))
             expected = np.asarray(step["obs"], dtype=np.float32)
@@ -138,3 +138,28 @@ def test_an_environment_pickles_as_a_new_one_with_its_settings():
     np.testing.assert_array_equal(first, again)
     action = np.array([0.1, -0.1, 1.0], dtype=np.float32)
     np.testing.assert_array_equal(env.step(action)[0], copy.step(action)[0])
+
+
+@pytest.mark.parametrize("name", ["lightsout-cursor", "tileswap-cursor"])
+def test_the_cursors_observation_is_bounded_and_the_checker_has_no_warning(name):
+    """The cursor stays on the board: its part of the observation lies in [0, 1], and
+    Gymnasium's checker has nothing to warn about."""
+    import warnings
+
+    env = gymnasium.make(seads.gym_id(name))
+    space = env.observation_space
+    assert np.all(space.low[:2] == 0.0) and np.all(space.high[:2] == 1.0)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        check_env(env.unwrapped)
+
+
+def test_task_mode_reaches_the_deepest_boards_at_once():
+    """Task mode at 5 x 5 LightsOut's largest depth, 15: each reset's depth is the game's own
+    (it mapped every board up to the depth first: 681 s)."""
+    env = seads.SeadsEnv("lightsout-cursor", task=True, max_solution_depth=15,
+                         random_solution_depth=False)
+    game = seads.Game("lightsout")
+    for seed in range(5):
+        _, info = env.reset(seed=seed)
+        assert info["depth"] == game.depth(info["board"]) == 15

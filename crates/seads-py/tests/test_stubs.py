@@ -23,3 +23,16 @@ def test_the_stubs_cover_every_export_and_every_method():
             assert methods <= in_stub, f"{name}: not in the stubs: {methods - in_stub}"
             for m in methods:
                 assert getattr(obj, m).__doc__, f"{name}.{m} has no docstring"
+
+
+def test_mypy_stubtest_finds_the_stubs_equal_to_the_module():
+    """mypy's stubtest compares every stubbed signature, default and property with the compiled
+    module's own (a pyo3 class is built by ``__new__``, not ``__init__``)."""
+    import subprocess
+    import sys
+
+    result = subprocess.run(
+        [sys.executable, "-m", "mypy.stubtest", "seads._seads"],
+        capture_output=True, text=True, check=False,
+    )
+    assert result.returncode == 0, result.stdout + result.stderr

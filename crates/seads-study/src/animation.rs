@@ -5,76 +5,10 @@ use std::path::Path;
 
 use plotters::coord::Shift;
 use plotters::prelude::*;
-use seads_embodiment::{
-    EnvError, EnvSpec, Environment, Scene, SkillPolicy, StepOutcome, execute_skill,
-};
-use seads_games::SymbolicState;
+use seads_embodiment::{Environment, Filmed, Scene, SkillPolicy, execute_skill};
 
 use crate::draw::{draw_scene, plot_err, register_font};
 use crate::{Result, StudyError};
-
-/// An environment that keeps its scene after every step (and at the start), for an animation.
-pub struct Filmed {
-    inner: Box<dyn Environment>,
-    /// The scenes: the first when filming started, then one per step.
-    pub frames: Vec<Scene>,
-}
-
-impl Filmed {
-    /// Films `inner` from now on.
-    pub fn new(inner: Box<dyn Environment>) -> Self {
-        let frames = vec![inner.scene()];
-        Self { inner, frames }
-    }
-}
-
-impl Environment for Filmed {
-    fn spec(&self) -> &EnvSpec {
-        self.inner.spec()
-    }
-    fn seed(&mut self, seed: u64) {
-        self.inner.seed(seed);
-    }
-    fn reset(&mut self) -> Result<(), EnvError> {
-        self.inner.reset()
-    }
-    fn step(&mut self, action: &[f32]) -> Result<StepOutcome, EnvError> {
-        let outcome = self.inner.step(action)?;
-        self.frames.push(self.inner.scene());
-        Ok(outcome)
-    }
-    fn observe(&self, out: &mut [f32]) {
-        self.inner.observe(out);
-    }
-    fn board(&self) -> SymbolicState {
-        self.inner.board()
-    }
-    fn set_board(&mut self, board: SymbolicState) -> Result<(), EnvError> {
-        self.inner.set_board(board)
-    }
-    fn reset_step_counter(&mut self) {
-        self.inner.reset_step_counter();
-    }
-    fn set_step_limit(&mut self, limit: Option<usize>) {
-        self.inner.set_step_limit(limit);
-    }
-    fn restore_manipulator(&mut self, state: &[f32]) -> Result<(), EnvError> {
-        self.inner.restore_manipulator(state)
-    }
-    fn scene(&self) -> Scene {
-        self.inner.scene()
-    }
-    fn end_effector(&self) -> [f64; 2] {
-        self.inner.end_effector()
-    }
-    fn move_point(&self) -> Option<[f64; 2]> {
-        self.inner.move_point()
-    }
-    /// A clone films nothing: only this environment's steps are frames.
-    fn box_clone(&self) -> Box<dyn Environment> {
-        self.inner.box_clone()
-    }
-}
 
 /// One short clip per skill: each executed from `starts` of the coverage initialisations of `env`
 /// (seeds `seed`, `seed + 1`, …), a frame per step under "skill k · start i · step t", the last

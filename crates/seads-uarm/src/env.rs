@@ -264,6 +264,8 @@ impl UarmEnv {
             game: GameKind::LightsOut,
             board_size: 5,
             manipulator_dim: 2,
+            state_low: vec![f32::NEG_INFINITY; 2],
+            state_high: vec![f32::INFINITY; 2],
             symbolic_len: 25,
             obs_dim: 2 + 25 + 1,
             action_dim: low.len(),

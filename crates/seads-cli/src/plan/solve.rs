@@ -67,7 +67,7 @@ pub fn solve_board(args: SolveArgs) -> Result<()> {
         .as_deref()
         .filter(|p| p.extension().is_some_and(|e| e.eq_ignore_ascii_case("gif")));
     if let Some(out) = animate {
-        let mut filmed = seads_study::animation::Filmed::new(env);
+        let mut filmed = seads_embodiment::Filmed::new(env);
         let outcome = solve(&mut filmed, policy, model, game.goal(), &config)?;
         let captions = captions(&agent.config.env, &outcome, filmed.frames.len());
         let frames: Vec<_> = filmed.frames.into_iter().zip(captions).collect();

@@ -50,7 +50,8 @@ def _spaces(spec: dict[str, Any]) -> tuple[spaces.Box, spaces.Box]:
     m, obs_dim = spec["manipulator_dim"], spec["obs_dim"]
     low = np.zeros(obs_dim, dtype=np.float32)
     high = np.ones(obs_dim, dtype=np.float32)
-    low[:m], high[:m] = -np.inf, np.inf
+    low[:m] = np.asarray(spec["state_low"], dtype=np.float32)
+    high[:m] = np.asarray(spec["state_high"], dtype=np.float32)
     observation = spaces.Box(low=low, high=high, dtype=np.float32)
     action = spaces.Box(
         low=np.asarray(spec["action_low"], dtype=np.float32),
@@ -58,6 +59,18 @@ def _spaces(spec: dict[str, Any]) -> tuple[spaces.Box, spaces.Box]:
         dtype=np.float32,
     )
     return observation, action
+
+
+def _autoreset_mode(mode: AutoresetMode | str) -> AutoresetMode:
+    """Gymnasium's autoreset mode from itself, its value (``"NextStep"``) or its name in any case
+    (``"next_step"``)."""
+    if isinstance(mode, AutoresetMode):
+        return mode
+    key = str(mode).replace("_", "").lower()
+    for m in AutoresetMode:
+        if key in (m.value.lower(), m.name.replace("_", "").lower()):
+            return m
+    raise ValueError(f"autoreset_mode {mode!r}: one of {[m.value for m in AutoresetMode]}")
 
 
 def _seed_from(rng: np.random.Generator) -> int:
@@ -124,6 +137,13 @@ class SeadsEnv(gymnasium.Env):
         """The board's values (see ``info["board"]``)."""
         return self._core.board()
 
+    def set_state(self, initial_obs) -> None:
+        """Puts the environment into the state an episode file's ``initial_obs`` describes (the
+        manipulator state, then the board's bits; skill mode) and lifts the step limit, as
+        ``seads replay`` does: the recorded actions then give the recorded observations. A
+        ``ValueError`` for a state of the wrong length or one the manipulator cannot take."""
+        self._core.set_state(np.ascontiguousarray(initial_obs, dtype=np.float32).reshape(-1))
+
     def _info(self, move: int) -> dict[str, Any]:
         info: dict[str, Any] = {"board": self._core.board(), "move": move}
         if self.task:
@@ -134,9 +154,14 @@ class SeadsEnv(gymnasium.Env):
 class SeadsVectorEnv(VectorEnv):
     """``num_envs`` environments stepped in parallel in Rust, writing into NumPy arrays.
 
-    Autoreset is Gymnasium's default (next step): the step after an episode ended resets that
-    environment and returns its first observation with reward 0. ``info["move"]`` holds each
-    environment's game move (-1 for none); :meth:`boards` returns every board.
+    ``autoreset_mode`` is one of Gymnasium's (``AutoresetMode`` or its value): ``NEXT_STEP``
+    (the default: the step after an episode ended resets that environment and returns its first
+    observation with reward 0), ``SAME_STEP`` (the ending step resets at once; ``info`` then holds
+    ``final_obs`` and ``final_info``) or ``DISABLED`` (reset ended environments yourself with
+    ``reset(options={"reset_mask": mask})``). ``info`` holds ``board`` (each environment's board
+    values), ``move`` (each step's game move, -1 for none) and, in task mode, ``depth``, each with
+    its ``_``-prefixed mask as Gymnasium's vector environments give them; :meth:`boards` returns
+    every board.
     """
 
     metadata = {"render_modes": ["rgb_array"], "autoreset_mode": AutoresetMode.NEXT_STEP}
@@ -147,29 +172,55 @@ class SeadsVectorEnv(VectorEnv):
         num_envs: int,
         render_mode: str | None = None,
         task: bool = False,
+        autoreset_mode: AutoresetMode | str = AutoresetMode.NEXT_STEP,
         **options: Any,
     ):
         if render_mode not in (None, "rgb_array"):
             raise ValueError(f"render_mode {render_mode!r}: only 'rgb_array' is supported")
-        if not isinstance(num_envs, (int, np.integer)) or num_envs < 1:
+        if isinstance(num_envs, bool) or not isinstance(num_envs, (int, np.integer)) or num_envs < 1:
             raise ValueError(f"num_envs {num_envs!r}: must be a positive integer")
+        mode = _autoreset_mode(autoreset_mode)
         self.env_name = env_name
         self.num_envs = int(num_envs)
         self.render_mode = render_mode
-        self._core = _seads.VecEnv(env_name, self.num_envs, _options(options), task)
+        self.task = task
+        self.autoreset_mode = mode
+        self.metadata = {**type(self).metadata, "autoreset_mode": mode}
+        self._core = _seads.VecEnv(env_name, self.num_envs, _options(options), task, mode.value)
         self.spec_dict = self._core.spec()
         self.single_observation_space, self.single_action_space = _spaces(self.spec_dict)
         self.observation_space = batch_space(self.single_observation_space, self.num_envs)
         self.action_space = batch_space(self.single_action_space, self.num_envs)
-        n, obs_dim = self.num_envs, self.spec_dict["obs_dim"]
+        n, obs_dim, board_len = self.num_envs, self.spec_dict["obs_dim"], self._core.board_len
         self._obs = np.zeros((n, obs_dim), dtype=np.float32)
         self._reward = np.zeros(n, dtype=np.float32)
         self._terminated = np.zeros(n, dtype=np.bool_)
         self._truncated = np.zeros(n, dtype=np.bool_)
         self._move = np.full(n, -1, dtype=np.int64)
+        self._board = np.zeros((n, board_len), dtype=np.uint8)
+        self._depth = np.full(n, -1, dtype=np.int64)
+        self._final_obs = np.zeros((n, obs_dim), dtype=np.float32)
+        self._final_board = np.zeros((n, board_len), dtype=np.uint8)
+        self._ended = np.zeros(n, dtype=np.bool_)
         self._seeded = False
+        self._started = False
+        self._closed = False
 
     def reset(self, *, seed: int | list[int] | None = None, options: dict[str, Any] | None = None):
+        self._check_open()
+        options = dict(options or {})
+        mask = options.pop("reset_mask", None)
+        if options:
+            raise ValueError(f"reset options {sorted(options)}: only 'reset_mask' is known")
+        if mask is not None:
+            mask = np.asarray(mask)
+            if mask.dtype != np.bool_ or mask.shape != (self.num_envs,):
+                raise ValueError(
+                    f"reset_mask: a bool array of shape ({self.num_envs},), got {mask.dtype} {mask.shape}"
+                )
+            if not self._started and not mask.all():
+                raise ValueError("reset_mask: the first reset resets every environment")
+            mask = np.ascontiguousarray(mask)
         if isinstance(seed, (list, tuple)):
             if len(seed) != self.num_envs:
                 raise ValueError(f"{len(seed)} seeds for {self.num_envs} environments")
@@ -184,18 +235,44 @@ class SeadsVectorEnv(VectorEnv):
             else:
                 seeds = None
         self._seeded = True
-        self._core.reset(self._obs, seeds)
-        self._move.fill(-1)
-        return self._obs.copy(), {}
+        self._core.reset(self._obs, self._board, self._depth, seeds, mask)
+        self._started = True
+        reset = np.ones(self.num_envs, dtype=np.bool_) if mask is None else mask.copy()
+        self._move[reset] = -1
+        return self._obs.copy(), self._info(reset)
 
     def step(self, actions):
+        self._check_open()
+        if not self._started:
+            raise gymnasium.error.ResetNeeded("reset the vector environment before its first step")
         actions = np.ascontiguousarray(actions, dtype=np.float32)
         if actions.shape != self.action_space.shape:
             raise ValueError(
                 f"{self.env_name}: actions have shape {self.action_space.shape}, got {actions.shape}"
             )
-        self._core.step(actions, self._obs, self._reward, self._terminated, self._truncated, self._move)
-        info = {"move": self._move.copy(), "_move": np.ones(self.num_envs, dtype=np.bool_)}
+        depth_before = self._depth.copy()
+        self._core.step(
+            actions, self._obs, self._reward, self._terminated, self._truncated, self._move,
+            self._board, self._depth, self._final_obs, self._final_board, self._ended,
+        )
+        every = np.ones(self.num_envs, dtype=np.bool_)
+        info = self._info(every)
+        info["move"], info["_move"] = self._move.copy(), every
+        if self.autoreset_mode == AutoresetMode.SAME_STEP and self._ended.any():
+            ended = self._ended.copy()
+            final_obs = np.empty(self.num_envs, dtype=object)
+            for i in np.flatnonzero(ended):
+                final_obs[i] = self._final_obs[i].copy()
+            final_info: dict[str, Any] = {
+                "board": self._final_board.copy(), "_board": ended,
+                "move": self._move.copy(), "_move": ended,
+            }
+            if self.task:
+                final_info["depth"], final_info["_depth"] = depth_before, ended
+            # As Gymnasium's vector environments: the ending step's info is the final one, and
+            # the environment's own info is its reset's (no move yet).
+            info["move"][ended] = -1
+            info.update(final_obs=final_obs, _final_obs=ended, final_info=final_info, _final_info=ended)
         return (
             self._obs.copy(),
             self._reward.copy(),
@@ -203,6 +280,19 @@ class SeadsVectorEnv(VectorEnv):
             self._truncated.copy(),
             info,
         )
+
+    def close_extras(self, **kwargs: Any) -> None:
+        self._closed = True
+
+    def _check_open(self) -> None:
+        if self._closed:
+            raise gymnasium.error.ClosedEnvironmentError(f"{self.env_name}: the vector environment is closed")
+
+    def _info(self, valid: np.ndarray) -> dict[str, Any]:
+        info: dict[str, Any] = {"board": self._board.copy(), "_board": valid}
+        if self.task:
+            info["depth"], info["_depth"] = self._depth.copy(), valid
+        return info
 
     def boards(self) -> np.ndarray:
         """Every environment's board values (num_envs x board values, uint8)."""
