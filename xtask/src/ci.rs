@@ -51,12 +51,7 @@ pub fn run() -> Result<()> {
 /// with the dev profile, whose dependencies the Rust tests have just compiled, then its pytest
 /// suite, whose closing line is added to the totals.
 fn python_tests(totals: &mut Totals) -> Result<()> {
-    let venv = root().join("target").join("py-venv");
-    let python = venv.join("bin").join("python");
-    if !python.exists() {
-        step("python3", &["-m", "venv", &venv.to_string_lossy()])?;
-    }
-    let python = python.to_string_lossy().into_owned();
+    let python = py_venv()?;
     step_with_env(
         &python,
         &[
@@ -97,6 +92,54 @@ fn python_tests(totals: &mut Totals) -> Result<()> {
     )?;
     eprintln!("xtask: again with gymnasium {lowest}, the lowest the package supports");
     pytest(&python, totals)
+}
+
+/// The Python of the virtual environment `target/py-venv`, made on first use.
+pub fn py_venv() -> Result<String> {
+    let venv = root().join("target").join("py-venv");
+    let python = venv.join("bin").join("python");
+    if !python.exists() {
+        step("python3", &["-m", "venv", &venv.to_string_lossy()])?;
+    }
+    Ok(python.to_string_lossy().into_owned())
+}
+
+/// `cargo xtask package`'s wheel: one stripped, optimised abi3 wheel of the Python package for
+/// every CPython ≥ 3.9 of this platform, built by maturin (installed into `target/py-venv`) into
+/// `target/wheels`. Returns its path.
+pub fn wheel() -> Result<std::path::PathBuf> {
+    let python = py_venv()?;
+    step(
+        &python,
+        &["-m", "pip", "install", "--quiet", "--disable-pip-version-check", "maturin>=1.9,<2"],
+    )?;
+    let out = root().join("target").join("wheels");
+    // A wheel of an earlier build would be taken for this one.
+    if out.exists() {
+        std::fs::remove_dir_all(&out).context("clearing target/wheels")?;
+    }
+    step(
+        &python,
+        &[
+            "-m",
+            "maturin",
+            "build",
+            "--release",
+            "--strip",
+            "--manifest-path",
+            "crates/seads-py/Cargo.toml",
+            "--out",
+            &out.to_string_lossy(),
+        ],
+    )?;
+    let wheels: Vec<_> = std::fs::read_dir(&out)?
+        .filter_map(|e| e.ok().map(|e| e.path()))
+        .filter(|p| p.extension().is_some_and(|e| e == "whl"))
+        .collect();
+    match wheels.as_slice() {
+        [wheel] if wheel.to_string_lossy().contains("-abi3-") => Ok(wheel.clone()),
+        _ => bail!("maturin built {wheels:?}, not one abi3 wheel"),
+    }
 }
 
 /// The lowest Gymnasium `crates/seads-py/pyproject.toml` asks for (`"gymnasium>=X"`).

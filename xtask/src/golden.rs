@@ -6,8 +6,9 @@
 //! every metrics line up to epoch 300 field by field, clock fields left out. It names the first
 //! line and field that differ, so that a processor that parts from the golden shows when. It
 //! then compares the fingerprint of the floating-point primitives a run uses (the seads-rl
-//! example `numerics_fingerprint`) with the golden's, to show which. Not part of CI, whose
-//! processor varies.
+//! example `numerics_fingerprint`) with the golden's, to show which. CI checks the first 100
+//! epochs (`data/golden/first-100.jsonl`, the seads-cli test
+//! `the_golden_runs_first_100_epochs_repeat_line_for_line`); this command checks all 300.
 
 use std::path::Path;
 

@@ -20,7 +20,8 @@ Commands:
                and the Python package's pytest suite in target/py-venv (CI)
   setup        install libtorch for tch into .venv / .libtorch (idempotent; scripts/setup.sh);
                `setup --cuda` adds the CUDA libraries (then build with --features cuda)
-  package      cargo package every library crate in dependency order, building each package (slow)
+  package      cargo package every library crate in dependency order, building each package (slow),
+               then the Python package's one abi3 wheel (every CPython >= 3.9) into target/wheels
   gen-splits   write data/depth_counts.csv and data/split_counts.csv from a fresh enumeration
   golden       train the golden run (data/golden/) and say whether this processor repeats it
                (`--record` makes this processor's run the golden); not part of ci
@@ -42,9 +43,13 @@ fn main() -> ExitCode {
                 return ExitCode::from(2);
             }
         },
-        Some("package") => {
-            setup().and_then(|()| step("cargo", &[&PACKAGE[..], &["--allow-dirty"]].concat()))
-        }
+        Some("package") => setup()
+            .and_then(|()| step("cargo", &[&PACKAGE[..], &["--allow-dirty"]].concat()))
+            .and_then(|()| ci::wheel())
+            .map(|wheel| {
+                println!("Python wheel: {}", wheel.display());
+                println!("install it into any Python ≥ 3.9: pip install {}", wheel.display());
+            }),
         Some("gen-splits") => gen_splits::run(&root()),
         Some("golden") => match args.get(1).map(String::as_str) {
             None => golden::run(&root(), false),

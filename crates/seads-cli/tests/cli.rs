@@ -2196,3 +2196,61 @@ fn a_garbage_evaluation_file_is_named_as_such() {
     );
     assert!(!stderr.contains("cannot load checkpoint"), "{stderr}");
 }
+
+/// The golden run in CI (issue 45 item 6): its first 100 epochs (`data/golden/config.toml`,
+/// portable numerics, evaluated every 10 epochs) trained again by this build give every metrics
+/// line of `data/golden/first-100.jsonl` (clock fields left out), on any processor; a difference
+/// is named by its first epoch and field. `SEADS_BLESS_GOLDEN=1` writes this build's lines there
+/// instead (after a change that is meant to alter training). The file must also agree with the
+/// full golden `data/golden/metrics.jsonl` (`cargo xtask golden`) where both have the epoch.
+#[test]
+fn the_golden_runs_first_100_epochs_repeat_line_for_line() {
+    const CLOCK: [&str; 3] = ["wall_s", "steps_per_s", "timings"];
+    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../..");
+    let golden = root.join("data/golden");
+    let strip = |text: &str| -> Vec<serde_json::Map<String, serde_json::Value>> {
+        text.lines()
+            .map(|l| {
+                let mut line: serde_json::Map<_, _> = serde_json::from_str(l).unwrap();
+                line.retain(|k, _| !CLOCK.contains(&k.as_str()));
+                line
+            })
+            .collect()
+    };
+    let dir = tempfile::tempdir().unwrap();
+    let config = std::fs::read_to_string(golden.join("config.toml"))
+        .unwrap()
+        .replace("env_steps = 22000", "env_steps = 5016");
+    assert!(config.contains("env_steps = 5016"), "the golden's budget line");
+    let config_path = dir.path().join("config.toml");
+    std::fs::write(&config_path, config).unwrap();
+    let run = dir.path().join("run");
+    seads_ok(&["train", "--config", s(&config_path), "--out", s(&run), "--quiet"]);
+    let text = std::fs::read_to_string(run.join("metrics.jsonl")).unwrap();
+    let ours = strip(&text);
+    assert_eq!(ours.last().unwrap()["epoch"], 100, "the budget ends at epoch 100");
+    let first_100 = golden.join("first-100.jsonl");
+    if std::env::var_os("SEADS_BLESS_GOLDEN").is_some() {
+        let lines: String = ours
+            .iter()
+            .map(|l| serde_json::to_string(l).unwrap() + "\n")
+            .collect();
+        std::fs::write(&first_100, lines).unwrap();
+    }
+    let expected = strip(&std::fs::read_to_string(&first_100).unwrap());
+    let full = strip(&std::fs::read_to_string(golden.join("metrics.jsonl")).unwrap());
+    for (name, reference) in [("first-100.jsonl", &expected), ("metrics.jsonl", &full)] {
+        for (want, got) in reference.iter().zip(&ours) {
+            let epoch = &want["epoch"];
+            for (field, value) in want {
+                assert_eq!(
+                    got.get(field),
+                    Some(value),
+                    "data/golden/{name}: epoch {epoch} parts at field {field:?} \
+                     (SEADS_BLESS_GOLDEN=1 records this build's run if the change is meant)"
+                );
+            }
+        }
+    }
+    assert_eq!(expected.len(), ours.len(), "every epoch of first-100.jsonl");
+}

@@ -36,3 +36,9 @@ def test_mypy_stubtest_finds_the_stubs_equal_to_the_module():
         capture_output=True, text=True, check=False,
     )
     assert result.returncode == 0, result.stdout + result.stderr
+
+
+def test_the_extension_is_built_for_the_stable_abi():
+    """One abi3 wheel serves every CPython from 3.9 on: the compiled module is named for the
+    stable ABI, not for this interpreter."""
+    assert pathlib.Path(_seads.__file__).name == "_seads.abi3.so"

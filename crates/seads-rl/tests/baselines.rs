@@ -135,21 +135,30 @@ fn a_resumed_hac_run_is_the_uninterrupted_run() {
 fn task_success_covers_every_depth() {
     let config = small(1, 800);
     let agent = TaskSac::new(config.clone()).unwrap();
+    let mut ended = Vec::new();
     let results = task_success(
         &config,
         &mut agent.policy(),
         &TaskSet::standard(3),
-        |_, _, _, _| {},
+        |depth, seed, board, solved| ended.push((depth, seed, board, solved)),
     )
     .unwrap();
     assert_eq!(
         results.iter().map(|r| r.depth).collect::<Vec<_>>(),
         [1, 2, 3, 4, 5]
     );
+    // Each task's board has the depth it is counted under (the GF(2) solver's, independent of
+    // the task environment), and the tallies are those of the tasks as they ended.
+    let game = seads_games::LightsOut::new(5).unwrap();
     for r in &results {
-        assert_eq!(r.tasks, 3);
-        assert!(r.solved <= 3);
-        assert!(r.solution_steps.iter().all(|&s| s <= 10 * r.depth));
+        let tasks: Vec<_> = ended.iter().filter(|t| t.0 == r.depth).collect();
+        assert_eq!((r.tasks, tasks.len()), (3, 3));
+        for &&(depth, _, board, _) in &tasks {
+            assert_eq!(game.solver().depth(board).unwrap(), depth);
+        }
+        let solved = tasks.iter().filter(|t| t.3).count();
+        assert_eq!((r.solved, r.solution_steps.len()), (solved, solved));
+        assert!(r.solution_steps.iter().all(|&s| (1..=10 * r.depth).contains(&s)));
     }
 }
 
