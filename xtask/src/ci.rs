@@ -111,7 +111,14 @@ pub fn wheel() -> Result<std::path::PathBuf> {
     let python = py_venv()?;
     step(
         &python,
-        &["-m", "pip", "install", "--quiet", "--disable-pip-version-check", "maturin>=1.9,<2"],
+        &[
+            "-m",
+            "pip",
+            "install",
+            "--quiet",
+            "--disable-pip-version-check",
+            "maturin>=1.9,<2",
+        ],
     )?;
     let out = root().join("target").join("wheels");
     // A wheel of an earlier build would be taken for this one.

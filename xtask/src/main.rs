@@ -48,7 +48,10 @@ fn main() -> ExitCode {
             .and_then(|()| ci::wheel())
             .map(|wheel| {
                 println!("Python wheel: {}", wheel.display());
-                println!("install it into any Python ≥ 3.9: pip install {}", wheel.display());
+                println!(
+                    "install it into any Python ≥ 3.9: pip install {}",
+                    wheel.display()
+                );
             }),
         Some("gen-splits") => gen_splits::run(&root()),
         Some("golden") => match args.get(1).map(String::as_str) {

@@ -2221,14 +2221,28 @@ fn the_golden_runs_first_100_epochs_repeat_line_for_line() {
     let config = std::fs::read_to_string(golden.join("config.toml"))
         .unwrap()
         .replace("env_steps = 22000", "env_steps = 5016");
-    assert!(config.contains("env_steps = 5016"), "the golden's budget line");
+    assert!(
+        config.contains("env_steps = 5016"),
+        "the golden's budget line"
+    );
     let config_path = dir.path().join("config.toml");
     std::fs::write(&config_path, config).unwrap();
     let run = dir.path().join("run");
-    seads_ok(&["train", "--config", s(&config_path), "--out", s(&run), "--quiet"]);
+    seads_ok(&[
+        "train",
+        "--config",
+        s(&config_path),
+        "--out",
+        s(&run),
+        "--quiet",
+    ]);
     let text = std::fs::read_to_string(run.join("metrics.jsonl")).unwrap();
     let ours = strip(&text);
-    assert_eq!(ours.last().unwrap()["epoch"], 100, "the budget ends at epoch 100");
+    assert_eq!(
+        ours.last().unwrap()["epoch"],
+        100,
+        "the budget ends at epoch 100"
+    );
     let first_100 = golden.join("first-100.jsonl");
     if std::env::var_os("SEADS_BLESS_GOLDEN").is_some() {
         let lines: String = ours

@@ -209,6 +209,11 @@ pub trait BoardGame: Send + Sync {
     fn apply(&self, board: SymbolicState, mv: MoveId) -> SymbolicState;
     /// The canonical field values, row-major (LightsOut 0/1, TileSwap the tile id of each cell).
     fn values(&self, board: SymbolicState) -> Vec<u8>;
+    /// [`BoardGame::values`] written into `out` (one value per field), without allocating where
+    /// the game says how.
+    fn write_values(&self, board: SymbolicState, out: &mut [u8]) {
+        out.copy_from_slice(&self.values(board));
+    }
     /// The board with these canonical field values.
     fn board_from_values(&self, values: &[u8]) -> Result<SymbolicState, GameError>;
     /// Whether `z` encodes a board of this game (TileSwap: a one-hot permutation matrix).

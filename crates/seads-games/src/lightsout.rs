@@ -98,6 +98,11 @@ impl BoardGame for LightsOut {
     fn values(&self, board: SymbolicState) -> Vec<u8> {
         (0..self.n * self.n).map(|d| board.get(d) as u8).collect()
     }
+    fn write_values(&self, board: SymbolicState, out: &mut [u8]) {
+        for (d, v) in out.iter_mut().enumerate() {
+            *v = board.get(d) as u8;
+        }
+    }
     fn board_from_values(&self, values: &[u8]) -> Result<SymbolicState, GameError> {
         let expected = self.n * self.n;
         if values.len() != expected {

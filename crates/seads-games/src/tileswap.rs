@@ -97,6 +97,9 @@ impl BoardGame for TileSwap {
     fn values(&self, board: SymbolicState) -> Vec<u8> {
         Self::tiles(board).to_vec()
     }
+    fn write_values(&self, board: SymbolicState, out: &mut [u8]) {
+        out.copy_from_slice(&Self::tiles(board));
+    }
     fn board_from_values(&self, values: &[u8]) -> Result<SymbolicState, GameError> {
         if values.len() != CELLS {
             return Err(GameError::WrongLength {

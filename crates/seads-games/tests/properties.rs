@@ -104,3 +104,18 @@ proptest! {
         prop_assert_eq!(t.parse(&t.format(ts)).unwrap(), ts);
     }
 }
+
+proptest! {
+    /// `write_values` writes what `values` returns, and `board_from_values` reads it back.
+    #[test]
+    fn written_values_are_the_values((n, board) in lightsout_board(), tiles in tileswap_board()) {
+        let game = LightsOut::new(n).unwrap();
+        let mut out = vec![7u8; n * n];
+        game.write_values(board, &mut out);
+        prop_assert_eq!(&out, &game.values(board));
+        prop_assert_eq!(game.board_from_values(&out).unwrap(), board);
+        let mut out = [7u8; 9];
+        TileSwap::new().write_values(tiles, &mut out);
+        prop_assert_eq!(out.to_vec(), TileSwap::new().values(tiles));
+    }
+}

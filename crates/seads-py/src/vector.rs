@@ -221,7 +221,7 @@ impl VecEnv {
                     m.core.reset()?;
                     m.ended = false;
                     m.core.observe(obs);
-                    board.copy_from_slice(&game.values(m.core.env().board()));
+                    game.write_values(m.core.env().board(), board);
                     *depth = m.core.depth().map_or(-1, |d| d as i64);
                     Ok::<_, EnvError>(())
                 })
@@ -344,13 +344,13 @@ impl VecEnv {
                         *end = false;
                         if m.ended && autoreset == Autoreset::SameStep {
                             m.core.observe(fo);
-                            fb.copy_from_slice(&game.values(m.core.env().board()));
+                            game.write_values(m.core.env().board(), fb);
                             m.core.reset()?;
                             m.ended = false;
                             *end = true;
                         }
                         m.core.observe(obs);
-                        board.copy_from_slice(&game.values(m.core.env().board()));
+                        game.write_values(m.core.env().board(), board);
                         *depth = m.core.depth().map_or(-1, |d| d as i64);
                         (*r, *te, *tr, *mv) = (s.reward, s.terminated, s.truncated, s.game_move);
                         Ok::<_, EnvError>(())

@@ -158,7 +158,11 @@ fn task_success_covers_every_depth() {
         }
         let solved = tasks.iter().filter(|t| t.3).count();
         assert_eq!((r.solved, r.solution_steps.len()), (solved, solved));
-        assert!(r.solution_steps.iter().all(|&s| (1..=10 * r.depth).contains(&s)));
+        assert!(
+            r.solution_steps
+                .iter()
+                .all(|&s| (1..=10 * r.depth).contains(&s))
+        );
     }
 }
 

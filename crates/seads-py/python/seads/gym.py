@@ -202,6 +202,9 @@ class SeadsVectorEnv(VectorEnv):
         self._final_obs = np.zeros((n, obs_dim), dtype=np.float32)
         self._final_board = np.zeros((n, board_len), dtype=np.uint8)
         self._ended = np.zeros(n, dtype=np.bool_)
+        # The mask of an info entry every environment has: shared, so read-only.
+        self._every = np.ones(n, dtype=np.bool_)
+        self._every.flags.writeable = False
         self._seeded = False
         self._started = False
         self._closed = False
@@ -237,7 +240,7 @@ class SeadsVectorEnv(VectorEnv):
         self._seeded = True
         self._core.reset(self._obs, self._board, self._depth, seeds, mask)
         self._started = True
-        reset = np.ones(self.num_envs, dtype=np.bool_) if mask is None else mask.copy()
+        reset = self._every if mask is None else mask.copy()
         self._move[reset] = -1
         return self._obs.copy(), self._info(reset)
 
@@ -250,15 +253,15 @@ class SeadsVectorEnv(VectorEnv):
             raise ValueError(
                 f"{self.env_name}: actions have shape {self.action_space.shape}, got {actions.shape}"
             )
-        depth_before = self._depth.copy()
+        same_step = self.autoreset_mode == AutoresetMode.SAME_STEP
+        depth_before = self._depth.copy() if same_step and self.task else None
         self._core.step(
             actions, self._obs, self._reward, self._terminated, self._truncated, self._move,
             self._board, self._depth, self._final_obs, self._final_board, self._ended,
         )
-        every = np.ones(self.num_envs, dtype=np.bool_)
-        info = self._info(every)
-        info["move"], info["_move"] = self._move.copy(), every
-        if self.autoreset_mode == AutoresetMode.SAME_STEP and self._ended.any():
+        info = self._info(self._every)
+        info["move"], info["_move"] = self._move.copy(), self._every
+        if same_step and self._ended.any():
             ended = self._ended.copy()
             final_obs = np.empty(self.num_envs, dtype=object)
             for i in np.flatnonzero(ended):
