@@ -58,7 +58,7 @@ pub struct RenderArgs {
     #[arg(long)]
     board_size: Option<usize>,
     /// Relative spacing between fields (spaced LightsOut boards), in [0, 1].
-    #[arg(long, value_parser = seads_study::numbers::positive_finite)]
+    #[arg(long, value_parser = crate::numbers::positive_finite)]
     spacing: Option<f64>,
 }
 

@@ -76,7 +76,7 @@ pub fn record(args: RecordArgs) -> Result<()> {
     } else {
         Vec::new()
     };
-    seads_study::paths::refuse_unsafe_output(&args.out, &inputs).map_err(crate::study_error)?;
+    crate::paths::refuse_unsafe_output(&args.out, &inputs)?;
     env.seed(args.seed);
     let mut rng = ChaCha8Rng::seed_from_u64(args.seed);
     // Written beside the output and renamed over it when complete: never a half-written file.
@@ -125,8 +125,7 @@ pub struct ReplayArgs {
 
 /// `seads replay`.
 pub fn replay(args: ReplayArgs) -> Result<()> {
-    seads_study::paths::refuse_unsafe_output(&args.out, &[&args.input])
-        .map_err(crate::study_error)?;
+    crate::paths::refuse_unsafe_output(&args.out, &[&args.input])?;
     let mut env = build_env(&args.env, &EnvConfig::default())?;
     let m = env.spec().manipulator_dim;
     let input = std::fs::File::open(&args.input)

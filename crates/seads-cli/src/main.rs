@@ -17,6 +17,8 @@ mod envs;
 mod episodes;
 mod games;
 mod kernels;
+mod numbers;
+mod paths;
 
 mod plan;
 mod plot;

@@ -35,7 +35,7 @@ pub struct ReportArgs {
 /// Runs `seads report`.
 pub fn report(args: ReportArgs) -> Result<()> {
     let inputs: Vec<&std::path::Path> = args.inputs.iter().map(PathBuf::as_path).collect();
-    seads_study::paths::refuse_overwriting_input(&args.out, &inputs).map_err(crate::study_error)?;
+    crate::paths::refuse_overwriting_input(&args.out, &inputs)?;
     let options = ReportOptions {
         inputs: args.inputs.clone(),
         reference: args.reference.clone(),

@@ -92,7 +92,7 @@ pub struct CalibrateArgs {
     #[arg(long, default_value = "uarm-calibration.toml")]
     out: PathBuf,
     /// Distance from the screen for z = 1, mm.
-    #[arg(long, default_value_t = 100.0, value_parser = seads_study::numbers::positive_finite)]
+    #[arg(long, default_value_t = 100.0, value_parser = crate::numbers::positive_finite)]
     d_max_mm: f64,
 }
 
@@ -224,7 +224,7 @@ pub struct RobotTraining {
     episodes_per_epoch: Option<u64>,
     /// SAC's entropy temperature α (default: the paper's 0.1 for the robot).
     #[arg(long, value_name = "ALPHA", conflicts_with = "resume",
-          value_parser = seads_study::numbers::positive_finite)]
+          value_parser = crate::numbers::positive_finite)]
     alpha: Option<f64>,
 }
 

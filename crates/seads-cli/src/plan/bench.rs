@@ -25,7 +25,7 @@ pub struct PlanBenchArgs {
     #[arg(long, default_value = "cpu")]
     device: seads_rl::ComputeDevice,
     /// Time limit per search, seconds: the first depth that hits it is the last one run.
-    #[arg(long, value_parser = seads_study::numbers::positive_finite)]
+    #[arg(long, value_parser = crate::numbers::positive_finite)]
     timeout: Option<f64>,
     /// Compute every logit in float32, without the 8-bit screen (the same plans, more
     /// arithmetic; for comparison).

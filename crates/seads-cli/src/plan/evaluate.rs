@@ -48,7 +48,7 @@ pub struct EvaluateArgs {
     /// Execute skills with Gaussian noise of this standard deviation on every low-level action
     /// (the authors' evaluation under noise used 0.05 for the cursor), drawn from each task's
     /// seed; the files are named `evaluation-replan-noise-STD…`.
-    #[arg(long, value_parser = seads_study::numbers::non_negative_finite, conflicts_with = "checkpoints")]
+    #[arg(long, value_parser = crate::numbers::non_negative_finite, conflicts_with = "checkpoints")]
     action_noise: Option<f64>,
     /// Where the networks run: cpu, cuda (the first GPU) or cuda:N, whichever device the run
     /// trained on. The plans are the same on either.
@@ -64,7 +64,7 @@ pub struct EvaluateArgs {
 
 /// `seads evaluate`.
 pub fn evaluate_run(args: EvaluateArgs) -> Result<()> {
-    let depths = seads_study::numbers::depths(&args.depths)
+    let depths = crate::numbers::depths(&args.depths)
         .map_err(|e| BadInput(anyhow::anyhow!("--depths: {e}")))?;
     // The planner's parts run on rayon's threads, each on one libtorch thread.
     seads_rl::set_threads(1);

@@ -36,7 +36,7 @@ pub struct SearchArgs {
     max_expanded: u64,
     /// Also stop each search after this many seconds (off by default: a clock makes the outcome
     /// depend on the machine's speed and load; the authors used 60).
-    #[arg(long, value_name = "SECONDS", value_parser = seads_study::numbers::positive_finite)]
+    #[arg(long, value_name = "SECONDS", value_parser = crate::numbers::positive_finite)]
     timeout: Option<f64>,
     /// Which of the shortest plans to take: `most-likely` (the plan the forward model gives the
     /// highest probability, each step by the skill likeliest to make it; re-planning avoids a

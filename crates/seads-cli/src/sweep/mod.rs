@@ -83,8 +83,8 @@ pub struct RunArgs {
     cores: Option<u64>,
     /// Only the runs of these seeds, a list (1,2,3) or a range (1-3): finish a few seeds of every
     /// variant before starting more.
-    #[arg(long, value_parser = seads_study::numbers::NumberList::parse)]
-    seeds: Option<seads_study::numbers::NumberList>,
+    #[arg(long, value_parser = crate::numbers::NumberList::parse)]
+    seeds: Option<crate::numbers::NumberList>,
     /// Where each run's networks train and evaluate: cpu, cuda (the first GPU) or cuda:N. The
     /// workers share the device.
     #[arg(long, default_value = "cpu")]
@@ -112,8 +112,8 @@ pub struct TaskArgs {
     dir: PathBuf,
     /// Index of the run in the sweep (0-based; a Slurm array task passes $SLURM_ARRAY_TASK_ID),
     /// or a list of runs (0,5,10) to train as one population.
-    #[arg(long, value_parser = seads_study::numbers::NumberList::parse)]
-    index: seads_study::numbers::NumberList,
+    #[arg(long, value_parser = crate::numbers::NumberList::parse)]
+    index: crate::numbers::NumberList,
     /// Cores of this task; its libtorch threads follow them (Slurm: $SLURM_CPUS_PER_TASK).
     #[arg(long, default_value_t = 2)]
     cores: u64,

@@ -3,7 +3,14 @@
 use std::os::unix::fs::MetadataExt as _;
 use std::path::Path;
 
-use crate::{Result, StudyError};
+use anyhow::{Result, anyhow};
+
+use crate::BadInput;
+
+/// The user's input to fix: exit 2 with `message`.
+fn invalid(message: String) -> anyhow::Error {
+    BadInput(anyhow!(message)).into()
+}
 
 /// Refuses an output path that is one of the command's inputs (the same file or folder, through
 /// any path or link), as the user's input to fix: an output never overwrites what the command
@@ -16,7 +23,7 @@ pub fn refuse_overwriting_input(output: &Path, inputs: &[&Path]) -> Result<()> {
         if let Ok(meta) = std::fs::metadata(input)
             && (meta.dev(), meta.ino()) == (out.dev(), out.ino())
         {
-            return Err(StudyError::invalid(format!(
+            return Err(invalid(format!(
                 "{} is also an input ({}): an output never overwrites its input",
                 output.display(),
                 input.display()
@@ -42,7 +49,7 @@ pub fn refuse_unsafe_output(output: &Path, inputs: &[&Path]) -> Result<()> {
         } else {
             "a special file"
         };
-        return Err(StudyError::invalid(format!(
+        return Err(invalid(format!(
             "{} is {kind}: an output replaces only a regular file",
             output.display()
         )));
@@ -57,7 +64,7 @@ pub fn refuse_unsafe_output(output: &Path, inputs: &[&Path]) -> Result<()> {
                 && input.is_dir()
                 && parent.starts_with(&input)
             {
-                return Err(StudyError::invalid(format!(
+                return Err(invalid(format!(
                     "{} lies inside {}, which this command reads: write it elsewhere",
                     output.display(),
                     input.display()
@@ -81,7 +88,7 @@ mod tests {
         std::os::unix::fs::symlink(&input, &link).unwrap();
         let e = refuse_overwriting_input(&link, &[&input]).unwrap_err();
         assert!(
-            e.is_invalid() && e.to_string().contains("also an input"),
+            e.downcast_ref::<BadInput>().is_some() && e.to_string().contains("also an input"),
             "{e}"
         );
         assert!(refuse_overwriting_input(&tmp.path().join("new.json"), &[&input]).is_ok());
@@ -101,7 +108,10 @@ mod tests {
         std::os::unix::fs::symlink(&target, &link).unwrap();
         let refused = |out: &Path, inputs: &[&Path], why: &str| {
             let e = refuse_unsafe_output(out, inputs).unwrap_err();
-            assert!(e.is_invalid() && e.to_string().contains(why), "{e}");
+            assert!(
+                e.downcast_ref::<BadInput>().is_some() && e.to_string().contains(why),
+                "{e}"
+            );
         };
         refused(&link, &[], "a symbolic link");
         refused(&run, &[], "a folder");
