@@ -2,7 +2,7 @@
 
 use std::sync::OnceLock;
 
-use crate::{BoardGame, GameError, GameKind, Gf2Solver, MoveId, SymbolicState};
+use crate::{BoardGame, Enumerable, GameError, GameKind, Gf2Solver, MoveId, SymbolicState};
 
 /// LightsOut on an N×N board, 3 ≤ N ≤ 13. Bit `row·N + col` of a board is 1 iff that light is on.
 #[derive(Debug, Clone)]
@@ -141,9 +141,37 @@ impl BoardGame for LightsOut {
     }
 }
 
+impl Gf2Solver {
+    /// Eliminates the move matrix of `game`.
+    pub fn new(game: &LightsOut) -> Self {
+        Gf2Solver::from_masks(&game.masks)
+    }
+}
+
+impl Enumerable for LightsOut {
+    fn index_space(&self) -> Option<u64> {
+        let bits = self.num_moves() as u32;
+        (bits <= 32).then(|| 1u64 << bits)
+    }
+    fn index_of(&self, board: SymbolicState) -> u32 {
+        board.low_u64() as u32
+    }
+    fn board_at(&self, index: u32) -> SymbolicState {
+        SymbolicState::from_u64(index as u64)
+    }
+    fn neighbours(&self, index: u32, out: &mut [u32]) {
+        // The hot path of the 5×5 enumeration: one XOR per move.
+        // `enumerate` only runs for N ≤ 5 (index_space), where the low 32 bits are the whole mask.
+        for (o, m) in out.iter_mut().zip(self.masks_low()) {
+            *o = index ^ m;
+        }
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::enumerate;
 
     #[test]
     fn corner_edge_interior_presses_toggle_3_4_5_fields() {
@@ -190,5 +218,67 @@ mod tests {
         let b = g.parse("1, 1,0,1,0,0,0,0,0").unwrap();
         assert_eq!(g.format(b), "1,1,0,1,0,0,0,0,0");
         assert_eq!(b, g.apply(g.goal(), 0));
+    }
+
+    #[test]
+    fn five_by_five_has_rank_23_and_weight_12_quiet_patterns() {
+        let s = Gf2Solver::new(&LightsOut::new(5).unwrap());
+        assert_eq!(s.rank(), 23);
+        assert_eq!(s.nullity(), 2);
+        let g = LightsOut::new(5).unwrap();
+        for &k in s.kernel() {
+            let pressed: Vec<MoveId> = k.ones().collect();
+            assert!(
+                g.is_goal(g.apply_all(g.goal(), &pressed)),
+                "quiet pattern changes nothing"
+            );
+            assert!(k.count_ones() >= 12);
+        }
+    }
+
+    #[test]
+    fn unsolvable_board_is_reported() {
+        let g = LightsOut::new(5).unwrap();
+        let s = Gf2Solver::new(&g);
+        let mut board = g.goal();
+        board.set(0, true); // a single lit corner is not in the image of A for 5×5
+        assert_eq!(
+            s.solve(board),
+            Err(GameError::Unsolvable { game: "lightsout" })
+        );
+    }
+
+    #[test]
+    fn solves_known_board_optimally() {
+        let g = LightsOut::new(5).unwrap();
+        let s = Gf2Solver::new(&g);
+        let board = g.apply_all(g.goal(), &[3, 7, 19]);
+        assert_eq!(s.solve(board).unwrap(), vec![3, 7, 19]);
+        assert_eq!(s.depth(g.goal()).unwrap(), 0);
+    }
+
+    #[test]
+    fn thirteen_by_thirteen_is_invertible() {
+        let g = LightsOut::new(13).unwrap();
+        let s = Gf2Solver::new(&g);
+        let board = g.apply_all(g.goal(), &[0, 84, 168]);
+        let moves = s.solve(board).unwrap();
+        assert!(g.is_goal(g.apply_all(board, &moves)));
+        assert!(moves.len() <= 3);
+    }
+
+    #[test]
+    fn small_lightsout_is_fully_solvable_at_3x3() {
+        let e = enumerate(&LightsOut::new(3).unwrap(), None).unwrap();
+        // The 3×3 move matrix is invertible: all 512 boards are solvable, depth counts C(9, d).
+        assert_eq!(e.depth_counts(), vec![1, 9, 36, 84, 126, 126, 84, 36, 9, 1]);
+    }
+
+    #[test]
+    fn large_lightsout_is_rejected() {
+        assert!(matches!(
+            enumerate(&LightsOut::new(6).unwrap(), None),
+            Err(GameError::TooLargeToEnumerate { size: 6, .. })
+        ));
     }
 }

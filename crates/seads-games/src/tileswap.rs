@@ -2,7 +2,7 @@
 
 use std::sync::OnceLock;
 
-use crate::{BoardGame, DepthTable, GameError, GameKind, MoveId, SymbolicState};
+use crate::{BoardGame, DepthTable, Enumerable, GameError, GameKind, MoveId, SymbolicState};
 
 /// Number of cells (and tiles) of the 3×3 board.
 const CELLS: usize = 9;
@@ -170,9 +170,84 @@ fn depth_table() -> &'static DepthTable {
     TABLE.get_or_init(|| DepthTable::build(&TileSwap).expect("TileSwap 3×3 enumerates"))
 }
 
+/// n! for n = 0..9.
+const FACTORIAL: [u32; 10] = [1, 1, 2, 6, 24, 120, 720, 5040, 40320, 362880];
+
+/// Lehmer rank of a permutation of 0..9 (lexicographic order, identity = 0).
+fn rank(perm: &[u8; 9]) -> u32 {
+    let mut used = 0u16;
+    let mut r = 0;
+    for (i, &p) in perm.iter().enumerate() {
+        let smaller_used = (used & ((1u16 << p) - 1)).count_ones();
+        r += (p as u32 - smaller_used) * FACTORIAL[8 - i];
+        used |= 1 << p;
+    }
+    r
+}
+
+/// Inverse of [`rank`].
+fn unrank(mut r: u32) -> [u8; 9] {
+    let mut free: u16 = 0x1ff;
+    std::array::from_fn(|i| {
+        let f = FACTORIAL[8 - i];
+        let mut k = r / f;
+        r %= f;
+        let mut bits = free;
+        while k > 0 {
+            bits &= bits - 1;
+            k -= 1;
+        }
+        let p = bits.trailing_zeros() as u8;
+        free &= !(1 << p);
+        p
+    })
+}
+
+impl Enumerable for TileSwap {
+    fn index_space(&self) -> Option<u64> {
+        Some(FACTORIAL[9] as u64)
+    }
+    fn index_of(&self, board: SymbolicState) -> u32 {
+        rank(&TileSwap::tiles(board))
+    }
+    fn board_at(&self, index: u32) -> SymbolicState {
+        TileSwap::from_tiles(&unrank(index))
+    }
+    fn neighbours(&self, index: u32, out: &mut [u32]) {
+        // A swap of cells p < q only changes the Lehmer digits of positions p..=q, so each
+        // neighbour's rank is the current rank plus the change of those few digits.
+        let tiles = unrank(index);
+        let mut suffix = [0u16; 9]; // suffix[i]: tiles at positions > i
+        for i in (0..8).rev() {
+            suffix[i] = suffix[i + 1] | 1 << tiles[i + 1];
+        }
+        let digit = |seen: u16, tile: u8| (seen & ((1u16 << tile) - 1)).count_ones() as i64;
+        for (mv, o) in out.iter_mut().enumerate() {
+            let (p, q) = TileSwap::swap_cells(mv);
+            let (a, b) = (tiles[p], tiles[q]);
+            let moved = (1u16 << a) | (1u16 << b);
+            let mut delta = 0i64;
+            for i in p..=q {
+                let new_tile = if i == p {
+                    b
+                } else if i == q {
+                    a
+                } else {
+                    tiles[i]
+                };
+                let new_suffix = if i < q { suffix[i] ^ moved } else { suffix[i] };
+                delta += (digit(new_suffix, new_tile) - digit(suffix[i], tiles[i]))
+                    * FACTORIAL[8 - i] as i64;
+            }
+            *o = (index as i64 + delta) as u32;
+        }
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::enumerate;
 
     #[test]
     fn move_table_matches_spec() {
@@ -238,5 +313,43 @@ mod tests {
             Err(GameError::UnsupportedSize { .. })
         ));
         assert!(!g.is_valid(SymbolicState::from_u64(3)));
+    }
+
+    #[test]
+    fn rank_unrank_round_trip() {
+        for r in [0, 1, 2, 100, 362879] {
+            assert_eq!(rank(&unrank(r)), r);
+        }
+        assert_eq!(unrank(0), [0, 1, 2, 3, 4, 5, 6, 7, 8]);
+        assert_eq!(unrank(362879), [8, 7, 6, 5, 4, 3, 2, 1, 0]);
+    }
+
+    #[test]
+    fn incremental_tileswap_neighbours_match_full_ranking() {
+        let g = TileSwap::new();
+        let mut fast = [0u32; 12];
+        for index in (0..362880).step_by(997) {
+            g.neighbours(index, &mut fast);
+            let board = g.board_at(index);
+            for (mv, &n) in fast.iter().enumerate() {
+                assert_eq!(n, g.index_of(g.apply(board, mv)), "rank {index}, move {mv}");
+            }
+        }
+    }
+
+    #[test]
+    fn depth_limit_stops_early() {
+        let e = enumerate(&TileSwap::new(), Some(2)).unwrap();
+        assert_eq!(e.depth_counts(), vec![1, 12, 88]);
+    }
+
+    #[test]
+    fn tileswap_solution_reaches_goal() {
+        let g = TileSwap::new();
+        let table = DepthTable::build(&g).unwrap();
+        let board = g.parse("8,7,6,5,4,3,2,1,0").unwrap();
+        let moves = table.solve(&g, board).unwrap();
+        assert_eq!(moves.len() as u8, table.depth(&g, board).unwrap());
+        assert!(g.is_goal(g.apply_all(board, &moves)));
     }
 }
