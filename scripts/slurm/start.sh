@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Starts a private single-node Slurm cluster (munged, slurmctld, slurmd; Debian's packages, no
 # systemd) with its configuration, key, sockets, state and logs all under DIR, for the
-# project's Slurm test (crates/seads-cli/tests/slurm.rs). Waits until the node is idle, then
+# project's Slurm test (crates/seads-cli/tests/end_to_end/slurm.rs). Waits until the node is idle, then
 # prints `export SLURM_CONF=DIR/etc/slurm.conf`.
 #
 #   scripts/slurm/start.sh DIR        scripts/slurm/stop.sh DIR

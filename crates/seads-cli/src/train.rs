@@ -176,7 +176,7 @@ pub fn resume<L: Learner>(
     Ok(run)
 }
 
-/// The variable of the crash-point tests (`crates/seads-cli/tests/crash.rs`): `list` names every
+/// The variable of the crash-point tests (`crates/seads-cli/tests/end_to_end/crash.rs`): `list` names every
 /// [`Moment`] of the run on stderr as it passes; a number N stops the process at the N-th moment
 /// (counted from 1 in this process), says so on stderr and waits there to be killed.
 pub const CRASH_POINT_VAR: &str = "SEADS_CRASH_POINT";

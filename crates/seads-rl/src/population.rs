@@ -9,7 +9,7 @@
 //! inputs) and of the forward model (50), by up to 1.2e-5 (`examples/stacked_vs_solo.rs`,
 //! `docs/results/population/stacked-vs-solo.json`). Keeping each member's own kernels makes a
 //! population a pure speed feature on the CPU, whose members' metrics equal their solo runs'
-//! row for row (`crates/seads-cli/tests/population.rs`).
+//! row for row (`crates/seads-cli/tests/end_to_end/population.rs`).
 
 use std::sync::Mutex;
 

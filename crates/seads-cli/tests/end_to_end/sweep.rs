@@ -6,8 +6,7 @@ use std::path::{Path, PathBuf};
 use std::process::Stdio;
 use std::time::{Duration, Instant};
 
-mod common;
-use common::*;
+use crate::common::*;
 
 /// A study of tiny runs: small networks, 600 steps, checkpoints every 5 epochs.
 const MANIFEST: &str = r#"

@@ -4,8 +4,7 @@
 
 use std::path::{Path, PathBuf};
 
-mod common;
-use common::*;
+use crate::common::*;
 
 /// A tiny baseline run of `algorithm` (sac or hac): 30 epochs of 8 steps, evaluations and
 /// checkpoints every 10 epochs.

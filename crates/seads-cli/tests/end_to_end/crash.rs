@@ -13,8 +13,7 @@ use std::sync::OnceLock;
 
 use serde_json::Value;
 
-mod common;
-use common::{kill_at_moment, metrics_without_clock, park_at_moment};
+use crate::common::{kill_at_moment, metrics_without_clock, park_at_moment};
 
 const SEADS: &str = env!("CARGO_BIN_EXE_seads");
 

@@ -7,8 +7,7 @@ use std::process::Command;
 
 use serde_json::Value;
 
-mod common;
-use common::*;
+use crate::common::*;
 
 /// Tiny runs of seeds 1–3 in two variants of different network shapes, no evaluation by planning
 /// (training is what a population changes).

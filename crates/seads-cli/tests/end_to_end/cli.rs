@@ -1,7 +1,6 @@
 //! End-to-end tests of the `seads` binary.
 
-mod common;
-use common::*;
+use crate::common::*;
 
 #[test]
 fn depths_json() {
