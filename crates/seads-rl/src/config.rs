@@ -224,101 +224,10 @@ impl Default for TrainConfig {
     }
 }
 
-/// The shipped presets: the paper's settings per environment (`configs/*.toml`).
-const PRESETS: &[(&str, &str)] = &[
-    (
-        "lightsout-cursor",
-        include_str!("../configs/lightsout-cursor.toml"),
-    ),
-    (
-        "tileswap-cursor",
-        include_str!("../configs/tileswap-cursor.toml"),
-    ),
-    (
-        "lightsout-reacher",
-        include_str!("../configs/lightsout-reacher.toml"),
-    ),
-    (
-        "tileswap-reacher",
-        include_str!("../configs/tileswap-reacher.toml"),
-    ),
-    (
-        "lightsout-jaco",
-        include_str!("../configs/lightsout-jaco.toml"),
-    ),
-    (
-        "tileswap-jaco",
-        include_str!("../configs/tileswap-jaco.toml"),
-    ),
-    (
-        "lightsout3d-jaco",
-        include_str!("../configs/lightsout3d-jaco.toml"),
-    ),
-];
-
-/// The presets of the HAC baseline (`configs/hac-*.toml`).
-const HAC_PRESETS: &[(&str, &str)] = &[
-    (
-        "lightsout-cursor",
-        include_str!("../configs/hac-lightsout-cursor.toml"),
-    ),
-    (
-        "tileswap-cursor",
-        include_str!("../configs/hac-tileswap-cursor.toml"),
-    ),
-    (
-        "lightsout-reacher",
-        include_str!("../configs/hac-lightsout-reacher.toml"),
-    ),
-    (
-        "tileswap-reacher",
-        include_str!("../configs/hac-tileswap-reacher.toml"),
-    ),
-    (
-        "lightsout-jaco",
-        include_str!("../configs/hac-lightsout-jaco.toml"),
-    ),
-    (
-        "tileswap-jaco",
-        include_str!("../configs/hac-tileswap-jaco.toml"),
-    ),
-    (
-        "lightsout3d-jaco",
-        include_str!("../configs/hac-lightsout3d-jaco.toml"),
-    ),
-];
-
-/// The presets of the flat SAC baseline (`configs/sac-*.toml`).
-const SAC_PRESETS: &[(&str, &str)] = &[
-    (
-        "lightsout-cursor",
-        include_str!("../configs/sac-lightsout-cursor.toml"),
-    ),
-    (
-        "tileswap-cursor",
-        include_str!("../configs/sac-tileswap-cursor.toml"),
-    ),
-    (
-        "lightsout-reacher",
-        include_str!("../configs/sac-lightsout-reacher.toml"),
-    ),
-    (
-        "tileswap-reacher",
-        include_str!("../configs/sac-tileswap-reacher.toml"),
-    ),
-    (
-        "lightsout-jaco",
-        include_str!("../configs/sac-lightsout-jaco.toml"),
-    ),
-    (
-        "tileswap-jaco",
-        include_str!("../configs/sac-tileswap-jaco.toml"),
-    ),
-    (
-        "lightsout3d-jaco",
-        include_str!("../configs/sac-lightsout3d-jaco.toml"),
-    ),
-];
+// The shipped presets, the paper's settings per environment: `PRESETS` (SEADS,
+// `configs/<env>.toml`), `SAC_PRESETS` (`configs/sac-<env>.toml`) and `HAC_PRESETS`
+// (`configs/hac-<env>.toml`), each `(environment, TOML text)`, found by file name (build.rs).
+include!(concat!(env!("OUT_DIR"), "/presets.rs"));
 
 impl TrainConfig {
     /// Sets the libtorch threads for a run with `cores` cores to itself: two training threads
