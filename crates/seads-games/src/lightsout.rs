@@ -75,6 +75,21 @@ impl LightsOut {
     }
 }
 
+/// For each byte, its eight bits as eight bytes 0 or 1 (bit i in byte i, little-endian).
+const SPREAD: [u64; 256] = {
+    let mut table = [0u64; 256];
+    let mut byte = 0;
+    while byte < 256 {
+        let mut bit = 0;
+        while bit < 8 {
+            table[byte] |= ((byte as u64 >> bit) & 1) << (8 * bit);
+            bit += 1;
+        }
+        byte += 1;
+    }
+    table
+};
+
 impl BoardGame for LightsOut {
     fn kind(&self) -> GameKind {
         GameKind::LightsOut
@@ -98,9 +113,12 @@ impl BoardGame for LightsOut {
     fn values(&self, board: SymbolicState) -> Vec<u8> {
         (0..self.n * self.n).map(|d| board.get(d) as u8).collect()
     }
+    /// Eight fields at a time: each byte of the board's bits spread over eight values.
     fn write_values(&self, board: SymbolicState, out: &mut [u8]) {
-        for (d, v) in out.iter_mut().enumerate() {
-            *v = board.get(d) as u8;
+        let words = board.words();
+        for (k, values) in out.chunks_mut(8).enumerate() {
+            let byte = (words[k / 8] >> (8 * (k % 8))) & 0xff;
+            values.copy_from_slice(&SPREAD[byte as usize].to_le_bytes()[..values.len()]);
         }
     }
     fn board_from_values(&self, values: &[u8]) -> Result<SymbolicState, GameError> {

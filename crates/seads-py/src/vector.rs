@@ -131,10 +131,11 @@ impl VecEnv {
             game,
             members,
             autoreset,
-            // About four pieces of work per thread: every thread steps even a small vector of
-            // slow environments (a Jaco arm's step is ~100 µs), and a large vector of cursors
-            // is not cut into pieces smaller than their scheduling.
-            chunk: (num_envs / (4 * threads)).max(1),
+            // At least four pieces of work per thread, so that every thread steps even a small
+            // vector of slow environments (a Jaco arm's step is ~100 µs) and a busy core holds
+            // back little; at most 64 environments a piece, so that a large vector is shared
+            // out finely too.
+            chunk: (num_envs / (4 * threads)).clamp(1, 64),
         })
     }
 
@@ -311,48 +312,60 @@ impl VecEnv {
         let (action_dim, chunk, autoreset, game) =
             (self.action_dim, self.chunk, self.autoreset, &*self.game);
         let members = &mut self.members;
+        // Pieces of `chunk` environments, each stepped in a plain loop: the arrays are cut
+        // once per piece, not once per environment.
         py.detach(|| {
             out.obs
-                .par_chunks_mut(obs_dim)
-                .zip(actions.par_chunks(action_dim))
-                .zip(members.par_iter_mut())
-                .zip(out.reward.par_iter_mut())
-                .zip(out.terminated.par_iter_mut())
-                .zip(out.truncated.par_iter_mut())
-                .zip(out.game_move.par_iter_mut())
-                .zip(out.board.par_chunks_mut(board_len))
-                .zip(out.depth.par_iter_mut())
-                .zip(out.final_obs.par_chunks_mut(obs_dim))
-                .zip(out.final_board.par_chunks_mut(board_len))
-                .zip(out.ended.par_iter_mut())
-                .with_min_len(chunk)
+                .par_chunks_mut(obs_dim * chunk)
+                .zip(actions.par_chunks(action_dim * chunk))
+                .zip(members.par_chunks_mut(chunk))
+                .zip(out.reward.par_chunks_mut(chunk))
+                .zip(out.terminated.par_chunks_mut(chunk))
+                .zip(out.truncated.par_chunks_mut(chunk))
+                .zip(out.game_move.par_chunks_mut(chunk))
+                .zip(out.board.par_chunks_mut(board_len * chunk))
+                .zip(out.depth.par_chunks_mut(chunk))
+                .zip(out.final_obs.par_chunks_mut(obs_dim * chunk))
+                .zip(out.final_board.par_chunks_mut(board_len * chunk))
+                .zip(out.ended.par_chunks_mut(chunk))
                 .try_for_each(
                     |(
-                        ((((((((((obs, action), m), r), te), tr), mv), board), depth), fo), fb),
+                        (
+                            (
+                                ((((((((obs, actions), members), r), te), tr), mv), board), depth),
+                                fo,
+                            ),
+                            fb,
+                        ),
                         end,
                     )| {
-                        let s = if m.ended {
-                            m.core.reset()?;
-                            Stepped {
-                                game_move: -1,
-                                ..Stepped::default()
+                        for (j, m) in members.iter_mut().enumerate() {
+                            let (o, b) = (j * obs_dim, j * board_len);
+                            let s = if m.ended {
+                                m.core.reset()?;
+                                Stepped {
+                                    game_move: -1,
+                                    ..Stepped::default()
+                                }
+                            } else {
+                                m.core
+                                    .step(&actions[j * action_dim..(j + 1) * action_dim])?
+                            };
+                            m.ended = s.terminated || s.truncated;
+                            end[j] = false;
+                            if m.ended && autoreset == Autoreset::SameStep {
+                                m.core.observe(&mut fo[o..o + obs_dim]);
+                                game.write_values(m.core.env().board(), &mut fb[b..b + board_len]);
+                                m.core.reset()?;
+                                m.ended = false;
+                                end[j] = true;
                             }
-                        } else {
-                            m.core.step(action)?
-                        };
-                        m.ended = s.terminated || s.truncated;
-                        *end = false;
-                        if m.ended && autoreset == Autoreset::SameStep {
-                            m.core.observe(fo);
-                            game.write_values(m.core.env().board(), fb);
-                            m.core.reset()?;
-                            m.ended = false;
-                            *end = true;
+                            m.core.observe(&mut obs[o..o + obs_dim]);
+                            game.write_values(m.core.env().board(), &mut board[b..b + board_len]);
+                            depth[j] = m.core.depth().map_or(-1, |d| d as i64);
+                            (r[j], te[j], tr[j], mv[j]) =
+                                (s.reward, s.terminated, s.truncated, s.game_move);
                         }
-                        m.core.observe(obs);
-                        game.write_values(m.core.env().board(), board);
-                        *depth = m.core.depth().map_or(-1, |d| d as i64);
-                        (*r, *te, *tr, *mv) = (s.reward, s.terminated, s.truncated, s.game_move);
                         Ok::<_, EnvError>(())
                     },
                 )
