@@ -52,46 +52,30 @@ pub fn run() -> Result<()> {
 /// suite, whose closing line is added to the totals.
 fn python_tests(totals: &mut Totals) -> Result<()> {
     let python = py_venv()?;
-    step_with_env(
+    pip_install(
         &python,
-        &[
-            "-m",
-            "pip",
-            "install",
-            "--quiet",
-            "--disable-pip-version-check",
-            "./crates/seads-py[test]",
-        ],
+        &["./crates/seads-py[test]"],
         &[("MATURIN_PEP517_ARGS", "--profile dev")],
     )?;
     // The newest Gymnasium first, then the lowest the package supports (its pin).
-    step(
-        &python,
-        &[
-            "-m",
-            "pip",
-            "install",
-            "--quiet",
-            "--disable-pip-version-check",
-            "--upgrade",
-            "gymnasium",
-        ],
-    )?;
+    pip_install(&python, &["--upgrade", "gymnasium"], &[])?;
     pytest(&python, totals)?;
     let lowest = lowest_gymnasium()?;
-    step(
-        &python,
-        &[
-            "-m",
-            "pip",
-            "install",
-            "--quiet",
-            "--disable-pip-version-check",
-            &format!("gymnasium=={lowest}"),
-        ],
-    )?;
+    pip_install(&python, &[&format!("gymnasium=={lowest}")], &[])?;
     eprintln!("xtask: again with gymnasium {lowest}, the lowest the package supports");
     pytest(&python, totals)
+}
+
+/// `python -m pip install --quiet <args>` with extra environment variables.
+fn pip_install(python: &str, args: &[&str], env: &[(&str, &str)]) -> Result<()> {
+    let quiet = [
+        "-m",
+        "pip",
+        "install",
+        "--quiet",
+        "--disable-pip-version-check",
+    ];
+    step_with_env(python, &[&quiet[..], args].concat(), env)
 }
 
 /// The Python of the virtual environment `target/py-venv`, made on first use.
@@ -109,17 +93,7 @@ pub fn py_venv() -> Result<String> {
 /// `target/wheels`. Returns its path.
 pub fn wheel() -> Result<std::path::PathBuf> {
     let python = py_venv()?;
-    step(
-        &python,
-        &[
-            "-m",
-            "pip",
-            "install",
-            "--quiet",
-            "--disable-pip-version-check",
-            "maturin>=1.9,<2",
-        ],
-    )?;
+    pip_install(&python, &["maturin>=1.9,<2"], &[])?;
     let out = root().join("target").join("wheels");
     // A wheel of an earlier build would be taken for this one.
     if out.exists() {
