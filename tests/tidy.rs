@@ -701,3 +701,106 @@ fn libraries_neither_parse_arguments_nor_print() {
     }
     assert!(libraries >= 7, "{libraries} library crates found");
 }
+
+/// Games are an open set: a game is one type in seads-games, listed once in its registry, and
+/// no source outside that crate names a concrete game's type or builds one by name. The one
+/// exception is the real robot (seads-uarm), whose tablet shows the paper's LightsOut 5×5, and
+/// the Jaco arm's physical boards, which name the games they model. Everything else reaches a
+/// game through `GameKind` and the `BoardGame` trait.
+#[test]
+fn no_game_is_named_outside_the_games_crate() {
+    let types = ["LightsOut", "TileSwap", "SlidingPuzzle", "Gf2Solver"];
+    let mut offenders = Vec::new();
+    let mut checked = 0;
+    for entry in std::fs::read_dir(root().join("crates")).unwrap() {
+        let dir = entry.unwrap().path();
+        let name = dir.file_name().unwrap().to_string_lossy().into_owned();
+        if name == "seads-games" || name == "seads-uarm" {
+            continue;
+        }
+        for file in rust_files(&dir.join("src")) {
+            let text = std::fs::read_to_string(&file).unwrap();
+            checked += 1;
+            // Code only, tests apart: the words may appear in comments, docs, text and tests.
+            let code = code_only(text.split("#[cfg(test)]").next().unwrap_or(""));
+            let jaco_boards = name == "seads-embodiment"
+                && (file.ends_with("registry.rs")
+                    || file.ends_with("jaco.rs")
+                    || file.starts_with(dir.join("src/jaco")));
+            for word in words(&code) {
+                if types.contains(&word) && !jaco_boards {
+                    offenders.push(format!("{} names {word}", file.display()));
+                }
+            }
+            if text
+                .split("#[cfg(test)]")
+                .next()
+                .unwrap_or("")
+                .lines()
+                .any(|l| {
+                    l.split("//")
+                        .next()
+                        .unwrap_or("")
+                        .contains("GameKind::named(\"")
+                })
+                && !jaco_boards
+            {
+                offenders.push(format!("{} builds a game by name", file.display()));
+            }
+        }
+    }
+    assert!(checked > 50, "{checked} source files checked");
+    assert!(offenders.is_empty(), "{offenders:#?}");
+}
+
+/// `source` without its comments and the contents of its string literals (a rough Rust lexer:
+/// enough for names in code).
+fn code_only(source: &str) -> String {
+    let mut out = String::with_capacity(source.len());
+    let mut chars = source.chars().peekable();
+    let mut in_string = false;
+    while let Some(c) = chars.next() {
+        if in_string {
+            match c {
+                '\\' => {
+                    chars.next();
+                }
+                '"' => {
+                    in_string = false;
+                    out.push('"');
+                }
+                '\n' => out.push('\n'),
+                _ => {}
+            }
+        } else if c == '/' && chars.peek() == Some(&'/') {
+            for rest in chars.by_ref() {
+                if rest == '\n' {
+                    out.push('\n');
+                    break;
+                }
+            }
+        } else if c == '"' {
+            in_string = true;
+            out.push('"');
+        } else if c == '\'' {
+            // A char literal ('"', '\\') or a lifetime: keep it out of the string state.
+            out.push(c);
+            let mut lookahead = chars.clone();
+            match (lookahead.next(), lookahead.next(), lookahead.next()) {
+                (Some('\\'), Some(_), Some('\'')) => {
+                    chars.next();
+                    chars.next();
+                    chars.next();
+                }
+                (Some(_), Some('\''), _) => {
+                    chars.next();
+                    chars.next();
+                }
+                _ => {}
+            }
+        } else {
+            out.push(c);
+        }
+    }
+    out
+}

@@ -25,7 +25,8 @@ pub enum GamesCommand {
         #[command(flatten)]
         game: GameArgs,
         /// The board, row-major, values separated by commas: LightsOut 0/1 per field
-        /// ("1,0,0,…", N² values), TileSwap the tile id of each cell ("3,1,2,0,4,5,6,7,8").
+        /// ("1,0,0,…", N² values), TileSwap the tile id of each cell ("3,1,2,0,4,5,6,7,8"), the
+        /// sliding puzzle likewise with 0 for the gap ("1,2,3,4,5,6,7,0,8").
         #[arg(long)]
         board: String,
     },
@@ -34,10 +35,10 @@ pub enum GamesCommand {
 /// Which game and size, and the output format.
 #[derive(Debug, Args)]
 pub struct GameArgs {
-    /// The game: lightsout or tileswap.
+    /// The game: lightsout, tileswap or sliding (the 8-puzzle, or the 15-puzzle at size 4).
     #[arg(long)]
     game: GameKind,
-    /// Board side length (default: 5 for LightsOut, 3 for TileSwap).
+    /// Board side length (default: 5 for LightsOut, 3 for TileSwap and the sliding puzzle).
     #[arg(long)]
     size: Option<usize>,
     /// Print JSON instead of a table.

@@ -5,20 +5,19 @@ use std::sync::{Arc, Mutex, OnceLock};
 
 use rand::{RngExt, SeedableRng};
 use rand_chacha::ChaCha8Rng;
-use seads_games::{
-    BoardDataset, BoardGame, GameKind, LightsOut, MoveId, Split, SymbolicState, TileSwap,
-    action_sampling_boards, sample_by_action_sampling,
-};
+use seads_games::{BoardDataset, BoardGame, GameKind, MoveId, Split, SymbolicState};
 
 use crate::{EnvConfig, EnvError};
 
 /// Where reset boards come from.
 #[derive(Clone)]
 enum BoardSource {
-    /// Uniform among the enumerated boards of a depth and split (LightsOut ≤ 5×5, TileSwap).
+    /// Uniform among the enumerated boards of a depth and split (LightsOut ≤ 5×5, TileSwap, the
+    /// 8-puzzle).
     Dataset(Arc<BoardDataset>),
-    /// Distinct random moves from the goal, redrawn until the split matches (larger boards).
-    ActionSampling,
+    /// Drawn by the game at a depth and split (games too large to enumerate; LightsOut: distinct
+    /// random moves from the goal).
+    Sampled,
 }
 
 /// The board side of an environment: the game, its current board, the reset distribution and
@@ -30,7 +29,7 @@ enum BoardSource {
 /// use seads_games::GameKind;
 ///
 /// let config = EnvConfig { max_solution_depth: 3, random_solution_depth: false, ..EnvConfig::default() };
-/// let mut board = BoardState::new(GameKind::LightsOut, 5, &config)?;
+/// let mut board = BoardState::new(GameKind::named("lightsout")?, 5, &config)?;
 /// board.seed(7);
 /// board.reset();
 /// // An environment seeded alike starts from the same board.
@@ -44,6 +43,8 @@ enum BoardSource {
 pub struct BoardState {
     game: Arc<dyn BoardGame>,
     source: BoardSource,
+    /// Depths up to the largest whose split holds no board, skipped when the depth is random.
+    lacking: Vec<usize>,
     split: Split,
     max_depth: usize,
     random_depth: bool,
@@ -56,42 +57,45 @@ impl BoardState {
     pub fn new(kind: GameKind, size: usize, config: &EnvConfig) -> Result<Self, EnvError> {
         let game: Arc<dyn BoardGame> = Arc::from(kind.build(size)?);
         let max_depth = config.max_solution_depth;
-        let source = if kind == GameKind::TileSwap || size <= 5 {
-            let data = dataset(kind, size, max_depth);
-            let split = config.reset_split;
-            let depths = if config.random_solution_depth {
-                1..=max_depth
-            } else {
-                max_depth..=max_depth
-            };
-            if let Some(d) = depths.clone().find(|&d| data.boards(d, split).is_empty()) {
-                return Err(EnvError::InvalidConfig(format!(
-                    "{kind} {size}×{size} has no {split} boards of solution depth {d} (max_solution_depth = {max_depth})"
-                )));
-            }
-            BoardSource::Dataset(data)
+        let split = config.reset_split;
+        let depths = if config.random_solution_depth {
+            1..=max_depth
+        } else {
+            max_depth..=max_depth
+        };
+        let lacks = |d| {
+            EnvError::InvalidConfig(format!(
+                "{kind} {size}×{size} has no {split} boards of solution depth {d} (max_solution_depth = {max_depth})"
+            ))
+        };
+        let (source, lacking) = if game.enumerable().is_some() {
+            let data = dataset(kind, size, max_depth)?;
+            let lacking: Vec<usize> = depths
+                .clone()
+                .filter(|&d| data.boards(d, split).is_empty())
+                .collect();
+            (BoardSource::Dataset(data), lacking)
         } else {
             // A depth that few move sets reach may have no board in the split (7×7 has one board
             // of depth 49): said now, not found by drawing for ever.
-            let split = config.reset_split;
-            let depths = if config.random_solution_depth {
-                1..=max_depth
-            } else {
-                max_depth..=max_depth
-            };
-            for d in depths {
-                if lacks_boards(game.as_ref(), size, d, split) {
-                    return Err(EnvError::InvalidConfig(format!(
-                        "{kind} {size}×{size} has no {split} boards of solution depth {d} (max_solution_depth = {max_depth})"
-                    )));
-                }
-            }
-            BoardSource::ActionSampling
+            let lacking = depths
+                .clone()
+                .filter(|&d| lacks_boards(game.as_ref(), d, split))
+                .collect();
+            (BoardSource::Sampled, lacking)
         };
+        // A random depth skips the depths the split lacks (the 8-puzzle's two boards of depth 1
+        // are both test boards); a fixed depth, or every depth, lacking is an error.
+        if (lacking.len() == depths.clone().count() || !config.random_solution_depth)
+            && let Some(&d) = lacking.first()
+        {
+            return Err(lacks(d));
+        }
         let goal = game.goal();
         Ok(Self {
             game,
             source,
+            lacking,
             split: config.reset_split,
             max_depth,
             random_depth: config.random_solution_depth,
@@ -124,7 +128,12 @@ impl BoardState {
     /// Draws a new board from the reset distribution.
     pub fn reset(&mut self) {
         let depth = if self.random_depth {
-            self.rng.random_range(1..=self.max_depth)
+            loop {
+                let depth = self.rng.random_range(1..=self.max_depth);
+                if !self.lacking.contains(&depth) {
+                    break depth;
+                }
+            }
         } else {
             self.max_depth
         };
@@ -132,10 +141,10 @@ impl BoardState {
             BoardSource::Dataset(data) => data
                 .sample(depth, self.split, &mut self.rng)
                 .expect("checked in new()"),
-            BoardSource::ActionSampling => {
-                sample_by_action_sampling(self.game.as_ref(), depth, self.split, &mut self.rng)
-                    .expect("checked in new()")
-            }
+            BoardSource::Sampled => self
+                .game
+                .sample_at_depth(depth, self.split, &mut self.rng)
+                .expect("checked in new()"),
         };
     }
 
@@ -170,35 +179,37 @@ pub(crate) fn shared<K: Ord, V>(cache: &Shared<K, V>, key: K, make: impl FnOnce(
     cache.entry(key).or_insert_with(|| Arc::new(make())).clone()
 }
 
-/// Whether `split` holds no board that `depth` distinct moves make, for a game too large to
-/// enumerate (listed only where few move sets reach the depth), remembered per process: every
-/// environment of a vector asks it.
-fn lacks_boards(game: &dyn BoardGame, size: usize, depth: usize, split: Split) -> bool {
+/// Whether `split` holds no board of `depth` for a game too large to enumerate
+/// ([`BoardGame::lacks_boards`]), remembered per process: every environment of a vector asks it.
+fn lacks_boards(game: &dyn BoardGame, depth: usize, split: Split) -> bool {
     static CACHE: Shared<(GameKind, usize, usize, bool), bool> = OnceLock::new();
-    let key = (game.kind(), size, depth, split == Split::Train);
-    *shared(&CACHE, key, || {
-        action_sampling_boards(game, depth, split).is_some_and(|b| b.is_empty())
-    })
+    let key = (game.kind(), game.size(), depth, split == Split::Train);
+    *shared(&CACHE, key, || game.lacks_boards(depth, split))
 }
 
 /// Enumerated boards are shared by every environment of the same game, size and depth.
-fn dataset(kind: GameKind, size: usize, max_depth: usize) -> Arc<BoardDataset> {
+fn dataset(kind: GameKind, size: usize, max_depth: usize) -> Result<Arc<BoardDataset>, EnvError> {
     static CACHE: Shared<(GameKind, usize, usize), BoardDataset> = OnceLock::new();
-    shared(&CACHE, (kind, size, max_depth), || {
-        let data = match kind {
-            GameKind::LightsOut => {
-                BoardDataset::build(&LightsOut::new(size).expect("size checked"), max_depth)
-            }
-            GameKind::TileSwap => BoardDataset::build(&TileSwap::new(), max_depth),
-        };
-        data.expect("LightsOut ≤ 5×5 and TileSwap are enumerable")
-    })
+    let game = kind.build(size)?;
+    if game.enumerable().is_none() {
+        return Err(EnvError::InvalidConfig(format!(
+            "{kind} {size}×{size} cannot be enumerated"
+        )));
+    }
+    Ok(shared(&CACHE, (kind, size, max_depth), || {
+        BoardDataset::build(game.enumerable().expect("checked"), max_depth)
+            .expect("an enumerable game enumerates")
+    }))
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
     use seads_games::{LightsOut, split_of};
+
+    fn lightsout() -> GameKind {
+        GameKind::named("lightsout").unwrap()
+    }
 
     /// 7×7 LightsOut has one board of depth 49: an environment that would reset to depth 49 in
     /// the split that lacks it is refused when it is made (it used to draw for ever), and one in
@@ -218,12 +229,12 @@ mod tests {
             random_solution_depth: false,
             ..EnvConfig::default()
         };
-        let refused = BoardState::new(GameKind::LightsOut, 7, &config(lacks))
+        let refused = BoardState::new(lightsout(), 7, &config(lacks))
             .err()
             .unwrap();
         assert!(refused.to_string().contains("no"), "{refused}");
         assert!(refused.to_string().contains("depth 49"), "{refused}");
-        let mut board = BoardState::new(GameKind::LightsOut, 7, &config(has)).unwrap();
+        let mut board = BoardState::new(lightsout(), 7, &config(has)).unwrap();
         board.seed(3);
         board.reset();
         assert_eq!(board.board(), all);

@@ -3,7 +3,7 @@
 
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
-use seads_games::SymbolicState;
+use seads_games::{FieldMark, SymbolicState};
 
 use crate::board::BoardState;
 use crate::{EnvError, EnvSpec, FieldView, Layout, Push, Scene, Shape, StepOutcome};
@@ -225,9 +225,15 @@ impl<M: Manipulator> Environment for Embodied<M> {
             if matches!(push, Push::Move(_)) {
                 return Push::None; // at most one move per step
             }
-            let result = match touch {
-                Touch::At { u, v } => layout.locate(u, v).map_or(Push::Miss, Push::Move),
-                Touch::Field(index) => layout.field_move(index).map_or(Push::Miss, Push::Move),
+            let located = match touch {
+                Touch::At { u, v } => layout.locate(u, v),
+                Touch::Field(index) => layout.field_move(index),
+            };
+            // A push whose move leaves the board as it is (a sliding tile away from the gap)
+            // moves nothing: z did not change.
+            let result = match located {
+                Some(mv) if board.game().changes(board.board(), mv) => Push::Move(mv),
+                _ => Push::Miss,
             };
             match result {
                 Push::Move(mv) => {
@@ -313,19 +319,16 @@ impl<M: Manipulator> Environment for Embodied<M> {
                 let height = (0..heights.len())
                     .find(|&i| self.layout.field_move(i) == Some(mv))
                     .map_or(0.0, |i| heights[i]);
-                match self.spec.game {
-                    seads_games::GameKind::LightsOut => FieldView {
-                        rect,
-                        lit: Some(v == 1),
-                        label: None,
-                        height,
-                    },
-                    seads_games::GameKind::TileSwap => FieldView {
-                        rect,
-                        lit: None,
-                        label: Some(v.to_string()),
-                        height,
-                    },
+                let (lit, label) = match game.field_mark(v) {
+                    FieldMark::Light(on) => (Some(on), None),
+                    FieldMark::Label(text) => (None, Some(text)),
+                    FieldMark::Blank => (None, None),
+                };
+                FieldView {
+                    rect,
+                    lit,
+                    label,
+                    height,
                 }
             })
             .collect();

@@ -3,7 +3,7 @@
 //! Coordinates are normalised to the board: u ∈ [0, 1] selects the column (left to right), v ∈
 //! [0, 1] the row (row 0 at v = 0), as for the Cursor whose origin is the top-left corner.
 
-use seads_games::{GameKind, MoveId};
+use seads_games::{BoardGame, MoveId, MoveSite};
 
 /// The 12 TileSwap pivots `(u, v, move id)`, in the reference's order and computed with its
 /// floating-point formulas: pushes exactly on a diamond's edge (field centres lie on four edges)
@@ -69,12 +69,26 @@ pub enum Layout {
 }
 
 impl Layout {
-    /// The standard layout of a game (fields tile the square; TileSwap pivots).
-    pub fn standard(game: GameKind, n: usize) -> Self {
-        match game {
-            GameKind::LightsOut => Layout::Grid { n },
-            GameKind::TileSwap => Layout::Pivots,
+    /// The standard layout of a game: fields tiling the square where its moves are made at
+    /// fields, the pivots where they are made between the fields of a 3×3 board (TileSwap);
+    /// `None` for a game whose moves neither layout places.
+    pub fn standard(game: &dyn BoardGame) -> Option<Self> {
+        let n = game.size();
+        let at = |mv| game.move_site(mv);
+        if (0..game.num_moves()).all(|mv| at(mv) == MoveSite::Field(mv)) {
+            return Some(Layout::Grid { n });
         }
+        let pivots = pivots();
+        let edges_match = game.num_moves() == pivots.len()
+            && pivots.iter().all(|&(u, v, mv)| {
+                // The pivot lies on the edge between the two fields the game names.
+                matches!(at(mv), MoveSite::Edge(p, q) if {
+                    let centre = |f: usize| ((f % 3) as f64 + 0.5, (f / 3) as f64 + 0.5);
+                    let ((pu, pv), (qu, qv)) = (centre(p), centre(q));
+                    ((pu + qu) / 6.0 - u).abs() < 1e-9 && ((pv + qv) / 6.0 - v).abs() < 1e-9
+                })
+            });
+        (n == 3 && edges_match).then_some(Layout::Pivots)
     }
 
     /// The move triggered by a push at (u, v), or `None` if the push hits no move.

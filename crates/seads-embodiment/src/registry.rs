@@ -1,6 +1,12 @@
 //! Environments by name (SPEC §2.5): `make_env("lightsout-cursor", &config)`.
+//!
+//! An environment is a (game × manipulator) pair. The Cursor and the Reacher play every game of
+//! the games' registry (`<game>-cursor`, `<game>-reacher`), so a new game needs no entry here;
+//! the Jaco arm plays the games it has a physical board for.
 
-use seads_games::GameKind;
+use std::sync::OnceLock;
+
+use seads_games::{BoardGame, GameKind, MoveSite};
 use serde::Serialize;
 
 use crate::board::BoardState;
@@ -10,13 +16,15 @@ use crate::{Jaco, JacoBoard};
 
 /// One registered environment.
 struct Entry {
-    name: &'static str,
-    description: &'static str,
+    name: String,
+    /// CamelCase name (`LightsOutCursor`), for Gymnasium ids.
+    title: String,
+    description: String,
     game: GameKind,
     embodiment: Embodiment,
 }
 
-#[derive(Clone, Copy)]
+#[derive(Clone, Copy, PartialEq)]
 enum Embodiment {
     Cursor,
     Reacher,
@@ -24,57 +32,84 @@ enum Embodiment {
     Jaco(JacoBoard),
 }
 
-const REGISTRY: &[Entry] = &[
-    Entry {
-        name: "lightsout-cursor",
-        description: "LightsOut 5×5 (or spaced 7×7…13×13) pushed by a 2-D cursor",
-        game: GameKind::LightsOut,
-        embodiment: Embodiment::Cursor,
-    },
-    Entry {
-        name: "tileswap-cursor",
-        description: "TileSwap 3×3 pushed by a 2-D cursor",
-        game: GameKind::TileSwap,
-        embodiment: Embodiment::Cursor,
-    },
-    Entry {
-        name: "lightsout-reacher",
-        description: "LightsOut 5×5 under a planar 2-link Reacher arm (exact MuJoCo dynamics)",
-        game: GameKind::LightsOut,
-        embodiment: Embodiment::Reacher,
-    },
-    Entry {
-        name: "tileswap-reacher",
-        description: "TileSwap 3×3 under a planar 2-link Reacher arm (exact MuJoCo dynamics)",
-        game: GameKind::TileSwap,
-        embodiment: Embodiment::Reacher,
-    },
-    #[cfg(feature = "jaco")]
-    Entry {
-        name: "lightsout-jaco",
-        description: "LightsOut 5×5 pressed by a Kinova Jaco arm with 3-finger hand (rapier3d)",
-        game: GameKind::LightsOut,
-        embodiment: Embodiment::Jaco(JacoBoard::LightsOut { stairs: false }),
-    },
-    #[cfg(feature = "jaco")]
-    Entry {
-        name: "tileswap-jaco",
-        description: "TileSwap 3×3 pressed by a Kinova Jaco arm with 3-finger hand (rapier3d)",
-        game: GameKind::TileSwap,
-        embodiment: Embodiment::Jaco(JacoBoard::TileSwap),
-    },
-    #[cfg(feature = "jaco")]
-    Entry {
-        name: "lightsout3d-jaco",
-        description: "LightsOut 5×5 with fields raised by distance from the centre, pressed by a Jaco arm",
-        game: GameKind::LightsOut,
-        embodiment: Embodiment::Jaco(JacoBoard::LightsOut { stairs: true }),
-    },
+/// The manipulators that play every game: name, title and how they push.
+const EVERY_GAME: [(Embodiment, &str, &str, &str); 2] = [
+    (
+        Embodiment::Cursor,
+        "cursor",
+        "Cursor",
+        "pushed by a 2-D cursor",
+    ),
+    (
+        Embodiment::Reacher,
+        "reacher",
+        "Reacher",
+        "under a planar 2-link Reacher arm (exact MuJoCo dynamics)",
+    ),
 ];
+
+/// Every environment: the Cursor and the Reacher on each game, then the Jaco boards.
+fn registry() -> &'static [Entry] {
+    static REGISTRY: OnceLock<Vec<Entry>> = OnceLock::new();
+    REGISTRY.get_or_init(|| {
+        let mut entries = Vec::new();
+        for (embodiment, arm, arm_title, how) in EVERY_GAME {
+            for game in GameKind::all() {
+                let n = game.default_size();
+                entries.push(Entry {
+                    name: format!("{}-{arm}", game.name()),
+                    title: format!("{}{arm_title}", game.title()),
+                    description: format!("{} {n}×{n} {how}", game.title()),
+                    game,
+                    embodiment,
+                });
+            }
+        }
+        #[cfg(feature = "jaco")]
+        entries.extend(jaco_entries());
+        entries
+    })
+}
+
+/// The Jaco arm's boards: LightsOut flat and raised as stairs, and TileSwap.
+#[cfg(feature = "jaco")]
+fn jaco_entries() -> Vec<Entry> {
+    let game = |name| GameKind::named(name).expect("a registered game");
+    let entry = |name: &str, title: &str, description: &str, game, board| Entry {
+        name: name.to_owned(),
+        title: title.to_owned(),
+        description: description.to_owned(),
+        game,
+        embodiment: Embodiment::Jaco(board),
+    };
+    vec![
+        entry(
+            "lightsout-jaco",
+            "LightsOutJaco",
+            "LightsOut 5×5 pressed by a Kinova Jaco arm with 3-finger hand (rapier3d)",
+            game("lightsout"),
+            JacoBoard::LightsOut { stairs: false },
+        ),
+        entry(
+            "tileswap-jaco",
+            "TileSwapJaco",
+            "TileSwap 3×3 pressed by a Kinova Jaco arm with 3-finger hand (rapier3d)",
+            game("tileswap"),
+            JacoBoard::TileSwap,
+        ),
+        entry(
+            "lightsout3d-jaco",
+            "LightsOut3DJaco",
+            "LightsOut 5×5 with fields raised by distance from the centre, pressed by a Jaco arm",
+            game("lightsout"),
+            JacoBoard::LightsOut { stairs: true },
+        ),
+    ]
+}
 
 /// The registered environment names.
 pub fn env_names() -> Vec<&'static str> {
-    REGISTRY.iter().map(|e| e.name).collect()
+    registry().iter().map(|e| e.name.as_str()).collect()
 }
 
 /// Builds the environment `name` with `config` (validated).
@@ -94,7 +129,7 @@ pub fn env_names() -> Vec<&'static str> {
 /// # Ok::<(), seads_embodiment::EnvError>(())
 /// ```
 pub fn make_env(name: &str, config: &EnvConfig) -> Result<Box<dyn Environment>, EnvError> {
-    let entry = REGISTRY
+    let entry = registry()
         .iter()
         .find(|e| e.name == name)
         .ok_or_else(|| EnvError::UnknownEnv {
@@ -102,7 +137,11 @@ pub fn make_env(name: &str, config: &EnvConfig) -> Result<Box<dyn Environment>, 
             valid: env_names().join(", "),
         })?;
     config.validate()?;
-    let layout = layout(entry, config)?;
+    let game = entry
+        .game
+        .build(config.board_size.unwrap_or(entry.game.default_size()))
+        .map_err(|e| EnvError::InvalidConfig(format!("{}: {e}", entry.name)))?;
+    let layout = layout(entry, game.as_ref(), config)?;
     #[cfg(feature = "jaco")]
     let jaco = matches!(entry.embodiment, Embodiment::Jaco(_));
     #[cfg(not(feature = "jaco"))]
@@ -113,20 +152,17 @@ pub fn make_env(name: &str, config: &EnvConfig) -> Result<Box<dyn Environment>, 
             entry.name
         )));
     }
-    let size = match layout {
-        Layout::Grid { n } | Layout::Spaced { n, .. } | Layout::ColumnMajor { n } => n,
-        Layout::Pivots => 3,
-    };
-    let board = BoardState::new(entry.game, size, config)?;
+    let board = BoardState::new(entry.game, game.size(), config)?;
+    let name = entry.name.as_str();
     Ok(match entry.embodiment {
-        Embodiment::Cursor => build(entry.name, Cursor::default(), board, layout, config),
-        Embodiment::Reacher => build(entry.name, Reacher::default(), board, layout, config),
+        Embodiment::Cursor => build(name, Cursor::default(), board, layout, config),
+        Embodiment::Reacher => build(name, Reacher::default(), board, layout, config),
         #[cfg(feature = "jaco")]
         Embodiment::Jaco(jaco) => {
             let substeps = config
                 .physics_substeps
                 .unwrap_or(crate::jaco::DEFAULT_SUBSTEPS);
-            build(entry.name, Jaco::new(jaco, substeps), board, layout, config)
+            build(name, Jaco::new(jaco, substeps), board, layout, config)
         }
     })
 }
@@ -147,11 +183,15 @@ fn build<M: Manipulator>(
     ))
 }
 
-/// The board layout an entry gets under `config`; only `lightsout-cursor` has variants.
-fn layout(entry: &Entry, config: &EnvConfig) -> Result<Layout, EnvError> {
+/// The board layout an entry gets under `config`: fields tiling the board, or the pivots
+/// between them where the game's moves are made at edges. Other sizes are for the Cursor, on
+/// games whose moves are made at fields: up to 5×5 the fields tile the board, larger boards
+/// and any `spacing` keep fields of side 1/13 (SPEC §1.6).
+fn layout(entry: &Entry, game: &dyn BoardGame, config: &EnvConfig) -> Result<Layout, EnvError> {
     let default = entry.game.default_size();
-    let size = config.board_size.unwrap_or(default);
+    let size = game.size();
     let variant = size != default || config.spacing.is_some();
+    let at_fields = matches!(game.move_site(0), MoveSite::Field(_));
     if !variant {
         // The reference numbers LightsOut3DJaco's fields column by column.
         #[cfg(feature = "jaco")]
@@ -161,17 +201,22 @@ fn layout(entry: &Entry, config: &EnvConfig) -> Result<Layout, EnvError> {
         ) {
             return Ok(Layout::ColumnMajor { n: size });
         }
-        return Ok(Layout::standard(entry.game, size));
+        return Layout::standard(game)
+            .ok_or_else(|| EnvError::InvalidConfig(format!("{} has no board layout", entry.name)));
     }
-    if entry.name != "lightsout-cursor" {
+    if entry.embodiment != Embodiment::Cursor || !at_fields {
         return Err(EnvError::InvalidConfig(format!(
-            "{} has only the {default}×{default} board; board_size and spacing apply to lightsout-cursor",
+            "{} has only the {default}×{default} board; board_size and spacing apply to the Cursor on games pushed at fields",
             entry.name
         )));
     }
+    // Boards up to 5×5 tile the square; larger ones keep fields of side 1/13 (SPEC §1.6).
+    if size <= 5 && config.spacing.is_none() {
+        return Ok(Layout::Grid { n: size });
+    }
     if !(5..=13).contains(&size) || size.is_multiple_of(2) {
         return Err(EnvError::InvalidConfig(format!(
-            "spaced LightsOut boards have odd sizes 5 to 13, got {size}"
+            "spaced boards have odd sizes 5 to 13, got {size}"
         )));
     }
     Ok(Layout::Spaced {
@@ -185,6 +230,8 @@ fn layout(entry: &Entry, config: &EnvConfig) -> Result<Layout, EnvError> {
 pub struct EnvInfo {
     /// Registered name.
     pub name: String,
+    /// CamelCase name (`LightsOutCursor`), for Gymnasium ids.
+    pub title: String,
     /// One line.
     pub description: String,
     /// Observation length.
@@ -199,15 +246,16 @@ pub struct EnvInfo {
 
 /// Every registered environment with its default dimensions.
 pub fn list_envs() -> Vec<EnvInfo> {
-    REGISTRY
+    registry()
         .iter()
         .map(|e| {
             let env =
-                make_env(e.name, &EnvConfig::default()).expect("registered environments build");
+                make_env(&e.name, &EnvConfig::default()).expect("registered environments build");
             let spec = env.spec();
             EnvInfo {
-                name: e.name.to_owned(),
-                description: e.description.to_owned(),
+                name: e.name.clone(),
+                title: e.title.clone(),
+                description: e.description.clone(),
                 obs_dim: spec.obs_dim,
                 action_dim: spec.action_dim,
                 num_skills: spec.num_skills,

@@ -91,7 +91,8 @@ pub enum Push {
     /// No push (or a push off the board).
     #[default]
     None,
-    /// A push on the board that hit no move (TileSwap outside every pivot, a gap between fields).
+    /// A push on the board that made no move (TileSwap outside every pivot, a gap between
+    /// fields, a sliding tile away from the gap).
     Miss,
     /// A game move with its ground-truth id (SPEC §1 numbering).
     Move(MoveId),

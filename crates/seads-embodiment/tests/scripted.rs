@@ -2,37 +2,43 @@
 //! environments' code) drive each manipulator to every field or pivot and push, and every one of
 //! the K ground-truth moves happens within the skill's step limit, on several seeds.
 
-use seads_embodiment::{EnvConfig, Environment, Layout, Push, make_env};
-use seads_games::{GameKind, MoveId};
+use seads_embodiment::{EnvConfig, Environment, Layout, Push, env_names, make_env};
+use seads_games::MoveId;
 
 const SEEDS: [u64; 20] = [
     1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15, 16, 17, 18, 19, 20,
 ];
 
-/// Where to push for each move, in normalised board coordinates: field centres (LightsOut) or
-/// pivot points (TileSwap).
-fn targets(game: GameKind) -> Vec<(MoveId, [f64; 2])> {
-    match game {
-        GameKind::LightsOut => (0..25)
-            .map(|m| (m, [(m % 5) as f64 * 0.2 + 0.1, (m / 5) as f64 * 0.2 + 0.1]))
-            .collect(),
-        GameKind::TileSwap => {
-            let pivots = Layout::Pivots.pivots();
-            (0..12)
-                .map(|m| {
-                    (
-                        m,
-                        pivots
-                            .iter()
-                            .copied()
-                            .find(|&(u, v)| Layout::Pivots.locate(u, v) == Some(m))
-                            .map(|(u, v)| [u, v])
-                            .unwrap(),
-                    )
-                })
-                .collect()
-        }
-    }
+/// Where to push for each move, in normalised board coordinates: the pivot of the move where
+/// the layout has pivots (TileSwap), else the centre of the move's field.
+fn targets(layout: Layout, moves: usize) -> Vec<(MoveId, [f64; 2])> {
+    let pivots = layout.pivots();
+    let fields = layout.fields();
+    (0..moves)
+        .map(|m| {
+            let target = match pivots
+                .iter()
+                .find(|&&(u, v)| layout.locate(u, v) == Some(m))
+            {
+                Some(&(u, v)) => [u, v],
+                None => {
+                    let [u0, v0, u1, v1] = fields[m];
+                    [(u0 + u1) / 2.0, (v0 + v1) / 2.0]
+                }
+            };
+            (m, target)
+        })
+        .collect()
+}
+
+/// Every registered environment of a manipulator (`-cursor`, `-reacher`): every game.
+fn envs_of(manipulator: &str) -> Vec<&'static str> {
+    let names: Vec<_> = env_names()
+        .into_iter()
+        .filter(|n| n.ends_with(manipulator))
+        .collect();
+    assert!(names.len() >= 3, "{manipulator}: {names:?}");
+    names
 }
 
 /// Runs `controller` from a fresh reset until the skill ends; returns the move it made.
@@ -55,12 +61,21 @@ fn run_skill(
     panic!("the step limit must end the skill")
 }
 
+/// Aims `controller` at every move that changes the reset board (all of them but in games
+/// whose moves depend on the state), on every seed; each must be made.
 fn check_all_moves(name: &str, controller: impl Fn(Layout, MoveId, [f64; 2], &[f32]) -> [f32; 3]) {
     let mut env = make_env(name, &EnvConfig::default()).unwrap();
-    let game = env.spec().game;
-    let layout = Layout::standard(game, env.spec().board_size);
+    let spec = env.spec().clone();
+    let game = spec.game.build(spec.board_size).unwrap();
+    let layout = Layout::standard(game.as_ref()).unwrap();
     for seed in SEEDS {
-        for (mv, target) in targets(game) {
+        env.seed(seed);
+        env.reset().unwrap();
+        let board = env.board();
+        for (mv, target) in targets(layout, game.num_moves()) {
+            if !game.changes(board, mv) {
+                continue;
+            }
             let made = run_skill(env.as_mut(), seed, |obs| {
                 controller(layout, mv, target, obs)
             });
@@ -82,8 +97,9 @@ fn cursor_controller(_: Layout, _: MoveId, target: [f64; 2], obs: &[f32]) -> [f3
 
 #[test]
 fn cursor_produces_every_move() {
-    check_all_moves("lightsout-cursor", cursor_controller);
-    check_all_moves("tileswap-cursor", cursor_controller);
+    for name in envs_of("-cursor") {
+        check_all_moves(name, cursor_controller);
+    }
 }
 
 /// Reacher: inverse kinematics to the target, a PD law on the joints (gains sized for the 0.04 s
@@ -145,8 +161,9 @@ fn reacher_controller(
 
 #[test]
 fn reacher_produces_every_move() {
-    check_all_moves("lightsout-reacher", reacher_controller);
-    check_all_moves("tileswap-reacher", reacher_controller);
+    for name in envs_of("-reacher") {
+        check_all_moves(name, reacher_controller);
+    }
 }
 
 #[test]

@@ -1,14 +1,14 @@
-//! `SymbolicState`: a fixed-size bitset holding a symbolic board observation z (up to 192 bits).
+//! `SymbolicState`: a fixed-size bitset holding a symbolic board observation z (up to 256 bits).
 
 use serde::{Deserialize, Serialize};
 
 /// Number of 64-bit words in a [`SymbolicState`].
-const WORDS: usize = 3;
+const WORDS: usize = 4;
 
 /// A binary symbolic state z, bit-packed: bit `d` is z_d.
 ///
-/// 192 bits hold every game of the project (LightsOut up to 13×13 = 169 bits, TileSwap's 81-bit
-/// one-hot matrix). Bits at or beyond the game's length D are always zero, so `==` and hashing
+/// 256 bits hold every game of the project (LightsOut up to 13×13 = 169 bits, TileSwap's 81-bit
+/// one-hot matrix, the 15-puzzle's 256-bit one). Bits at or beyond the game's length D are always zero, so `==` and hashing
 /// compare symbolic states exactly.
 #[derive(Clone, Copy, Default, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize, Deserialize)]
 pub struct SymbolicState {
@@ -16,6 +16,9 @@ pub struct SymbolicState {
 }
 
 impl SymbolicState {
+    /// Number of 64-bit words.
+    pub const WORDS: usize = WORDS;
+
     /// Largest number of bits a symbolic state can hold.
     pub const MAX_BITS: usize = 64 * WORDS;
 
@@ -25,14 +28,14 @@ impl SymbolicState {
     /// The state whose low 64 bits are `bits`.
     pub const fn from_u64(bits: u64) -> Self {
         Self {
-            words: [bits, 0, 0],
+            words: [bits, 0, 0, 0],
         }
     }
 
     /// The state whose low 128 bits are `bits`.
     pub const fn from_u128(bits: u128) -> Self {
         Self {
-            words: [bits as u64, (bits >> 64) as u64, 0],
+            words: [bits as u64, (bits >> 64) as u64, 0, 0],
         }
     }
 
@@ -108,7 +111,7 @@ impl SymbolicState {
     pub fn from_bools(bits: &[bool]) -> Self {
         assert!(
             bits.len() <= Self::MAX_BITS,
-            "a symbolic state holds at most 192 bits"
+            "a symbolic state holds at most 256 bits"
         );
         let mut z = Self::ZERO;
         for (d, &b) in bits.iter().enumerate() {
@@ -121,7 +124,7 @@ impl SymbolicState {
     pub fn from_observation(values: &[f32]) -> Self {
         assert!(
             values.len() <= Self::MAX_BITS,
-            "a symbolic state holds at most 192 bits"
+            "a symbolic state holds at most 256 bits"
         );
         let mut z = Self::ZERO;
         for (d, &v) in values.iter().enumerate() {
@@ -150,11 +153,7 @@ impl std::ops::BitXor for SymbolicState {
     #[inline]
     fn bitxor(self, rhs: Self) -> Self {
         Self {
-            words: [
-                self.words[0] ^ rhs.words[0],
-                self.words[1] ^ rhs.words[1],
-                self.words[2] ^ rhs.words[2],
-            ],
+            words: std::array::from_fn(|i| self.words[i] ^ rhs.words[i]),
         }
     }
 }
@@ -171,22 +170,21 @@ impl std::ops::BitAnd for SymbolicState {
     #[inline]
     fn bitand(self, rhs: Self) -> Self {
         Self {
-            words: [
-                self.words[0] & rhs.words[0],
-                self.words[1] & rhs.words[1],
-                self.words[2] & rhs.words[2],
-            ],
+            words: std::array::from_fn(|i| self.words[i] & rhs.words[i]),
         }
     }
 }
 
 impl std::fmt::Debug for SymbolicState {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        write!(
-            f,
-            "SymbolicState({:#x}, {:#x}, {:#x})",
-            self.words[2], self.words[1], self.words[0]
-        )
+        write!(f, "SymbolicState(")?;
+        for (i, w) in self.words.iter().rev().enumerate() {
+            if i > 0 {
+                write!(f, ", ")?;
+            }
+            write!(f, "{w:#x}")?;
+        }
+        write!(f, ")")
     }
 }
 
@@ -197,16 +195,22 @@ mod tests {
     #[test]
     fn set_get_flip_across_words() {
         let mut z = SymbolicState::ZERO;
-        for d in [0, 63, 64, 127, 128, 191] {
+        for d in [0, 63, 64, 127, 128, 191, 192, 255] {
             z.set(d, true);
             assert!(z.get(d));
         }
-        assert_eq!(z.count_ones(), 6);
-        assert_eq!(z.ones().collect::<Vec<_>>(), vec![0, 63, 64, 127, 128, 191]);
+        assert_eq!(z.count_ones(), 8);
+        assert_eq!(
+            z.ones().collect::<Vec<_>>(),
+            vec![0, 63, 64, 127, 128, 191, 192, 255]
+        );
         z.flip(64);
         assert!(!z.get(64));
         z.set(0, false);
-        assert_eq!(z.ones().collect::<Vec<_>>(), vec![63, 127, 128, 191]);
+        assert_eq!(
+            z.ones().collect::<Vec<_>>(),
+            vec![63, 127, 128, 191, 192, 255]
+        );
     }
 
     #[test]

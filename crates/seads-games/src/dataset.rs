@@ -82,8 +82,8 @@ fn split_index(split: Split) -> usize {
 /// [`FEW_MOVE_SETS`]) may have none there, which [`action_sampling_boards`] tells beforehand. The
 /// draws stop after [`MAX_DRAWS`]; then such a depth's boards are listed and one is drawn
 /// among them.
-pub fn sample_by_action_sampling<R: Rng + ?Sized>(
-    game: &dyn BoardGame,
+pub fn sample_by_action_sampling<G: BoardGame + ?Sized, R: Rng + ?Sized>(
+    game: &G,
     depth: usize,
     split: Split,
     rng: &mut R,
@@ -111,8 +111,8 @@ pub const FEW_MOVE_SETS: u128 = 4096;
 /// The boards in `split` that `depth` distinct moves from the goal make, listed (distinct, in
 /// move-set order) where there are at most [`FEW_MOVE_SETS`] such move sets; `None` where there
 /// are more (then both splits hold many of them).
-pub fn action_sampling_boards(
-    game: &dyn BoardGame,
+pub fn action_sampling_boards<G: BoardGame + ?Sized>(
+    game: &G,
     depth: usize,
     split: Split,
 ) -> Option<Vec<SymbolicState>> {

@@ -58,8 +58,9 @@ impl Enumeration {
 
 /// Breadth-first search from the goal, up to `max_depth` moves (all reachable boards if `None`).
 ///
-/// Moves are their own inverses, so the layer in which a board first appears is its solution
-/// depth. Errors if the game's state space is too large to index.
+/// Every move can be undone by a move (LightsOut's and TileSwap's are their own inverses, a
+/// slide is undone by sliding the tile back), so the layer in which a board first appears is its
+/// solution depth. Errors if the game's state space is too large to index.
 ///
 /// ```
 /// use seads_games::{LightsOut, enumerate};
@@ -79,7 +80,6 @@ pub fn enumerate<G: Enumerable + ?Sized>(
         .ok_or_else(|| GameError::TooLargeToEnumerate {
             game: game.kind().name(),
             size: game.size(),
-            space: format!("2^{}", game.num_moves()),
         })?;
     let mut visited = vec![0u64; space.div_ceil(64) as usize];
     let goal = game.index_of(game.goal());

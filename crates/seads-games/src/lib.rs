@@ -1,4 +1,5 @@
-//! Board games of SEADS: LightsOut N×N and TileSwap 3×3 (SPEC §1).
+//! Board games of SEADS: LightsOut N×N, TileSwap 3×3 (SPEC §1) and the sliding-tile puzzle
+//! (the 8- and 15-puzzle), listed by name in one registry ([`GameKind`]).
 //!
 //! A board *is* its symbolic state z ([`SymbolicState`], bit-packed), so the one game trait,
 //! [`BoardGame`], is object safe and every later stage (environments, forward model, planner)
@@ -41,7 +42,10 @@ mod dataset;
 mod enumerate;
 mod gf2;
 mod lightsout;
+mod perm;
+mod registry;
 mod reports;
+mod sliding;
 mod split;
 mod successor;
 pub mod tables;
@@ -54,10 +58,16 @@ pub use dataset::{
 pub use enumerate::{DepthTable, Enumerable, Enumeration, enumerate};
 pub use gf2::Gf2Solver;
 pub use lightsout::LightsOut;
+pub use registry::{GameEntry, GameKind};
 pub use reports::{DepthsReport, SolveReport, SplitReport};
+pub use sliding::SlidingPuzzle;
 pub use split::{Split, board_string, split_of};
 pub use successor::{GameSuccessor, Successor};
 pub use tileswap::TileSwap;
+
+/// Every game, in listing order: the one place that names them (each game's file holds its
+/// [`GameEntry`]).
+static GAMES: &[&GameEntry] = &[&lightsout::ENTRY, &tileswap::ENTRY, &sliding::ENTRY];
 
 /// Identifier of a game move (SPEC §1: LightsOut `row·N + col`, TileSwap ids 0..11).
 pub type MoveId = usize;
@@ -87,11 +97,15 @@ pub enum GameError {
         /// The allowed values, in words.
         allowed: &'static str,
     },
-    /// A TileSwap board that is not a permutation of the tiles 0..8.
+    /// A board of tiles that is not a permutation of its tiles.
     #[error(
-        "a tileswap board must hold each tile 0..8 exactly once; tile {tile} appears {count} times"
+        "a {game} board must hold each tile 0..{last} exactly once; tile {tile} appears {count} times"
     )]
     NotPermutation {
+        /// Game name.
+        game: &'static str,
+        /// The largest tile id.
+        last: u8,
         /// A tile id that is missing or repeated.
         tile: u8,
         /// How often it appears.
@@ -121,73 +135,43 @@ pub enum GameError {
     },
     /// Enumerating every board is infeasible for this game.
     #[error(
-        "enumerating every {game} board of size {size} is infeasible ({space} states); only LightsOut up to 5×5 and TileSwap 3×3 are enumerated"
+        "enumerating every {game} board of size {size} is infeasible (more than 2^32 boards); LightsOut up to 5×5, TileSwap 3×3 and the 8-puzzle are enumerated"
     )]
     TooLargeToEnumerate {
         /// Game name.
         game: &'static str,
         /// Board size.
         size: usize,
-        /// Size of the state space, in words.
-        space: String,
+    },
+    /// No registered game has this name.
+    #[error("unknown game {name:?} (valid: {valid})")]
+    UnknownGame {
+        /// The name given.
+        name: String,
+        /// The registered names.
+        valid: String,
     },
 }
 
-/// Which game, as named on the command line and in configs.
-#[derive(
-    Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord, serde::Serialize, serde::Deserialize,
-)]
-#[serde(rename_all = "lowercase")]
-pub enum GameKind {
-    /// LightsOut: press a field to toggle it and its four neighbours.
-    LightsOut,
-    /// TileSwap: swap two edge-adjacent tiles.
-    TileSwap,
+/// Where on the board a move is made.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum MoveSite {
+    /// By pushing one field (row-major index): LightsOut's and the sliding puzzle's moves.
+    Field(usize),
+    /// By pushing the edge between two edge-adjacent fields (row-major indices): TileSwap's
+    /// swaps.
+    Edge(usize, usize),
 }
 
-impl GameKind {
-    /// The lower-case name used on the command line.
-    pub fn name(self) -> &'static str {
-        match self {
-            GameKind::LightsOut => "lightsout",
-            GameKind::TileSwap => "tileswap",
-        }
-    }
-
-    /// The default board size (5 for LightsOut, 3 for TileSwap; SPEC §1).
-    pub fn default_size(self) -> usize {
-        match self {
-            GameKind::LightsOut => 5,
-            GameKind::TileSwap => 3,
-        }
-    }
-
-    /// Builds the game of this kind and size.
-    pub fn build(self, size: usize) -> Result<Box<dyn BoardGame>, GameError> {
-        Ok(match self {
-            GameKind::LightsOut => Box::new(LightsOut::new(size)?),
-            GameKind::TileSwap => Box::new(TileSwap::with_size(size)?),
-        })
-    }
-}
-
-impl std::fmt::Display for GameKind {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        f.write_str(self.name())
-    }
-}
-
-impl std::str::FromStr for GameKind {
-    type Err = String;
-    fn from_str(s: &str) -> Result<Self, String> {
-        match s.to_ascii_lowercase().as_str() {
-            "lightsout" => Ok(GameKind::LightsOut),
-            "tileswap" => Ok(GameKind::TileSwap),
-            other => Err(format!(
-                "unknown game {other:?} (valid: lightsout, tileswap)"
-            )),
-        }
-    }
+/// How a field's value is shown.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub enum FieldMark {
+    /// A light, on or off (LightsOut).
+    Light(bool),
+    /// A label (a tile's number).
+    Label(String),
+    /// Nothing (the sliding puzzle's gap).
+    Blank,
 }
 
 /// A board game whose boards are identified with their symbolic states z (SPEC §1).
@@ -218,6 +202,76 @@ pub trait BoardGame: Send + Sync {
     fn board_from_values(&self, values: &[u8]) -> Result<SymbolicState, GameError>;
     /// Whether `z` encodes a board of this game (TileSwap: a one-hot permutation matrix).
     fn is_valid(&self, z: SymbolicState) -> bool;
+    /// The field values a board may hold, in words (for error messages: "0 or 1").
+    fn allowed_values(&self) -> &'static str;
+    /// Where on the board move `mv` is made.
+    fn move_site(&self, mv: MoveId) -> MoveSite;
+    /// How a field holding `value` is shown.
+    fn field_mark(&self, value: u8) -> FieldMark;
+    /// Move `mv` in words, for listings ("12 (press row 2 col 2)").
+    fn describe_move(&self, mv: MoveId) -> String {
+        match self.move_site(mv) {
+            MoveSite::Field(f) => format!(
+                "{mv} (push row {} col {})",
+                f / self.size(),
+                f % self.size()
+            ),
+            MoveSite::Edge(p, q) => {
+                let n = self.size();
+                format!(
+                    "{mv} (between ({},{}) and ({},{}))",
+                    p / n,
+                    p % n,
+                    q / n,
+                    q % n
+                )
+            }
+        }
+    }
+    /// A uniformly random valid board ([`BoardGame::is_valid`]), reachable from the goal or not.
+    fn random_board(&self, rng: &mut dyn rand::Rng) -> SymbolicState;
+
+    /// The game as one whose boards can be listed densely, where enumerating every board is
+    /// feasible (LightsOut up to 5×5, TileSwap, the 8-puzzle); `None` otherwise.
+    fn enumerable(&self) -> Option<&dyn Enumerable> {
+        None
+    }
+
+    /// A board about `depth` moves from the goal that lies in `split`, for a game too large to
+    /// enumerate; `None` where `split` holds none. By default `depth` distinct random moves from
+    /// the goal, redrawn until the split matches (the reference's action sampling: the true depth
+    /// may be smaller); a game with a solver may draw boards of exactly that depth.
+    fn sample_at_depth(
+        &self,
+        depth: usize,
+        split: Split,
+        rng: &mut dyn rand::Rng,
+    ) -> Option<SymbolicState> {
+        dataset::sample_by_action_sampling(self, depth, split, rng)
+    }
+
+    /// Whether [`BoardGame::sample_at_depth`] can draw no board of `depth` in `split` (a depth
+    /// that few move sets reach may have none there), said without drawing.
+    fn lacks_boards(&self, depth: usize, split: Split) -> bool {
+        dataset::action_sampling_boards(self, depth, split).is_some_and(|b| b.is_empty())
+    }
+
+    /// Whether a sequence of moves takes `from` to `to`, where the game can tell at once;
+    /// `None` where only a search finds out. By default through the game's solver when `to` is
+    /// the goal.
+    fn can_reach(&self, from: SymbolicState, to: SymbolicState) -> Option<bool> {
+        if to == self.goal() {
+            self.solution_depth(from).map(|d| d.is_ok())
+        } else {
+            None
+        }
+    }
+
+    /// Whether move `mv` changes `board` (a sliding puzzle's push of a tile away from the gap
+    /// does not).
+    fn changes(&self, board: SymbolicState, mv: MoveId) -> bool {
+        self.apply(board, mv) != board
+    }
 
     /// A shortest move sequence from `board` to the goal by the game's own solver, `None` where
     /// the game has none (then only a search finds one). An error if `board` cannot reach the
@@ -267,10 +321,7 @@ pub trait BoardGame: Send + Sync {
                     game,
                     index,
                     symbol: (*f).to_owned(),
-                    allowed: match self.kind() {
-                        GameKind::LightsOut => "0 or 1",
-                        GameKind::TileSwap => "a tile id 0..8",
-                    },
+                    allowed: self.allowed_values(),
                 })
             })
             .collect::<Result<Vec<u8>, _>>()?;

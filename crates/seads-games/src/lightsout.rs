@@ -2,7 +2,21 @@
 
 use std::sync::OnceLock;
 
-use crate::{BoardGame, Enumerable, GameError, GameKind, Gf2Solver, MoveId, SymbolicState};
+use rand::RngExt;
+
+use crate::{
+    BoardGame, Enumerable, FieldMark, GameEntry, GameError, GameKind, Gf2Solver, MoveId, MoveSite,
+    SymbolicState,
+};
+
+/// LightsOut in the registry.
+pub(crate) static ENTRY: GameEntry = GameEntry {
+    name: "lightsout",
+    title: "LightsOut",
+    description: "LightsOut N×N (3 to 13): a push toggles a field and its edge neighbours",
+    default_size: 5,
+    build: |size| Ok(Box::new(LightsOut::new(size)?)),
+};
 
 /// LightsOut on an N×N board, 3 ≤ N ≤ 13. Bit `row·N + col` of a board is 1 iff that light is on.
 #[derive(Debug, Clone)]
@@ -92,7 +106,7 @@ const SPREAD: [u64; 256] = {
 
 impl BoardGame for LightsOut {
     fn kind(&self) -> GameKind {
-        GameKind::LightsOut
+        GameKind::of(&ENTRY)
     }
     fn size(&self) -> usize {
         self.n
@@ -149,6 +163,34 @@ impl BoardGame for LightsOut {
     }
     fn is_valid(&self, z: SymbolicState) -> bool {
         z.ones().all(|d| d < self.n * self.n)
+    }
+    fn allowed_values(&self) -> &'static str {
+        "0 or 1"
+    }
+    fn move_site(&self, mv: MoveId) -> MoveSite {
+        MoveSite::Field(mv)
+    }
+    fn field_mark(&self, value: u8) -> FieldMark {
+        FieldMark::Light(value == 1)
+    }
+    fn describe_move(&self, mv: MoveId) -> String {
+        format!("{mv} (press row {} col {})", mv / self.n, mv % self.n)
+    }
+    /// Every field on or off with probability ½ (a quarter of the 5×5 patterns are solvable).
+    fn random_board(&self, rng: &mut dyn rand::Rng) -> SymbolicState {
+        let mut z = SymbolicState::ZERO;
+        for d in 0..self.n * self.n {
+            z.set(d, rng.random::<bool>());
+        }
+        z
+    }
+    /// Up to 5×5 (2²⁵ boards).
+    fn enumerable(&self) -> Option<&dyn Enumerable> {
+        (self.n <= 5).then_some(self as &dyn Enumerable)
+    }
+    /// Lights flip, so `to` is reachable from `from` iff `from ⊕ to` is solvable (GF(2)).
+    fn can_reach(&self, from: SymbolicState, to: SymbolicState) -> Option<bool> {
+        Some(self.solver().depth(from ^ to).is_ok())
     }
     /// By linear algebra over GF(2) ([`Gf2Solver`]).
     fn solve(&self, board: SymbolicState) -> Option<Result<Vec<MoveId>, GameError>> {

@@ -5,17 +5,18 @@ use std::fmt::Write as _;
 
 use serde::Serialize;
 
-use crate::{
-    BoardDataset, DepthTable, Enumerable, GameError, GameKind, Gf2Solver, LightsOut, MoveId, Split,
-    TileSwap, enumerate,
-};
+use crate::{BoardDataset, BoardGame, GameError, GameKind, MoveId, Split, enumerate};
 
-/// `kind` at `size` as a game that can be enumerated (both games are).
-fn enumerable(kind: GameKind, size: usize) -> Result<Box<dyn Enumerable>, GameError> {
-    Ok(match kind {
-        GameKind::LightsOut => Box::new(LightsOut::new(size)?),
-        GameKind::TileSwap => Box::new(TileSwap::with_size(size)?),
-    })
+/// `game` at `size`, refused where its boards cannot all be listed.
+fn listed(game: GameKind, size: usize) -> Result<Box<dyn BoardGame>, GameError> {
+    let g = game.build(size)?;
+    if g.enumerable().is_none() {
+        return Err(GameError::TooLargeToEnumerate {
+            game: game.name(),
+            size,
+        });
+    }
+    Ok(g)
 }
 
 /// Boards per solution depth of a whole game.
@@ -34,16 +35,17 @@ impl DepthsReport {
     ///
     /// ```
     /// use seads_games::{DepthsReport, GameKind};
-    /// let report = DepthsReport::of(GameKind::LightsOut, 3).unwrap();
+    /// let report = DepthsReport::of(GameKind::named("lightsout").unwrap(), 3).unwrap();
     /// assert_eq!(report.counts.iter().sum::<u64>(), 512);
     /// assert!(report.table().ends_with(" total         512"));
     /// ```
     pub fn of(game: GameKind, size: usize) -> Result<Self, GameError> {
-        let g = enumerable(game, size)?;
+        let g = listed(game, size)?;
+        let e = g.enumerable().expect("checked by listed");
         Ok(Self {
             game,
             size,
-            counts: enumerate(g.as_ref(), None)?.depth_counts(),
+            counts: enumerate(e, None)?.depth_counts(),
         })
     }
 
@@ -73,8 +75,8 @@ pub struct SplitReport {
 impl SplitReport {
     /// The split of `game` at `size` up to `max_depth` (at least 1).
     pub fn of(game: GameKind, size: usize, max_depth: usize) -> Result<Self, GameError> {
-        let g = enumerable(game, size)?;
-        let data = BoardDataset::build(g.as_ref(), max_depth)?;
+        let g = listed(game, size)?;
+        let data = BoardDataset::build(g.enumerable().expect("checked by listed"), max_depth)?;
         let count = |s| (1..=max_depth).map(|d| data.boards(d, s).len()).collect();
         Ok(Self {
             train: count(Split::Train),
@@ -105,24 +107,33 @@ pub struct SolveReport {
     pub depth: usize,
     /// Move ids in order (LightsOut: row·N + col pressed; TileSwap: the swap ids of SPEC §1.2).
     pub moves: Vec<MoveId>,
+    /// The moves in words, as the game describes them.
+    #[serde(skip)]
+    pub described: Vec<String>,
 }
 
 impl SolveReport {
-    /// Solves `board` (the game's text form) optimally: over GF(2) for LightsOut, from the depth
-    /// table for TileSwap.
+    /// Solves `board` (the game's text form) optimally by the game's own solver (GF(2) for
+    /// LightsOut, depth tables for TileSwap and the 8-puzzle, IDA* for the 15-puzzle), or from a
+    /// depth table where the game has none.
     ///
     /// ```
     /// use seads_games::{GameKind, SolveReport};
-    /// let report = SolveReport::of(GameKind::LightsOut, 3, "1,1,0,1,0,0,0,0,0").unwrap();
+    /// let lightsout = GameKind::named("lightsout").unwrap();
+    /// let report = SolveReport::of(lightsout, 3, "1,1,0,1,0,0,0,0,0").unwrap();
     /// assert_eq!((report.depth, report.moves.clone()), (1, vec![0]));
     /// assert!(report.table().ends_with("0 (press row 0 col 0)"));
     /// ```
     pub fn of(game: GameKind, size: usize, board: &str) -> Result<Self, GameError> {
-        let g = enumerable(game, size)?;
+        let g = game.build(size)?;
         let z = g.parse(board)?;
-        let moves = match game {
-            GameKind::LightsOut => Gf2Solver::new(&LightsOut::new(size)?).solve(z)?,
-            GameKind::TileSwap => DepthTable::build(g.as_ref())?.solve(g.as_ref(), z)?,
+        let moves = match g.solve(z) {
+            Some(moves) => moves?,
+            None => {
+                let e = listed(game, size)?;
+                crate::DepthTable::build(e.enumerable().expect("checked by listed"))?
+                    .solve(e.enumerable().expect("checked by listed"), z)?
+            }
         };
         debug_assert!(g.is_goal(g.apply_all(z, &moves)));
         Ok(Self {
@@ -130,13 +141,14 @@ impl SolveReport {
             size,
             board: g.format(z),
             depth: moves.len(),
+            described: moves.iter().map(|&m| g.describe_move(m)).collect(),
             moves,
         })
     }
 
     /// Two lines: the board, and the moves in words.
     pub fn table(&self) -> String {
-        let moves: Vec<String> = self.moves.iter().map(|m| self.describe(*m)).collect();
+        let moves = &self.described;
         format!(
             "{} {}×{} board {}\nsolution depth {}: {}",
             self.game,
@@ -150,17 +162,5 @@ impl SolveReport {
                 moves.join(", ")
             }
         )
-    }
-
-    fn describe(&self, mv: MoveId) -> String {
-        match self.game {
-            GameKind::LightsOut => {
-                format!("{mv} (press row {} col {})", mv / self.size, mv % self.size)
-            }
-            GameKind::TileSwap => {
-                let (p, q) = TileSwap::swap_cells(mv);
-                format!("{mv} (swap ({},{})↔({},{}))", p / 3, p % 3, q / 3, q % 3)
-            }
-        }
     }
 }

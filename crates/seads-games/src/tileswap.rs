@@ -2,7 +2,22 @@
 
 use std::sync::OnceLock;
 
-use crate::{BoardGame, DepthTable, Enumerable, GameError, GameKind, MoveId, SymbolicState};
+use rand::seq::SliceRandom;
+
+use crate::perm::{FACTORIAL, rank, unrank};
+use crate::{
+    BoardGame, DepthTable, Enumerable, FieldMark, GameEntry, GameError, GameKind, MoveId, MoveSite,
+    SymbolicState,
+};
+
+/// TileSwap in the registry.
+pub(crate) static ENTRY: GameEntry = GameEntry {
+    name: "tileswap",
+    title: "TileSwap",
+    description: "TileSwap 3×3: swap two edge-adjacent tiles",
+    default_size: 3,
+    build: |size| Ok(Box::new(TileSwap::with_size(size)?)),
+};
 
 /// Number of cells (and tiles) of the 3×3 board.
 const CELLS: usize = 9;
@@ -73,7 +88,7 @@ impl TileSwap {
 
 impl BoardGame for TileSwap {
     fn kind(&self) -> GameKind {
-        GameKind::TileSwap
+        GameKind::of(&ENTRY)
     }
     fn size(&self) -> usize {
         3
@@ -122,6 +137,8 @@ impl BoardGame for TileSwap {
         }
         if let Some(tile) = (0..CELLS).find(|&t| counts[t] != 1) {
             return Err(GameError::NotPermutation {
+                game: "tileswap",
+                last: 8,
                 tile: tile as u8,
                 count: counts[tile],
             });
@@ -131,7 +148,7 @@ impl BoardGame for TileSwap {
     }
     fn is_valid(&self, z: SymbolicState) -> bool {
         let bits = z.low_u128();
-        if z.words()[2] != 0 || bits >> 81 != 0 {
+        if z.words()[2..].iter().any(|&w| w != 0) || bits >> 81 != 0 {
             return false;
         }
         let mut seen = 0u16;
@@ -143,6 +160,29 @@ impl BoardGame for TileSwap {
             seen |= block;
         }
         seen == 0x1ff
+    }
+    fn allowed_values(&self) -> &'static str {
+        "a tile id 0..8"
+    }
+    fn move_site(&self, mv: MoveId) -> MoveSite {
+        let (p, q) = SWAPS[mv];
+        MoveSite::Edge(p, q)
+    }
+    fn field_mark(&self, value: u8) -> FieldMark {
+        FieldMark::Label(value.to_string())
+    }
+    fn describe_move(&self, mv: MoveId) -> String {
+        let (p, q) = SWAPS[mv];
+        format!("{mv} (swap ({},{})↔({},{}))", p / 3, p % 3, q / 3, q % 3)
+    }
+    /// Any permutation of the tiles (all 9! are reachable).
+    fn random_board(&self, rng: &mut dyn rand::Rng) -> SymbolicState {
+        let mut tiles: [u8; CELLS] = std::array::from_fn(|t| t as u8);
+        tiles.shuffle(rng);
+        Self::from_tiles(&tiles)
+    }
+    fn enumerable(&self) -> Option<&dyn Enumerable> {
+        Some(self)
     }
     /// Through the complete depth table (9! boards, built on first use).
     fn solve(&self, board: SymbolicState) -> Option<Result<Vec<MoveId>, GameError>> {
@@ -168,39 +208,6 @@ impl BoardGame for TileSwap {
 fn depth_table() -> &'static DepthTable {
     static TABLE: OnceLock<DepthTable> = OnceLock::new();
     TABLE.get_or_init(|| DepthTable::build(&TileSwap).expect("TileSwap 3×3 enumerates"))
-}
-
-/// n! for n = 0..9.
-const FACTORIAL: [u32; 10] = [1, 1, 2, 6, 24, 120, 720, 5040, 40320, 362880];
-
-/// Lehmer rank of a permutation of 0..9 (lexicographic order, identity = 0).
-fn rank(perm: &[u8; 9]) -> u32 {
-    let mut used = 0u16;
-    let mut r = 0;
-    for (i, &p) in perm.iter().enumerate() {
-        let smaller_used = (used & ((1u16 << p) - 1)).count_ones();
-        r += (p as u32 - smaller_used) * FACTORIAL[8 - i];
-        used |= 1 << p;
-    }
-    r
-}
-
-/// Inverse of [`rank`].
-fn unrank(mut r: u32) -> [u8; 9] {
-    let mut free: u16 = 0x1ff;
-    std::array::from_fn(|i| {
-        let f = FACTORIAL[8 - i];
-        let mut k = r / f;
-        r %= f;
-        let mut bits = free;
-        while k > 0 {
-            bits &= bits - 1;
-            k -= 1;
-        }
-        let p = bits.trailing_zeros() as u8;
-        free &= !(1 << p);
-        p
-    })
 }
 
 impl Enumerable for TileSwap {
@@ -294,7 +301,11 @@ mod tests {
         let g = TileSwap::new();
         assert!(matches!(
             g.parse("0,1,2,3,4,5,6,7,7"),
-            Err(GameError::NotPermutation { tile: 7, count: 2 })
+            Err(GameError::NotPermutation {
+                tile: 7,
+                count: 2,
+                ..
+            })
         ));
         assert!(matches!(
             g.parse("0,1,2,3,4,5,6,7,9"),
@@ -313,15 +324,6 @@ mod tests {
             Err(GameError::UnsupportedSize { .. })
         ));
         assert!(!g.is_valid(SymbolicState::from_u64(3)));
-    }
-
-    #[test]
-    fn rank_unrank_round_trip() {
-        for r in [0, 1, 2, 100, 362879] {
-            assert_eq!(rank(&unrank(r)), r);
-        }
-        assert_eq!(unrank(0), [0, 1, 2, 3, 4, 5, 6, 7, 8]);
-        assert_eq!(unrank(362879), [8, 7, 6, 5, 4, 3, 2, 1, 0]);
     }
 
     #[test]

@@ -202,8 +202,8 @@ impl Key for SymbolicState {
     }
 
     fn spread(&self) -> u64 {
-        let [a, b, c] = self.words();
-        (a ^ b.rotate_left(21) ^ c.rotate_left(42)).wrapping_mul(SPREAD)
+        let [a, b, c, d] = self.words();
+        (a ^ b.rotate_left(21) ^ c.rotate_left(42) ^ d.rotate_left(63)).wrapping_mul(SPREAD)
     }
 }
 

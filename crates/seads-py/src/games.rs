@@ -1,42 +1,38 @@
-//! The board games and breadth-first planning with the true game model, NumPy boards in and
-//! out: a board is its values, row-major (LightsOut: 0/1 per field; TileSwap: the tile on each
-//! field).
+//! The board games of the games' registry and breadth-first planning with the true game model,
+//! NumPy boards in and out: a board is its values, row-major (LightsOut: 0/1 per field;
+//! TileSwap and the sliding puzzle: the tile on each field, 0 the sliding puzzle's gap).
 
 use numpy::{PyArray1, PyArray2};
 use pyo3::prelude::*;
 use seads_games::{
-    BoardDataset, BoardGame, Enumerable, GameSuccessor, LightsOut, Split, SymbolicState, TileSwap,
-    enumerate, split_of,
+    BoardDataset, BoardGame, Enumerable, GameKind, GameSuccessor, Split, SymbolicState, enumerate,
+    split_of,
 };
 use seads_planner::{PlannerConfig, bfs_plan};
 
 use crate::{Values, move_arg, value_error};
 
-/// One of the two games.
-enum Rules {
-    LightsOut(LightsOut),
-    TileSwap(TileSwap),
-}
-
-/// A board game: `Game("lightsout", 5)` or `Game("tileswap")`.
+/// A board game: `Game("lightsout", 5)`, `Game("tileswap")`, `Game("sliding", 4)`.
 #[pyclass(module = "seads._seads", frozen)]
 pub struct Game {
-    rules: Rules,
+    rules: Box<dyn BoardGame>,
 }
 
 impl Game {
     fn game(&self) -> &dyn BoardGame {
-        match &self.rules {
-            Rules::LightsOut(g) => g,
-            Rules::TileSwap(g) => g,
-        }
+        self.rules.as_ref()
     }
 
-    fn enumerable(&self) -> &dyn Enumerable {
-        match &self.rules {
-            Rules::LightsOut(g) => g,
-            Rules::TileSwap(g) => g,
-        }
+    /// The game as one whose boards can be listed, or a `ValueError` where they cannot.
+    fn enumerable(&self) -> PyResult<&dyn Enumerable> {
+        self.rules.enumerable().ok_or_else(|| {
+            value_error(format!(
+                "{} {}×{} has too many boards to list",
+                self.rules.kind(),
+                self.rules.size(),
+                self.rules.size()
+            ))
+        })
     }
 
     /// `values` as a board of this game, or a `ValueError` saying what is wrong.
@@ -64,28 +60,19 @@ fn parse_split(split: &str) -> PyResult<Split> {
 
 #[pymethods]
 impl Game {
-    /// `Game(name, size=None)`: `"lightsout"` (size 5 by default; 3 to 13) or `"tileswap"`
-    /// (size 3).
+    /// `Game(name, size=None)`: a game of `game_names()` — `"lightsout"` (size 5 by default; 3
+    /// to 13), `"tileswap"` (size 3) or `"sliding"` (size 3, the 8-puzzle, or 4, the 15-puzzle).
     #[new]
     #[pyo3(signature = (name, size=None))]
     fn new(name: &str, size: Option<usize>) -> PyResult<Self> {
-        let rules = match name {
-            "lightsout" => {
-                Rules::LightsOut(LightsOut::new(size.unwrap_or(5)).map_err(value_error)?)
-            }
-            "tileswap" => {
-                Rules::TileSwap(TileSwap::with_size(size.unwrap_or(3)).map_err(value_error)?)
-            }
-            other => {
-                return Err(value_error(format!(
-                    "game {other:?}: must be \"lightsout\" or \"tileswap\""
-                )));
-            }
-        };
+        let kind = GameKind::named(name).map_err(value_error)?;
+        let rules = kind
+            .build(size.unwrap_or(kind.default_size()))
+            .map_err(value_error)?;
         Ok(Self { rules })
     }
 
-    /// `"lightsout"` or `"tileswap"`.
+    /// The game's name: `"lightsout"`, `"tileswap"` or `"sliding"`.
     #[getter]
     fn name(&self) -> &'static str {
         self.game().kind().name()
@@ -148,7 +135,7 @@ impl Game {
     /// breadth-first enumeration from the goal.
     #[pyo3(signature = (max_depth=None))]
     fn depth_counts(&self, py: Python<'_>, max_depth: Option<usize>) -> PyResult<Vec<u64>> {
-        let game = self.enumerable();
+        let game = self.enumerable()?;
         py.detach(|| enumerate(game, max_depth).map(|e| e.depth_counts()))
             .map_err(value_error)
     }
@@ -176,7 +163,7 @@ impl Game {
                 "depth {depth}: boards are listed up to depth 12"
             )));
         }
-        let game = self.enumerable();
+        let game = self.enumerable()?;
         let data = py
             .detach(|| BoardDataset::build(game, depth))
             .map_err(value_error)?;
@@ -214,13 +201,11 @@ pub fn plan(
     if start == goal {
         return Ok(Vec::new());
     }
-    // LightsOut's moves flip fields, so a plan to `goal` exists iff `start ^ goal` can be
-    // solved: the GF(2) solver says at once where the search would run to its limit.
-    if let Rules::LightsOut(lightsout) = &game.rules {
-        lightsout
-            .solver()
-            .depth(start ^ goal)
-            .map_err(value_error)?;
+    // Where the game tells at once that no plan exists, the search does not run to its limit.
+    if game.game().can_reach(start, goal) == Some(false) {
+        return Err(value_error(seads_games::GameError::Unsolvable {
+            game: game.game().kind().name(),
+        }));
     }
     let config = PlannerConfig {
         max_layers: max_depth,

@@ -96,11 +96,29 @@ fn env_names() -> Vec<&'static str> {
     seads_embodiment::env_names()
 }
 
+/// Each registered environment's name in CamelCase (`lightsout-cursor` → `LightsOutCursor`),
+/// from which the Gymnasium ids are made.
+#[pyfunction]
+fn env_titles() -> std::collections::BTreeMap<String, String> {
+    seads_embodiment::list_envs()
+        .into_iter()
+        .map(|e| (e.name, e.title))
+        .collect()
+}
+
+/// The names of the registered games (`lightsout`, `tileswap`, `sliding`), for `Game(name)`.
+#[pyfunction]
+fn game_names() -> Vec<&'static str> {
+    seads_games::GameKind::all().map(|g| g.name()).collect()
+}
+
 /// The Python module.
 #[pymodule]
 fn _seads(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     m.add_function(wrap_pyfunction!(env_names, m)?)?;
+    m.add_function(wrap_pyfunction!(env_titles, m)?)?;
+    m.add_function(wrap_pyfunction!(game_names, m)?)?;
     m.add_class::<env::Env>()?;
     m.add_class::<vector::VecEnv>()?;
     m.add_class::<games::Game>()?;

@@ -163,3 +163,24 @@ def test_task_mode_reaches_the_deepest_boards_at_once():
     for seed in range(5):
         _, info = env.reset(seed=seed)
         assert info["depth"] == game.depth(info["board"]) == 15
+
+
+def test_a_game_added_in_rust_is_here_without_python_code():
+    """The sliding puzzle is one Rust file: its game, environments and Gymnasium ids come from
+    the Rust registries."""
+    assert seads.game_names() == ["lightsout", "tileswap", "sliding"]
+    ids = {seads.gym_id(n) for n in seads.env_names()}
+    assert {"seads/SlidingCursor-v0", "seads/SlidingReacher-v0"} <= ids
+    game = seads.Game("sliding", 4)
+    goal = game.goal()
+    assert list(goal) == list(range(1, 16)) + [0]
+    # Push field 14 (tile 15 slides right into the gap), then field 10 (tile 11 slides down).
+    board = game.apply(game.apply(goal, 14), 10)
+    assert game.solve(board) == [14, 15]
+    assert seads.plan(game, board) == [14, 15]
+    swapped = goal.copy()
+    swapped[[0, 1]] = swapped[[1, 0]]
+    with pytest.raises(ValueError, match="cannot be solved"):
+        seads.plan(game, swapped)
+    with pytest.raises(ValueError, match="too many boards"):
+        game.boards(3)

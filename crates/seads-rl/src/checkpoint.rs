@@ -29,7 +29,8 @@ pub fn resume_only_files() -> Vec<&'static str> {
 }
 
 /// Writes the episodes as a table: one row per episode in `lengths`, `skills`, `moves` (−1: no
-/// move), `z0` and `zt` (the symbolic states' three 64-bit words), and the steps of all
+/// move), `z0` and `zt` (the symbolic states' 64-bit words, [`SymbolicState::WORDS`] a row;
+/// tables of three-word states, written before states grew to 256 bits, still load), and the steps of all
 /// episodes concatenated in `obs` (T + 1 rows each) and `actions` (T rows each).
 pub fn save_episodes(
     path: &Path,
@@ -44,7 +45,7 @@ pub fn save_episodes(
             .iter()
             .flat_map(|e| f(e).words().map(|w| w as i64))
             .collect();
-        Tensor::from_slice(&values).view([-1, 3])
+        Tensor::from_slice(&values).view([-1, SymbolicState::WORDS as i64])
     };
     let floats = |f: &dyn Fn(&Episode) -> &[f32]| -> Tensor {
         Tensor::from_slice(
@@ -84,15 +85,22 @@ pub fn load_episodes(
     );
     let (z0, zt) = (file.ints("z0")?, file.ints("zt")?);
     let n = lengths.len();
-    if skills.len() != n || moves.len() != n || z0.len() != 3 * n || zt.len() != 3 * n {
+    // Rows of three words were written before states grew to four.
+    let width = z0.len().checked_div(n).unwrap_or(SymbolicState::WORDS);
+    if skills.len() != n
+        || moves.len() != n
+        || !(width == 3 || width == SymbolicState::WORDS)
+        || z0.len() != width * n
+        || zt.len() != width * n
+    {
         return Err(mismatch());
     }
     let state = |words: &[i64], i: usize| {
-        SymbolicState::from_words([
-            words[3 * i] as u64,
-            words[3 * i + 1] as u64,
-            words[3 * i + 2] as u64,
-        ])
+        let mut state = [0u64; SymbolicState::WORDS];
+        for (w, &word) in state.iter_mut().zip(&words[width * i..width * (i + 1)]) {
+            *w = word as u64;
+        }
+        SymbolicState::from_words(state)
     };
     let (mut po, mut pa) = (0usize, 0usize);
     let mut episodes = VecDeque::with_capacity(n);
@@ -258,5 +266,74 @@ impl Prepared {
             mean_reward: stats[0],
             skill_model_loss: stats[1],
         })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Episode tables written before symbolic states grew from three words to four (every
+    /// checkpoint of the committed studies' runs) load to the same episodes.
+    #[test]
+    fn episode_tables_of_three_word_states_still_load() {
+        let mut z = SymbolicState::ZERO;
+        for bit in [0, 70, 150, 191] {
+            z.set(bit, true);
+        }
+        let episodes: VecDeque<Episode> = [
+            Episode {
+                skill: 2,
+                obs: vec![0.5; 3 * 4],
+                actions: vec![0.25; 2 * 3],
+                z0: z,
+                zt: SymbolicState::from_u64(5),
+                game_move: Some(7),
+            },
+            Episode {
+                skill: 0,
+                obs: vec![1.0; 2 * 4],
+                actions: vec![-1.0; 3],
+                z0: SymbolicState::ZERO,
+                zt: z,
+                game_move: None,
+            },
+        ]
+        .into();
+        let dir = tempfile::tempdir().unwrap();
+        let now = dir.path().join("now.safetensors");
+        save_episodes(&now, &episodes, 3).unwrap();
+        assert_eq!(load_episodes(&now, 4, 3, 3).unwrap(), episodes);
+        // The same table with three words a state, as the older code wrote it.
+        let old = dir.path().join("old.safetensors");
+        let tensors: Vec<(String, Tensor)> = Tensor::read_safetensors(&now)
+            .unwrap()
+            .into_iter()
+            .map(|(name, t)| {
+                let t = if name == "z0" || name == "zt" {
+                    t.narrow(1, 0, 3).contiguous()
+                } else {
+                    t
+                };
+                (name, t)
+            })
+            .collect();
+        Tensor::write_safetensors(&tensors, &old).unwrap();
+        assert_eq!(load_episodes(&old, 4, 3, 3).unwrap(), episodes);
+        // A table of any other width is refused.
+        let short = dir.path().join("short.safetensors");
+        let tensors: Vec<(String, Tensor)> = tensors
+            .into_iter()
+            .map(|(name, t)| {
+                let t = if name == "z0" || name == "zt" {
+                    t.narrow(1, 0, 2).contiguous()
+                } else {
+                    t
+                };
+                (name, t)
+            })
+            .collect();
+        Tensor::write_safetensors(&tensors, &short).unwrap();
+        assert!(load_episodes(&short, 4, 3, 3).is_err());
     }
 }

@@ -178,7 +178,11 @@ fn presets_carry_the_seeds_best_settings() {
         ("lightsout-jaco", 0.5, 0.0001),
         ("tileswap-jaco", 0.5, 0.0001),
     ];
-    assert_eq!(TrainConfig::sac_presets().len(), 7, "and LightsOut3DJaco");
+    assert_eq!(
+        TrainConfig::sac_presets().len(),
+        9,
+        "and LightsOut3DJaco, sliding-cursor and -reacher"
+    );
     for (env, n, alpha) in best {
         let c = TrainConfig::preset_for(env, Algorithm::Sac).unwrap();
         c.validate().unwrap();
@@ -239,7 +243,19 @@ fn hac_presets_carry_the_seeds_best_settings() {
         ("lightsout-jaco", 0.1, 0.001, 0.001),
         ("tileswap-jaco", 0.1, 0.0001, 0.001),
     ];
-    assert_eq!(TrainConfig::hac_presets().len(), 7, "and LightsOut3DJaco");
+    // The paper's seven, and the sliding puzzle's two with its TileSwap counterparts' settings.
+    assert_eq!(TrainConfig::hac_presets().len(), 9);
+    for (sliding, tileswap) in [
+        ("sliding-cursor", "tileswap-cursor"),
+        ("sliding-reacher", "tileswap-reacher"),
+    ] {
+        let a = TrainConfig::preset_for(sliding, Algorithm::Hac).unwrap();
+        let b = TrainConfig::preset_for(tileswap, Algorithm::Hac).unwrap();
+        assert_eq!(
+            (a.hac.temperature, a.sac.alpha),
+            (b.hac.temperature, b.sac.alpha)
+        );
+    }
     for (env, temperature, alpha_low, alpha_high) in best {
         let c = TrainConfig::preset_for(env, Algorithm::Hac).unwrap();
         c.validate().unwrap();

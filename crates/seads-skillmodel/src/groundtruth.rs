@@ -1,31 +1,12 @@
 //! Forward models fitted to a game's true move table (skill k = move k): the planner's benches
 //! and tests need a learned model whose mode is known.
 
-use rand::seq::SliceRandom;
 use rand::{RngExt, SeedableRng};
 use rand_chacha::ChaCha8Rng;
-use seads_games::{BoardGame, GameKind, Successor, SymbolicState};
+use seads_games::{BoardGame, Successor, SymbolicState};
 use tch::Device;
 
 use crate::{ForwardModel, SkillModel, SkillModelConfig, SkillTransition};
-
-/// A uniformly random board of `game` (LightsOut: any bits, TileSwap: any permutation).
-fn random_board(game: &dyn BoardGame, rng: &mut ChaCha8Rng) -> SymbolicState {
-    match game.kind() {
-        GameKind::LightsOut => {
-            let mut z = SymbolicState::ZERO;
-            for d in 0..game.symbolic_len() {
-                z.set(d, rng.random::<bool>());
-            }
-            z
-        }
-        GameKind::TileSwap => {
-            let mut tiles: Vec<u8> = (0..9).collect();
-            tiles.shuffle(rng);
-            game.board_from_values(&tiles).expect("a permutation")
-        }
-    }
-}
 
 /// Fits a forward model to `game`'s moves from `steps` batches of random boards and moves.
 pub fn fit_to_game(
@@ -45,7 +26,7 @@ pub fn fit_to_game(
     for _ in 0..steps {
         let batch: Vec<SkillTransition> = (0..config.batch_size)
             .map(|_| {
-                let z0 = random_board(game, &mut rng);
+                let z0 = game.random_board(&mut rng);
                 let skill = rng.random_range(0..game.num_moves());
                 SkillTransition {
                     z0,
@@ -67,7 +48,7 @@ pub fn agreement_with_game(
     seed: u64,
 ) -> f64 {
     let mut rng = ChaCha8Rng::seed_from_u64(seed);
-    let states: Vec<SymbolicState> = (0..boards).map(|_| random_board(game, &mut rng)).collect();
+    let states: Vec<SymbolicState> = (0..boards).map(|_| game.random_board(&mut rng)).collect();
     let mut out = Vec::new();
     model.successors(&states, &mut out);
     let k = game.num_moves();

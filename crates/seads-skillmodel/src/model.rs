@@ -285,7 +285,7 @@ impl ForwardModel {
         packed
             .chunks(words)
             .map(|chunk| {
-                let mut state = [0u64; 3];
+                let mut state = [0u64; SymbolicState::WORDS];
                 for (i, &half) in chunk.iter().enumerate() {
                     state[i / 2] |= (half as u64) << (32 * (i % 2));
                 }

@@ -1,11 +1,11 @@
 //! The planning benchmark of `seads plan-bench`: breadth-first search with a forward model fitted
-//! to the LightsOut 5×5 move table, timed per depth on test boards.
+//! to a game's move table (LightsOut 5×5 by default), timed per depth on test boards.
 
 use std::time::Instant;
 
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
-use seads_games::{BoardDataset, BoardGame, LightsOut, Split};
+use seads_games::{BoardDataset, GameKind, Split};
 use seads_planner::{PlanError, PlannerConfig, find_plan};
 use seads_rl::ComputeDevice;
 use seads_skillmodel::{SkillModelConfig, agreement_with_game, fit_to_game};
@@ -16,6 +16,8 @@ use crate::{Result, StudyError};
 /// What to time.
 #[derive(Debug, Clone)]
 pub struct PlanBench {
+    /// The game, at its default size, whose move table the model is fitted to.
+    pub game: GameKind,
     /// Hidden layer sizes of the forward model.
     pub hidden: Vec<i64>,
     /// Solution depths of the boards.
@@ -149,7 +151,14 @@ impl PlanBench {
                 "--hidden, --depths and --boards must be positive",
             ));
         }
-        let game = LightsOut::new(5).expect("LightsOut 5×5 exists");
+        let game = self
+            .game
+            .build(self.game.default_size())
+            .map_err(|e| StudyError::invalid(e.to_string()))?;
+        let game = game.as_ref();
+        let listed = game.enumerable().ok_or_else(|| {
+            StudyError::invalid(format!("{}: its boards cannot be listed", self.game))
+        })?;
         let config = SkillModelConfig {
             hidden: self.hidden.clone(),
             batch_size: 256,
@@ -159,8 +168,8 @@ impl PlanBench {
             .device
             .resolve()
             .map_err(|e| StudyError::invalid(e.to_string()))?;
-        let mut model = fit_to_game(&game, &config, 1500, 1);
-        let model_agreement = agreement_with_game(&mut model, &game, 2000, 2);
+        let mut model = fit_to_game(game, &config, 1500, 1);
+        let model_agreement = agreement_with_game(&mut model, game, 2000, 2);
         model.set_int8_screen(!self.float32);
         if self.device.is_cuda() {
             model = model
@@ -168,7 +177,7 @@ impl PlanBench {
                 .map_err(|e| StudyError::Failed(format!("copying the model to the device: {e}")))?;
         }
         let before = model.screen_counts();
-        let boards = BoardDataset::build(&game, max_depth)
+        let boards = BoardDataset::build(listed, max_depth)
             .map_err(|e| StudyError::invalid(format!("boards up to depth {max_depth}: {e}")))?;
         let mut rng = ChaCha8Rng::seed_from_u64(7);
         let mut depths = Vec::new();
@@ -189,7 +198,7 @@ impl PlanBench {
             };
             for _ in 0..self.boards {
                 let board = boards.sample(depth, Split::Test, &mut rng).ok_or_else(|| {
-                    StudyError::invalid(format!("LightsOut 5×5 has no test board of depth {depth}"))
+                    StudyError::invalid(format!("{} has no test board of depth {depth}", self.game))
                 })?;
                 let start = Instant::now();
                 let plan = find_plan(&mut model, board, game.goal(), &planner);

@@ -68,7 +68,7 @@ pub fn run_skills(config: &seads_rl::TrainConfig) -> usize {
 pub fn run_game(config: &seads_rl::TrainConfig) -> Result<Box<dyn seads_games::BoardGame>> {
     let game = match seads_embodiment::make_env(&config.env, &config.env_config) {
         Ok(env) => env.spec().game.build(env.spec().board_size),
-        Err(_) => seads_games::GameKind::LightsOut.build(seads_uarm::BOARD_SIZE),
+        Err(_) => Ok(Box::new(seads_uarm::game()) as Box<dyn seads_games::BoardGame>),
     };
     game.doing(|| format!("building the game of {}", config.env))
 }

@@ -5,7 +5,7 @@ use std::collections::BTreeMap;
 use std::path::Path;
 
 use seads_embodiment::Environment as _;
-use seads_games::{BoardGame, GameKind, Gf2Solver, LightsOut};
+use seads_games::BoardGame;
 use seads_planner::{DepthResult, EvaluationRecord, Protocol, SolveConfig, solve};
 use seads_rl::Agent;
 use seads_uarm::UarmEnv;
@@ -36,8 +36,7 @@ pub fn evaluate_robot(
     };
     let mut agent = Agent::load_for(config, env.spec().clone(), checkpoint)?;
     let (policy, model) = agent.parts()?;
-    let game = LightsOut::new(5).expect("LightsOut 5×5 exists");
-    let solver = Gf2Solver::new(&game);
+    let game = seads_uarm::game();
     let protocol = Protocol::planning(true, boards, limits);
     let solve_config = SolveConfig {
         replan: true,
@@ -53,11 +52,14 @@ pub fn evaluate_robot(
             if settable {
                 let board = protocol
                     .tasks
-                    .board(GameKind::LightsOut, 5, depth, seed)
+                    .board(game.kind(), game.size(), depth, seed)
                     .map_err(env_error)?;
                 env.set_board(board).map_err(env_error)?;
             }
-            let d = solver.depth(env.board()).unwrap_or(0);
+            let d = game
+                .solution_depth(env.board())
+                .and_then(Result::ok)
+                .unwrap_or(0);
             let outcome =
                 solve(&mut env, policy, model, game.goal(), &solve_config).map_err(env_error)?;
             results

@@ -9,7 +9,7 @@ use seads_embodiment::{
     BoardState, EnvConfig, EnvError, EnvSpec, Environment, FieldView, Layout, Push, Scene, Shape,
     StepOutcome,
 };
-use seads_games::{BoardGame, GameKind, LightsOut, SymbolicState};
+use seads_games::{BoardGame, SymbolicState};
 use serde::{Deserialize, Serialize};
 
 use crate::UarmError;
@@ -253,7 +253,7 @@ impl UarmEnv {
                 "step_limit must be at least 1 and tap_timeout_s in [0, 3600] seconds".into(),
             ));
         }
-        let game = LightsOut::new(crate::BOARD_SIZE).expect("5×5");
+        let game = crate::game();
         let name = config.action_space.env_name();
         let (low, high) = match config.action_space {
             ActionSpace::Absolute => (vec![0.0, 0.0], vec![1.0, 1.0]),
@@ -261,7 +261,7 @@ impl UarmEnv {
         };
         let spec = EnvSpec {
             name: name.into(),
-            game: GameKind::LightsOut,
+            game: game.kind(),
             board_size: 5,
             manipulator_dim: 2,
             state_low: vec![f32::NEG_INFINITY; 2],
@@ -279,7 +279,7 @@ impl UarmEnv {
         let centre = [0.5, 0.5];
         arm.move_to(calibration.to_arm(0.5, 0.5, HOVER_DISPLACEMENT))?;
         let report = tablet.latest(Duration::from_secs_f64(config.tap_timeout_s.max(1.0)))?;
-        let mut board = BoardState::new(GameKind::LightsOut, 5, &EnvConfig::default())
+        let mut board = BoardState::new(crate::game().kind(), 5, &EnvConfig::default())
             .expect("LightsOut 5×5 has boards of depth 1 to 5");
         board
             .set(report.board)

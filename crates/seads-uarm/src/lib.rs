@@ -65,6 +65,11 @@ pub use calibration::{Calibration, CalibrationFile};
 
 /// Side of the LightsOut board the robot plays (on the tablet); its K is the game's 25 moves.
 pub const BOARD_SIZE: usize = 5;
+
+/// The game the robot plays: the tablet's LightsOut 5×5.
+pub fn game() -> seads_games::LightsOut {
+    seads_games::LightsOut::new(BOARD_SIZE).expect("LightsOut 5×5 exists")
+}
 pub use driver::{DriverConfig, SerialTransport, Swift, Transport};
 pub use env::{ActionSpace, Observation, RobotSettings, UarmConfig, UarmEnv};
 pub use tablet::{AdbTablet, Tablet, TabletReport};

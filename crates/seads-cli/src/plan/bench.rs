@@ -1,5 +1,5 @@
-//! `seads plan-bench`: breadth-first search with a forward model fitted to the LightsOut 5×5
-//! move table, timed per depth.
+//! `seads plan-bench`: breadth-first search with a forward model fitted to a game's move table
+//! (LightsOut 5×5 by default), timed per depth.
 
 use anyhow::{Context, Result};
 use clap::Args;
@@ -8,6 +8,9 @@ use seads_study::bench::PlanBench;
 /// Arguments of `seads plan-bench`.
 #[derive(Debug, Args)]
 pub struct PlanBenchArgs {
+    /// The game whose move table the model is fitted to (one whose boards can be listed).
+    #[arg(long, default_value = "lightsout")]
+    game: seads_games::GameKind,
     /// Hidden layer sizes of the forward model (the paper's: 256,256).
     #[arg(long, default_value = "256,256", value_delimiter = ',')]
     hidden: Vec<i64>,
@@ -47,7 +50,7 @@ pub struct PlanBenchArgs {
 /// The widest hidden layer `--hidden` may ask for (the paper's is 256).
 const MAX_WIDTH: i64 = 16_384;
 
-/// `seads plan-bench`: BFS with a forward model fitted to the LightsOut 5×5 move table.
+/// `seads plan-bench`: BFS with a forward model fitted to a game's move table.
 pub fn plan_bench(args: PlanBenchArgs) -> Result<()> {
     let device = crate::usable_device(args.device)?;
     let threads = args.threads as usize;
@@ -67,6 +70,7 @@ pub fn plan_bench(args: PlanBenchArgs) -> Result<()> {
         .build()
         .context("starting the search's threads")?;
     let bench = PlanBench {
+        game: args.game,
         hidden: args.hidden.clone(),
         depths: args.depths.clone(),
         boards: args.boards,

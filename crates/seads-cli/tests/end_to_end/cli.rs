@@ -160,15 +160,21 @@ fn envs_json_lists_every_environment() {
         [
             "lightsout-cursor",
             "tileswap-cursor",
+            "sliding-cursor",
             "lightsout-reacher",
             "tileswap-reacher",
+            "sliding-reacher",
             "lightsout-jaco",
             "tileswap-jaco",
             "lightsout3d-jaco"
         ]
     );
-    assert_eq!(v[0]["obs_dim"], 28);
-    assert_eq!(v[5]["obs_dim"], 124);
+    let obs_dim = |name: &str| v[names.iter().position(|&n| n == name).unwrap()]["obs_dim"].clone();
+    assert_eq!(obs_dim("lightsout-cursor"), 28);
+    assert_eq!(obs_dim("tileswap-jaco"), 124);
+    // The 8-puzzle under the Cursor: its position (2), 81 one-hot bits, the time left.
+    assert_eq!(obs_dim("sliding-cursor"), 84);
+    assert_eq!(v[2]["title"], "SlidingCursor");
 }
 
 #[test]

@@ -1,6 +1,6 @@
 """SEADS's physically embedded board games for Python.
 
-The environments of the Rust workspace ``seads`` (LightsOut and TileSwap under a 2-D cursor, a
+The environments of the Rust workspace ``seads`` (LightsOut, TileSwap and the sliding puzzle under a 2-D cursor, a
 planar Reacher arm or a Kinova Jaco arm) as Gymnasium environments, registered as
 ``seads/<Name>-v0`` (for example ``gymnasium.make("seads/LightsOutCursor-v0")``), with a vector
 environment that steps many of them in parallel in Rust (``gymnasium.make_vec``); the board
@@ -12,7 +12,7 @@ evaluated in Rust without libtorch, so they sit safely beside PyTorch in one pro
 
 import gymnasium
 
-from ._seads import Agent, Env, Game, VecEnv, __version__, env_names, plan
+from ._seads import Agent, Env, Game, VecEnv, __version__, env_names, game_names, plan
 from .gym import SeadsEnv, SeadsVectorEnv, gym_id
 
 __all__ = [
@@ -24,6 +24,7 @@ __all__ = [
     "VecEnv",
     "__version__",
     "env_names",
+    "game_names",
     "gym_id",
     "plan",
 ]

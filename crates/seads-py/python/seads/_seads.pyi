@@ -9,7 +9,17 @@ import numpy as np
 import numpy.typing as npt
 
 __version__: str
-__all__ = ["__version__", "env_names", "Env", "VecEnv", "Game", "Agent", "plan"]
+__all__ = [
+    "__version__",
+    "env_names",
+    "env_titles",
+    "game_names",
+    "Env",
+    "VecEnv",
+    "Game",
+    "Agent",
+    "plan",
+]
 
 _Board = Sequence[int] | npt.ArrayLike
 """A board's values: 1-D (row-major) or square (N x N), whole numbers (ints, bools or integral
@@ -17,6 +27,12 @@ floats)."""
 
 def env_names() -> list[str]:
     """The names of the registered environments (``lightsout-cursor``, …)."""
+
+def env_titles() -> dict[str, str]:
+    """Each environment's name in CamelCase (``lightsout-cursor`` -> ``LightsOutCursor``)."""
+
+def game_names() -> list[str]:
+    """The names of the registered games (``lightsout``, ``tileswap``, ``sliding``)."""
 
 @final
 class Env:
@@ -103,7 +119,8 @@ class VecEnv:
 
 @final
 class Game:
-    """``Game("lightsout", size=5)`` or ``Game("tileswap")``; boards are uint8 arrays."""
+    """``Game("lightsout", size=5)``, ``Game("tileswap")`` or ``Game("sliding", 4)`` (a name of
+    ``game_names()``); boards are uint8 arrays."""
 
     def __new__(cls, name: str, size: int | None = None) -> Self: ...
     @property

@@ -25,20 +25,15 @@ from gymnasium.vector.utils import batch_space
 
 from . import _seads
 
-_WORDS = {
-    "lightsout": "LightsOut",
-    "lightsout3d": "LightsOut3D",
-    "tileswap": "TileSwap",
-    "cursor": "Cursor",
-    "reacher": "Reacher",
-    "jaco": "Jaco",
-}
+_TITLES: dict[str, str] = _seads.env_titles()
 
 
 def gym_id(env_name: str) -> str:
     """The Gymnasium id of a Rust environment name: ``lightsout-cursor`` -> ``seads/LightsOutCursor-v0``."""
-    camel = "".join(_WORDS.get(part, part.capitalize()) for part in env_name.split("-"))
-    return f"seads/{camel}-v0"
+    try:
+        return f"seads/{_TITLES[env_name]}-v0"
+    except KeyError:
+        raise ValueError(f"unknown environment {env_name!r}; one of {sorted(_TITLES)}") from None
 
 
 def _options(options: dict[str, Any]) -> str | None:

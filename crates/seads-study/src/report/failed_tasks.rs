@@ -226,6 +226,9 @@ pub fn failed_task_tables(groups: &[Group<'_>]) -> Result<Option<(String, String
 #[cfg(test)]
 mod tests {
     use seads_games::GameKind;
+    fn game(name: &str) -> Box<dyn seads_games::BoardGame> {
+        GameKind::named(name).unwrap().build(3).unwrap()
+    }
 
     use super::*;
 
@@ -237,7 +240,7 @@ mod tests {
     /// field 0 toggles 0, 1, 3. Skill 2's first kind of deviation ran 7 and 1 steps (median 4).
     #[test]
     fn deviations_are_told_as_moves_and_grouped_by_skill_and_effect() {
-        let game = GameKind::LightsOut.build(3).unwrap();
+        let game = game("lightsout");
         let empty = "0,0,0,0,0,0,0,0,0";
         let centre = "0,1,0,1,1,1,0,1,0";
         let corner = "1,1,0,1,0,0,0,0,0";
@@ -292,7 +295,7 @@ mod tests {
     /// the counts without steps, and one step reads in the singular.
     #[test]
     fn steps_are_left_out_where_the_file_does_not_have_them() {
-        let game = GameKind::TileSwap.build(3).unwrap();
+        let game = game("tileswap");
         let (goal, swapped) = ("0,1,2,3,4,5,6,7,8", "1,0,2,3,4,5,6,7,8");
         let task = |steps: &str| {
             let text = format!(
@@ -317,7 +320,7 @@ mod tests {
 
     #[test]
     fn solved_tasks_are_skipped_and_a_broken_board_is_an_error() {
-        let game = GameKind::TileSwap.build(3).unwrap();
+        let game = game("tileswap");
         let solved = r#"{"depth":1,"solved":true,"plan_found":true,"timed_out":false,"executed":[0],"deviations":[]}"#;
         assert!(
             FailedTask::of(game.as_ref(), &line(solved))
@@ -339,7 +342,7 @@ mod tests {
     /// TileSwap: swapping back the two tiles of move 6 (cells 0 and 1) is move 6 again.
     #[test]
     fn tileswap_effects_are_its_swaps() {
-        let game = GameKind::TileSwap.build(3).unwrap();
+        let game = game("tileswap");
         let goal = "0,1,2,3,4,5,6,7,8";
         assert_eq!(
             effect(game.as_ref(), goal, "1,0,2,3,4,5,6,7,8").unwrap(),
