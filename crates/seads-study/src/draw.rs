@@ -112,10 +112,12 @@ where
     let plot = chart.plotting_area();
     for field in &scene.fields {
         let [a, b, c, d] = field.rect;
-        let fill = match field.lit {
-            Some(true) => LIT,
-            Some(false) => UNLIT,
-            None => TILE,
+        // A field with neither light nor label is empty: the sliding puzzle's gap.
+        let fill = match (field.lit, &field.label) {
+            (Some(true), _) => LIT,
+            (Some(false), _) => UNLIT,
+            (None, Some(_)) => TILE,
+            (None, None) => WHITE,
         };
         plot.draw(&Rectangle::new([(a, b), (c, d)], fill.filled()))
             .map_err(plot_err)?;
