@@ -7,8 +7,7 @@ use anyhow::{Context, Result};
 use clap::Args;
 use seads_rl::store::MetricsLine as _;
 use seads_rl::{
-    Algorithm, ComputeDevice, Hac, Hook, InWords, Learner, Moment, Run, TaskSac, TrainConfig,
-    Trainer,
+    Algorithm, ComputeDevice, Hook, InWords, Learner, Moment, Run, TrainConfig, WithLearner,
 };
 
 use crate::BadInput;
@@ -111,22 +110,50 @@ pub fn train(args: TrainArgs) -> Result<()> {
             }
             let config = crate::run_config(dir)?;
             crate::kernels::use_kernels(config.portable_numerics)?;
-            match config.algorithm {
-                Algorithm::Seads => drive(&mut resume_on::<Trainer>(dir, device)?, args.quiet),
-                Algorithm::Sac => drive(&mut resume_on::<TaskSac>(dir, device)?, args.quiet),
-                Algorithm::Hac => drive(&mut resume_on::<Hac>(dir, device)?, args.quiet),
-            }
+            config.algorithm.with_learner(Resume {
+                dir,
+                device,
+                quiet: args.quiet,
+            })
         }
         None => {
             let config = config(&args)?;
             crate::kernels::use_kernels(config.portable_numerics)?;
             let out = args.out.as_ref().expect("clap requires --out");
-            match config.algorithm {
-                Algorithm::Seads => drive(&mut create::<Trainer>(out, config)?.0, args.quiet),
-                Algorithm::Sac => drive(&mut create::<TaskSac>(out, config)?.0, args.quiet),
-                Algorithm::Hac => drive(&mut create::<Hac>(out, config)?.0, args.quiet),
-            }
+            config.algorithm.with_learner(Create {
+                out,
+                config,
+                quiet: args.quiet,
+            })
         }
+    }
+}
+
+/// `seads train --resume`'s work with the run's learner.
+struct Resume<'a> {
+    dir: &'a std::path::Path,
+    device: ComputeDevice,
+    quiet: bool,
+}
+
+impl WithLearner for Resume<'_> {
+    type Output = Result<()>;
+    fn run<L: InWords + Send>(self) -> Result<()> {
+        drive(&mut resume_on::<L>(self.dir, self.device)?, self.quiet)
+    }
+}
+
+/// `seads train`'s work with a new run's learner.
+struct Create<'a> {
+    out: &'a std::path::Path,
+    config: TrainConfig,
+    quiet: bool,
+}
+
+impl WithLearner for Create<'_> {
+    type Output = Result<()>;
+    fn run<L: InWords + Send>(self) -> Result<()> {
+        drive(&mut create::<L>(self.out, self.config)?.0, self.quiet)
     }
 }
 

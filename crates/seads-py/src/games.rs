@@ -173,7 +173,11 @@ impl Game {
             .map(|&b| self.game().values(b))
             .collect();
         if rows.is_empty() {
-            return Ok(PyArray2::zeros(py, [0, self.game().symbolic_len()], false));
+            return Ok(PyArray2::zeros(
+                py,
+                [0, self.game().size() * self.game().size()],
+                false,
+            ));
         }
         PyArray2::from_vec2(py, &rows).map_err(value_error)
     }

@@ -184,3 +184,8 @@ def test_a_game_added_in_rust_is_here_without_python_code():
         seads.plan(game, swapped)
     with pytest.raises(ValueError, match="too many boards"):
         game.boards(3)
+    # The 8-puzzle's two boards of depth 1 are both test boards: no training board, and an
+    # empty table still has a column per field.
+    eight = seads.Game("sliding")
+    assert eight.boards(1, "train").shape == (0, 9)
+    assert eight.boards(1, "test").shape == (2, 9)

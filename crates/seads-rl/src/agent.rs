@@ -7,10 +7,9 @@ use seads_embodiment::{EnvSpec, SkillPolicy, make_env};
 use seads_skillmodel::{ForwardModel, SkillModel, SkillModelKind};
 
 use crate::episode::policy_input;
-use crate::hac::HacPolicy;
 use crate::store::{checkpoints, latest_checkpoint};
 use crate::task_policy::TaskPolicy;
-use crate::{Algorithm, RlError, Sac, TrainConfig, load_config};
+use crate::{InWords, RlError, Sac, TrainConfig, WithLearner, load_config};
 
 /// The skill policy π(a | s, k) of a trained agent, executed deterministically.
 pub struct AgentPolicy {
@@ -179,22 +178,23 @@ pub fn load_policy(
 ) -> Result<Box<dyn TaskPolicy>, RlError> {
     crate::store::check_origin(checkpoint, config)?;
     let spec = make_env(&config.env, &config.env_config)?.spec().clone();
-    match config.algorithm {
-        Algorithm::Sac => {
-            let mut sac = Sac::new(
-                spec.obs_dim,
-                &spec.action_low,
-                &spec.action_high,
-                &config.sac,
-                config.device.resolve()?,
-                0,
-            );
-            sac.load(checkpoint, true)?;
-            Ok(Box::new(sac))
-        }
-        Algorithm::Hac => Ok(Box::new(HacPolicy::load(config, &spec, checkpoint)?)),
-        Algorithm::Seads => Err(RlError::Config(
-            "a SEADS run has skills and a forward model, not a task policy; plan with it".into(),
-        )),
+    config.algorithm.with_learner(LoadPolicy {
+        config,
+        spec: &spec,
+        checkpoint,
+    })
+}
+
+/// [`load_policy`]'s work with the run's learner.
+struct LoadPolicy<'a> {
+    config: &'a TrainConfig,
+    spec: &'a EnvSpec,
+    checkpoint: &'a Path,
+}
+
+impl WithLearner for LoadPolicy<'_> {
+    type Output = Result<Box<dyn TaskPolicy>, RlError>;
+    fn run<L: InWords + Send>(self) -> Self::Output {
+        L::load_task_policy(self.config, self.spec, self.checkpoint)
     }
 }

@@ -230,19 +230,29 @@ impl Default for TrainConfig {
 include!(concat!(env!("OUT_DIR"), "/presets.rs"));
 
 impl TrainConfig {
-    /// Sets the libtorch threads for a run with `cores` cores to itself: two training threads
-    /// of `cores / 2` each, and all cores for SAC while the other thread waits (a run alone on
-    /// one core keeps one thread throughout).
+    /// Sets the libtorch threads for a run with `cores` cores to itself. SEADS: two training
+    /// threads of `cores / 2` each, and all cores for SAC while the other thread waits (a run
+    /// alone on one core keeps one thread throughout). A baseline: one training thread of all
+    /// `cores`.
     ///
     /// ```
-    /// let mut config = seads_rl::TrainConfig::default();
+    /// use seads_rl::{Algorithm, TrainConfig};
+    /// let mut config = TrainConfig::default();
     /// config.use_cores(4);
     /// assert_eq!((config.threads, config.sac_threads_alone), (2, 4));
     /// config.use_cores(1);
     /// assert_eq!((config.threads, config.sac_threads_alone), (1, 0));
+    /// let mut baseline = TrainConfig { algorithm: Algorithm::Sac, ..TrainConfig::default() };
+    /// baseline.use_cores(4);
+    /// assert_eq!((baseline.threads, baseline.sac_threads_alone), (4, 0));
     /// ```
     pub fn use_cores(&mut self, cores: usize) {
         let cores = cores.max(1);
+        if self.algorithm != Algorithm::Seads {
+            self.threads = cores;
+            self.sac_threads_alone = 0;
+            return;
+        }
         self.threads = (cores / 2).max(1);
         self.sac_threads_alone = if cores >= 2 { cores } else { 0 };
     }

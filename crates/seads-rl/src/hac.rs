@@ -785,6 +785,13 @@ impl Learner for Hac {
         ];
         FILES.to_vec()
     }
+    fn load_task_policy(
+        config: &TrainConfig,
+        spec: &seads_embodiment::EnvSpec,
+        checkpoint: &std::path::Path,
+    ) -> Result<Box<dyn TaskPolicy>, RlError> {
+        Ok(Box::new(HacPolicy::load(config, spec, checkpoint)?))
+    }
 }
 
 #[cfg(test)]

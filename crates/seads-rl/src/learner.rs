@@ -3,16 +3,19 @@
 
 use std::path::Path;
 
+use seads_embodiment::EnvSpec;
+
 use crate::store::MetricsLine;
+use crate::task_policy::TaskPolicy;
 use crate::{RlError, TrainConfig};
 
 /// What a [`Run`](crate::Run) drives: an agent in training whose whole state a checkpoint folder holds.
 /// [`Trainer`](crate::Trainer) (SEADS) and [`TaskSac`](crate::TaskSac) (the task-reward baseline) are learners.
 pub trait Learner: Sized {
     /// What one epoch reports.
-    type Stats: Clone;
+    type Stats: Clone + Send;
     /// One line of `metrics.jsonl`.
-    type Metrics: MetricsLine + Clone;
+    type Metrics: MetricsLine + Clone + Send;
     /// A fresh learner for `config` (validated).
     fn build(config: TrainConfig) -> Result<Self, RlError>;
     /// The configuration.
@@ -31,6 +34,14 @@ pub trait Learner: Sized {
     fn load(&mut self, dir: &Path) -> Result<(), RlError>;
     /// The checkpoint files only resuming needs, dropped from all but the two newest.
     fn resume_only_files() -> Vec<&'static str>;
+    /// The task policy in a checkpoint folder of a run with `config` on an environment of
+    /// `spec`, for a learner trained with the task reward; an error for one that learns skills
+    /// (they plan instead).
+    fn load_task_policy(
+        config: &TrainConfig,
+        spec: &EnvSpec,
+        checkpoint: &Path,
+    ) -> Result<Box<dyn TaskPolicy>, RlError>;
 }
 
 /// Moments of a run at which a crash leaves a different state on disk. A hook set with

@@ -100,4 +100,13 @@ impl Learner for Trainer {
     fn resume_only_files() -> Vec<&'static str> {
         crate::checkpoint::resume_only_files()
     }
+    fn load_task_policy(
+        _: &TrainConfig,
+        _: &seads_embodiment::EnvSpec,
+        _: &std::path::Path,
+    ) -> Result<Box<dyn crate::TaskPolicy>, RlError> {
+        Err(RlError::Config(
+            "a SEADS run has skills and a forward model, not a task policy; plan with it".into(),
+        ))
+    }
 }

@@ -314,4 +314,21 @@ impl Learner for TaskSac {
             .copied()
             .collect()
     }
+    /// Only the actor is read: older checkpoints keep nothing else.
+    fn load_task_policy(
+        config: &TrainConfig,
+        spec: &seads_embodiment::EnvSpec,
+        checkpoint: &std::path::Path,
+    ) -> Result<Box<dyn crate::TaskPolicy>, RlError> {
+        let mut sac = Sac::new(
+            spec.obs_dim,
+            &spec.action_low,
+            &spec.action_high,
+            &config.sac,
+            config.device.resolve()?,
+            0,
+        );
+        sac.load(checkpoint, true)?;
+        Ok(Box::new(sac))
+    }
 }

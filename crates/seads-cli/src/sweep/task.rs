@@ -7,9 +7,7 @@ use std::time::Duration;
 
 use anyhow::{Context, Result};
 use seads_rl::store::MetricsLine as _;
-use seads_rl::{
-    Algorithm, ComputeDevice, Hac, Learner, Members, Population, Run, TaskSac, TrainConfig, Trainer,
-};
+use seads_rl::{Algorithm, ComputeDevice, Learner, Members, Population, Run, WithLearner};
 
 use seads_rl::InWords;
 use seads_skillmodel::SkillModelKind;
@@ -79,29 +77,36 @@ pub fn run_task(
     }
 }
 
-/// Trains (or resumes) one run to its budget with `cores` cores: SEADS on two training threads
-/// (see [`seads_rl::TrainConfig::use_cores`]), a baseline on one.
+/// Trains (or resumes) one run to its budget with `cores` cores: SEADS on two training threads,
+/// a baseline on one ([`seads_rl::TrainConfig::use_cores`]).
 fn train(run: &Path, cores: usize, device: ComputeDevice) -> Result<()> {
     let config =
         seads_rl::load_config(run).with_context(|| format!("loading {}", run.display()))?;
     crate::kernels::use_kernels(config.portable_numerics)?;
-    match config.algorithm {
-        Algorithm::Seads => train_one::<Trainer>(run, |c| c.use_cores(cores), device),
-        Algorithm::Sac => train_one::<TaskSac>(run, |c| c.threads = cores, device),
-        Algorithm::Hac => train_one::<Hac>(run, |c| c.threads = cores, device),
+    config
+        .algorithm
+        .with_learner(TrainOne { run, cores, device })
+}
+
+/// [`train`]'s work with the run's learner.
+struct TrainOne<'a> {
+    run: &'a Path,
+    cores: usize,
+    device: ComputeDevice,
+}
+
+impl WithLearner for TrainOne<'_> {
+    type Output = Result<()>;
+    fn run<L: InWords + Send>(self) -> Result<()> {
+        train_one::<L>(self.run, self.cores, self.device)
     }
 }
 
-fn train_one<L: InWords>(
-    run: &Path,
-    threads: impl Fn(&mut TrainConfig),
-    device: ComputeDevice,
-) -> Result<()> {
+fn train_one<L: InWords>(run: &Path, cores: usize, device: ComputeDevice) -> Result<()> {
     let mut training = crate::train::resume(
         run,
         Run::resume_with(run, |mut c| {
-            c.sac_threads_alone = 0;
-            threads(&mut c);
+            c.use_cores(cores);
             c.device = device;
             L::build(c)
         }),
@@ -128,13 +133,30 @@ fn train_population(runs: &[&Path], cores: usize, device: ComputeDevice) -> Resu
     let config = seads_rl::load_config(runs[0])?;
     crate::kernels::use_kernels(config.portable_numerics)?;
     let cpu = ComputeDevice::Cpu;
-    match config.algorithm {
-        Algorithm::Seads if device != cpu => train_members(runs, cpu, |members| {
+    if config.algorithm == Algorithm::Seads && device != cpu {
+        return train_members(runs, cpu, |members| {
             seads_rl::StackedPopulation::new(members, cores, device)
-        }),
-        Algorithm::Seads => train_members(runs, device, |m| Population::<Trainer>::new(m, cores)),
-        Algorithm::Sac => train_members(runs, device, |m| Population::<TaskSac>::new(m, cores)),
-        Algorithm::Hac => train_members(runs, device, |m| Population::<Hac>::new(m, cores)),
+        });
+    }
+    config.algorithm.with_learner(TrainPopulation {
+        runs,
+        cores,
+        device,
+    })
+}
+
+/// [`train_population`]'s work with the runs' learner, on the CPU or one device.
+struct TrainPopulation<'a> {
+    runs: &'a [&'a Path],
+    cores: usize,
+    device: ComputeDevice,
+}
+
+impl WithLearner for TrainPopulation<'_> {
+    type Output = Result<()>;
+    fn run<L: InWords + Send>(self) -> Result<()> {
+        let cores = self.cores;
+        train_members(self.runs, self.device, |m| Population::<L>::new(m, cores))
     }
 }
 

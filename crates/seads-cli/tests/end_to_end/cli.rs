@@ -441,8 +441,8 @@ fn solve_evaluate_and_plot_a_trained_run() {
         "--board",
         board,
         "--replan",
-        "--timeout",
-        "0.5",
+        "--max-expanded",
+        "2000",
         "--json",
     ]);
     assert_eq!(v["board"], board);
@@ -517,8 +517,8 @@ fn solve_evaluate_and_plot_a_trained_run() {
         "1-2",
         "--boards",
         "2",
-        "--timeout",
-        "0.5",
+        "--max-expanded",
+        "2000",
         "--replan",
         "--json",
     ]);
@@ -570,8 +570,8 @@ fn solve_evaluate_and_plot_a_trained_run() {
         figures.to_str().unwrap(),
         "--boards",
         "1",
-        "--timeout",
-        "0.5",
+        "--max-expanded",
+        "2000",
     ]);
     for name in ["coverage", "success", "trajectories", "pushes"] {
         assert_eq!(
@@ -880,8 +880,8 @@ fn uarm_twin_calibrates_and_trains() {
         "12",
         "--boards",
         "1",
-        "--timeout",
-        "0.2",
+        "--max-expanded",
+        "2000",
         "--out",
         run.to_str().unwrap(),
         "--quiet",
@@ -947,8 +947,8 @@ fn a_resumed_robot_run_keeps_its_action_space() {
             "12",
             "--boards",
             "1",
-            "--timeout",
-            "0.2",
+            "--max-expanded",
+            "2000",
             "--out",
             s(&run),
             "--quiet",
@@ -1003,8 +1003,8 @@ fn a_resumed_robot_run_keeps_its_action_space() {
             s(&run),
             "--boards",
             "1",
-            "--timeout",
-            "0.2",
+            "--max-expanded",
+            "2000",
             "--quiet",
         ];
         args.extend_from_slice(extra);
