@@ -804,3 +804,29 @@ fn code_only(source: &str) -> String {
     }
     out
 }
+
+/// Manipulators likewise: no source outside seads-embodiment names the Cursor, the Reacher or
+/// the Jaco (the robot's crate has its own arm); everything else reaches them through the
+/// environment registry and the `Environment` trait.
+#[test]
+fn no_manipulator_is_named_outside_the_embodiment_crate() {
+    let types = ["Cursor", "Reacher", "Jaco", "JacoBoard"];
+    let mut offenders = Vec::new();
+    let mut checked = 0;
+    for entry in std::fs::read_dir(root().join("crates")).unwrap() {
+        let dir = entry.unwrap().path();
+        if dir.ends_with("seads-embodiment") {
+            continue;
+        }
+        for file in rust_files(&dir.join("src")) {
+            let text = std::fs::read_to_string(&file).unwrap();
+            checked += 1;
+            let code = code_only(text.split("#[cfg(test)]").next().unwrap_or(""));
+            for word in words(&code).filter(|w| types.contains(w)) {
+                offenders.push(format!("{} names {word}", file.display()));
+            }
+        }
+    }
+    assert!(checked > 50, "{checked} source files checked");
+    assert!(offenders.is_empty(), "{offenders:#?}");
+}
