@@ -47,6 +47,9 @@ def main() -> None:
     predicted = [collections.Counter() for _ in range(k)]
     per_move = [collections.Counter() for _ in range(k)]
     directions = [collections.Counter() for _ in range(k)]
+    # Whether the predicted successor is a board at all (each tile once) and how many fields
+    # it changes.
+    valid, changed_fields = 0, collections.Counter()
     per_direction = [collections.Counter() for _ in range(k)]
     for board in boards:
         after = {m: game.apply(board, m) for m in range(game.num_moves)}
@@ -54,6 +57,8 @@ def main() -> None:
         successors = agent.successors(board)
         for skill in range(k):
             z = successors[skill]
+            valid += sorted(z.tolist()) == list(range(9))
+            changed_fields[int((z != board).sum())] += 1
             if np.array_equal(z, board):
                 kind = "nothing"
             else:
@@ -105,12 +110,18 @@ def main() -> None:
                          "predicts_it_there": hits / exists if exists else None,
                          "predictions": dict(directions[skill])})
     report = {"run": args.run, "epoch": agent.epoch, "boards": len(boards),
-              "max_depth": args.depth, "skills": rows, "relative_to_the_gap": relative}
+              "max_depth": args.depth,
+              "predictions_that_are_boards": valid / (len(boards) * k),
+              "predictions_by_fields_changed": {str(n): c for n, c in sorted(changed_fields.items())},
+              "skills": rows, "relative_to_the_gap": relative}
     text = json.dumps(report, indent=1)
     if args.out:
         with open(args.out, "w") as f:
             f.write(text + "\n")
     print(f"{len(boards)} boards of depth 1-{args.depth}; agent at epoch {agent.epoch}")
+    print(f"predicted successors that are boards (each tile once): "
+          f"{100 * report['predictions_that_are_boards']:.1f} %; fields changed: "
+          f"{report['predictions_by_fields_changed']} (a slide changes 2)")
     print("skill  move  where it exists: predicted   where it does not: nothing / another move")
     for r in rows:
         if r["move"] is None:
