@@ -25,9 +25,10 @@ pub(crate) static ENTRY: GameEntry = GameEntry {
 /// Largest board side: 16 cells of 16 tiles fill a 256-bit [`SymbolicState`].
 const MAX_CELLS: usize = 16;
 
-/// Depths up to which the 15-puzzle's boards of one depth are listed to tell whether a split
-/// lacks them (depth 10 has 1,948 boards); deeper layers hold many boards in both splits.
-const LISTED_DEPTHS: usize = 10;
+/// Depths up to which the 15-puzzle's boards of one depth are listed, to draw among them and to
+/// tell whether a split lacks them (depth 12 has 7,808 boards); deeper layers hold many boards in
+/// both splits.
+const LISTED_DEPTHS: usize = 12;
 
 /// The sliding puzzle on an N×N board, N ∈ {3, 4}. A board holds a permutation of the tile ids
 /// 0..N²−1, where 0 is the gap; the goal has tile `1 + p` at cell p and the gap in the last cell.
@@ -35,13 +36,19 @@ const LISTED_DEPTHS: usize = 10;
 #[derive(Debug, Clone)]
 pub struct SlidingPuzzle {
     n: usize,
+    /// The boards of each depth up to [`LISTED_DEPTHS`], listed on first use: every reset at a
+    /// shallow depth draws among them.
+    layers: OnceLock<Vec<Vec<SymbolicState>>>,
 }
 
 impl SlidingPuzzle {
     /// The puzzle of side `n` (3: the 8-puzzle, 4: the 15-puzzle).
     pub fn new(n: usize) -> Result<Self, GameError> {
         if (3..=4).contains(&n) {
-            Ok(Self { n })
+            Ok(Self {
+                n,
+                layers: OnceLock::new(),
+            })
         } else {
             Err(GameError::UnsupportedSize {
                 game: "sliding",
@@ -89,24 +96,28 @@ impl SlidingPuzzle {
         (inversions + gap / self.n + gap % self.n) % 2 == 1
     }
 
-    /// The boards of solution depth `depth`, by breadth-first search from the goal.
-    fn layer(&self, depth: usize) -> Vec<SymbolicState> {
-        let goal = self.goal();
-        let mut seen = std::collections::BTreeSet::from([goal]);
-        let mut layer = vec![goal];
-        for _ in 0..depth {
-            let mut next = Vec::new();
-            for &board in &layer {
-                for mv in 0..self.cells() {
-                    let after = self.apply(board, mv);
-                    if seen.insert(after) {
-                        next.push(after);
+    /// The boards of solution depth `depth` ≤ [`LISTED_DEPTHS`], by breadth-first search from
+    /// the goal (once per game).
+    fn layer(&self, depth: usize) -> &[SymbolicState] {
+        let layers = self.layers.get_or_init(|| {
+            let goal = self.goal();
+            let mut seen = std::collections::BTreeSet::from([goal]);
+            let mut layers = vec![vec![goal]];
+            for _ in 0..LISTED_DEPTHS {
+                let mut next = Vec::new();
+                for &board in layers.last().expect("the goal layer") {
+                    for mv in 0..self.cells() {
+                        let after = self.apply(board, mv);
+                        if seen.insert(after) {
+                            next.push(after);
+                        }
                     }
                 }
+                layers.push(next);
             }
-            layer = next;
-        }
-        layer
+            layers
+        });
+        &layers[depth]
     }
 }
 
@@ -212,7 +223,8 @@ impl BoardGame for SlidingPuzzle {
     fn enumerable(&self) -> Option<&dyn Enumerable> {
         (self.n == 3).then_some(self as &dyn Enumerable)
     }
-    /// A board of exactly `depth`: a random walk of `depth` slides that never undoes the last
+    /// A board of exactly `depth` in `split`: drawn among the listed boards of that depth up to
+    /// [`LISTED_DEPTHS`]; deeper, a random walk of `depth` slides that never undoes the last
     /// one, kept when the solver finds it that deep and it lies in `split`.
     fn sample_at_depth(
         &self,
@@ -223,7 +235,8 @@ impl BoardGame for SlidingPuzzle {
         if depth <= LISTED_DEPTHS {
             return self
                 .layer(depth)
-                .into_iter()
+                .iter()
+                .copied()
                 .filter(|&b| split_of(&self.values(b)) == split)
                 .collect::<Vec<_>>()
                 .choose(rng)
@@ -310,7 +323,7 @@ impl Enumerable for SlidingPuzzle {
 fn eight_puzzle_table() -> &'static DepthTable {
     static TABLE: OnceLock<DepthTable> = OnceLock::new();
     TABLE.get_or_init(|| {
-        DepthTable::build(&SlidingPuzzle { n: 3 }).expect("the 8-puzzle enumerates")
+        DepthTable::build(&SlidingPuzzle::new(3).expect("3×3")).expect("the 8-puzzle enumerates")
     })
 }
 
@@ -485,7 +498,7 @@ mod tests {
         let g = SlidingPuzzle::new(4).unwrap();
         assert!(g.enumerable().is_none());
         for d in [0, 1, 2, 5, 9, 12] {
-            for board in g.layer(d).into_iter().take(5) {
+            for &board in g.layer(d).iter().take(5) {
                 let moves = g.solve(board).unwrap().unwrap();
                 assert_eq!(moves.len(), d);
                 assert!(g.is_goal(g.apply_all(board, &moves)));
