@@ -224,8 +224,8 @@ impl BoardGame for SlidingPuzzle {
         (self.n == 3).then_some(self as &dyn Enumerable)
     }
     /// A board of exactly `depth` in `split`: drawn among the listed boards of that depth up to
-    /// [`LISTED_DEPTHS`]; deeper, a random walk of `depth` slides that never undoes the last
-    /// one, kept when the solver finds it that deep and it lies in `split`.
+    /// depth 12 (`LISTED_DEPTHS`); deeper, a random walk of `depth` slides that never undoes the
+    /// last one, kept when the solver finds it that deep and it lies in `split`.
     fn sample_at_depth(
         &self,
         depth: usize,
