@@ -341,14 +341,14 @@ fn robot_config(env: &UarmEnv, args: &UarmTrainArgs) -> Result<TrainConfig> {
     config.seed = args.seed;
     config.sac.alpha = 0.1;
     if args.action_space == ActionSpace::Absolute {
-        config.episodes_per_epoch = 4;
+        config.seads.episodes_per_epoch = 4;
     }
     let training = &args.training;
     if let Some(n) = training.updates_per_epoch {
         config.sac.updates_per_epoch = n as usize;
     }
     if let Some(n) = training.episodes_per_epoch {
-        config.episodes_per_epoch = n as usize;
+        config.seads.episodes_per_epoch = n as usize;
     }
     if let Some(alpha) = training.alpha {
         config.sac.alpha = alpha;

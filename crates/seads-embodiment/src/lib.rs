@@ -56,6 +56,7 @@ mod layout;
 mod noise;
 mod policy;
 mod reacher;
+mod reacher3;
 mod record;
 mod registry;
 mod runner;
@@ -75,6 +76,7 @@ pub use layout::Layout;
 pub use noise::{ACTION_NOISE_STREAM, ActionNoise};
 pub use policy::{SkillPolicy, SkillRun, execute_skill};
 pub use reacher::Reacher;
+pub use reacher3::Reacher3;
 pub use record::{
     Comparison, EpisodeRecord, ReplayError, StepRecord, compare, record_episode, replay_episode,
     restore_state,

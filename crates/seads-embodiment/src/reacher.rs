@@ -14,13 +14,13 @@ use crate::cursor::PUSH_THRESHOLD;
 use crate::{Manipulator, Push, Shape, Touch};
 
 /// Physics time step (MuJoCo default), s.
-const H: f64 = 0.02;
+pub(crate) const H: f64 = 0.02;
 /// Physics steps per environment step (action repeat).
-const SUBSTEPS: usize = 2;
+pub(crate) const SUBSTEPS: usize = 2;
 /// Joint damping, N·m·s/rad.
-const DAMPING: f64 = 0.01;
+pub(crate) const DAMPING: f64 = 0.01;
 /// Motor gear: torque = GEAR · control.
-const GEAR: f64 = 0.05;
+pub(crate) const GEAR: f64 = 0.05;
 /// Upper arm length, m.
 const L1: f64 = 0.12;
 /// Distance wrist → fingertip, m.
@@ -34,17 +34,17 @@ const M2: f64 = 0.0397935069;
 /// Wrist → forearm centre of mass, m.
 const C2: f64 = 0.0573684211;
 /// Wrist limit ±160°.
-const WRIST_LIMIT: f64 = 2.792_526_803_190_927;
+pub(crate) const WRIST_LIMIT: f64 = 2.792_526_803_190_927;
 /// MuJoCo's constraint regulariser weight: (M⁻¹)₂₂ at q = 0.
 const INV_WEIGHT0: f64 = 20740.5487;
 /// Soft-limit impedance (solimp 0.9, 0.95, width 0.001, midpoint 0.5, power 2).
 const IMP_MIN: f64 = 0.9;
-const IMP_MAX: f64 = 0.95;
+pub(crate) const IMP_MAX: f64 = 0.95;
 const IMP_WIDTH: f64 = 0.001;
 /// Constraint time constant 0.02 s, raised to 2h by MuJoCo; damping ratio 1.
-const TIME_CONST: f64 = 2.0 * H;
+pub(crate) const TIME_CONST: f64 = 2.0 * H;
 /// Half-size of the board, m (the board spans [−0.15, 0.15]²).
-const BOARD_HALF: f64 = 0.15;
+pub(crate) const BOARD_HALF: f64 = 0.15;
 
 /// Joint state of the arm: angles q (shoulder, wrist) and velocities q̇.
 #[derive(Debug, Clone, Copy, Default, PartialEq)]
@@ -56,7 +56,7 @@ pub struct Reacher {
 }
 
 /// Impedance of the soft limit at violation depth `depth` ≥ 0.
-fn impedance(depth: f64) -> f64 {
+pub(crate) fn impedance(depth: f64) -> f64 {
     let x = depth / IMP_WIDTH;
     if x >= 1.0 {
         return IMP_MAX;
@@ -131,7 +131,7 @@ impl Reacher {
 }
 
 /// World plane (m) → normalised board coordinates (no flip: row 0 at y ≈ −0.15).
-fn to_board(p: [f64; 2]) -> [f64; 2] {
+pub(crate) fn to_board(p: [f64; 2]) -> [f64; 2] {
     [
         (p[0] + BOARD_HALF) / (2.0 * BOARD_HALF),
         (p[1] + BOARD_HALF) / (2.0 * BOARD_HALF),
@@ -277,6 +277,40 @@ mod tests {
             [-0.18596017210892762, -2.809363545113862],
             [0.7019913945536199, -0.8218370961467438],
         );
+    }
+
+    /// The closed form against MuJoCo itself: single steps of a two-link model with the
+    /// Reacher's parameters, free and against the wrist limit, recorded by MuJoCo 4
+    /// (`scripts/reference/reacher3_mujoco.py`).
+    #[test]
+    fn steps_match_mujoco() {
+        let text = include_str!("../../../data/reference/reacher3/steps.json");
+        let data: serde_json::Value = serde_json::from_str(text).unwrap();
+        let two = |v: &serde_json::Value| [v[0].as_f64().unwrap(), v[1].as_f64().unwrap()];
+        let steps = data["two_link"]["steps"].as_array().unwrap();
+        let limited = steps
+            .iter()
+            .filter(|s| two(&s["q"])[1].abs() > WRIST_LIMIT)
+            .count();
+        assert!(limited >= 50 && steps.len() - limited >= 50, "{limited}");
+        for step in steps {
+            let mut arm = Reacher {
+                q: two(&step["q"]),
+                qd: two(&step["qd"]),
+            };
+            arm.physics_step(two(&step["u"]));
+            let (q, qd) = (two(&step["q_next"]), two(&step["qd_next"]));
+            for i in 0..2 {
+                assert!(
+                    (arm.q[i] - q[i]).abs() < 1e-9 && (arm.qd[i] - qd[i]).abs() < 1e-7,
+                    "{step}: joint {i}: q {} against {}, q̇ {} against {}",
+                    arm.q[i],
+                    q[i],
+                    arm.qd[i],
+                    qd[i]
+                );
+            }
+        }
     }
 
     #[test]

@@ -1,7 +1,8 @@
 //! Environments by name (SPEC §2.5): `make_env("lightsout-cursor", &config)`.
 //!
-//! An environment is a (game × manipulator) pair. The Cursor and the Reacher play every game of
-//! the games' registry (`<game>-cursor`, `<game>-reacher`), so a new game needs no entry here;
+//! An environment is a (game × manipulator) pair. The Cursor and the Reachers play every game of
+//! the games' registry (`<game>-cursor`, `<game>-reacher`, `<game>-reacher3`), so a new game
+//! needs no entry here;
 //! the Jaco arm plays the games it has a physical board for.
 
 use std::sync::OnceLock;
@@ -10,7 +11,9 @@ use seads_games::{BoardGame, GameKind, MoveSite};
 use serde::Serialize;
 
 use crate::board::BoardState;
-use crate::{Cursor, Embodied, EnvConfig, EnvError, Environment, Layout, Manipulator, Reacher};
+use crate::{
+    Cursor, Embodied, EnvConfig, EnvError, Environment, Layout, Manipulator, Reacher, Reacher3,
+};
 #[cfg(feature = "jaco")]
 use crate::{Jaco, JacoBoard};
 
@@ -28,12 +31,13 @@ struct Entry {
 enum Embodiment {
     Cursor,
     Reacher,
+    Reacher3,
     #[cfg(feature = "jaco")]
     Jaco(JacoBoard),
 }
 
 /// The manipulators that play every game: name, title and how they push.
-const EVERY_GAME: [(Embodiment, &str, &str, &str); 2] = [
+const EVERY_GAME: [(Embodiment, &str, &str, &str); 3] = [
     (
         Embodiment::Cursor,
         "cursor",
@@ -46,9 +50,15 @@ const EVERY_GAME: [(Embodiment, &str, &str, &str); 2] = [
         "Reacher",
         "under a planar 2-link Reacher arm (exact MuJoCo dynamics)",
     ),
+    (
+        Embodiment::Reacher3,
+        "reacher3",
+        "Reacher3",
+        "under a planar 3-link Reacher arm (MuJoCo's dynamics)",
+    ),
 ];
 
-/// Every environment: the Cursor and the Reacher on each game, then the Jaco boards.
+/// Every environment: the Cursor and the two Reachers on each game, then the Jaco boards.
 fn registry() -> &'static [Entry] {
     static REGISTRY: OnceLock<Vec<Entry>> = OnceLock::new();
     REGISTRY.get_or_init(|| {
@@ -157,6 +167,7 @@ pub fn make_env(name: &str, config: &EnvConfig) -> Result<Box<dyn Environment>, 
     Ok(match entry.embodiment {
         Embodiment::Cursor => build(name, Cursor::default(), board, layout, config),
         Embodiment::Reacher => build(name, Reacher::default(), board, layout, config),
+        Embodiment::Reacher3 => build(name, Reacher3::default(), board, layout, config),
         #[cfg(feature = "jaco")]
         Embodiment::Jaco(jaco) => {
             let substeps = config

@@ -171,6 +171,8 @@ def test_a_game_added_in_rust_is_here_without_python_code():
     assert seads.game_names() == ["lightsout", "tileswap", "sliding"]
     ids = {seads.gym_id(n) for n in seads.env_names()}
     assert {"seads/SlidingCursor-v0", "seads/SlidingReacher-v0"} <= ids
+    # The three-link arm is one Rust file too.
+    assert {"seads/LightsOutReacher3-v0", "seads/SlidingReacher3-v0"} <= ids
     game = seads.Game("sliding", 4)
     goal = game.goal()
     assert list(goal) == list(range(1, 16)) + [0]

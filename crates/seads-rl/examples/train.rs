@@ -16,11 +16,11 @@ fn run(steps: u64, dir: &Path) -> Result<f64, RlError> {
     let mut config = TrainConfig::preset("lightsout-cursor")?;
     config.env_steps = steps;
     config.sac.hidden = vec![64, 64];
-    config.skill_model.hidden = vec![64, 64];
+    config.seads.skill_model.hidden = vec![64, 64];
     (
         config.eval_every,
         config.checkpoint_every,
-        config.eval_seeds,
+        config.seads.eval_seeds,
     ) = (10, 10, 4);
     let mut run = Run::<Trainer>::create(dir, config)?;
     while !run.finished() {

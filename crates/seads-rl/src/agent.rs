@@ -120,7 +120,7 @@ impl Agent {
         // network size) would evaluate another agent than the one trained, so it is refused as
         // a resume refuses it.
         crate::store::check_config(checkpoint, &config)?;
-        let k = config.num_skills.unwrap_or(spec.num_skills);
+        let k = config.seads.num_skills.unwrap_or(spec.num_skills);
         let device = config.device.resolve()?;
         let mut sac = Sac::new(
             spec.obs_dim + k,
@@ -131,10 +131,10 @@ impl Agent {
             0,
         );
         sac.load(checkpoint, true)?;
-        let model = match config.skill_model.kind {
+        let model = match config.seads.skill_model.kind {
             SkillModelKind::Forward => {
                 let mut model =
-                    ForwardModel::new(spec.symbolic_len, k, &config.skill_model, device, 0);
+                    ForwardModel::new(spec.symbolic_len, k, &config.seads.skill_model, device, 0);
                 model.load(checkpoint, false)?;
                 Some(model)
             }

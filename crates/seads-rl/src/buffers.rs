@@ -55,13 +55,13 @@ pub type RelabelObserver = dyn FnMut(&Relabelling<'_>) + Send;
 impl Buffers<'_> {
     /// Updates start once the buffer holds `sampled_episodes` episodes.
     pub(crate) fn ready(&self) -> bool {
-        self.episodes.len() >= self.config.sampled_episodes
+        self.episodes.len() >= self.config.seads.sampled_episodes
     }
 
     /// Appends new episodes, dropping the oldest beyond the capacity.
     pub(crate) fn push(&mut self, new: Vec<Episode>) {
         for episode in new {
-            if self.episodes.len() == self.config.buffer_capacity {
+            if self.episodes.len() == self.config.seads.buffer_capacity {
                 self.episodes.pop_front();
             }
             self.episodes.push_back(episode);
@@ -72,14 +72,14 @@ impl Buffers<'_> {
     /// buffer (all of it if it holds exactly that many), followed by the recent episodes.
     fn update_batch(&mut self) -> Vec<usize> {
         let n = self.episodes.len();
-        let mut batch: Vec<usize> = if n == self.config.sampled_episodes {
+        let mut batch: Vec<usize> = if n == self.config.seads.sampled_episodes {
             (0..n).collect()
         } else {
-            (0..self.config.sampled_episodes)
+            (0..self.config.seads.sampled_episodes)
                 .map(|_| self.rng.random_range(0..n))
                 .collect()
         };
-        batch.extend(n.saturating_sub(self.config.recent_episodes)..n);
+        batch.extend(n.saturating_sub(self.config.seads.recent_episodes)..n);
         batch
     }
 
@@ -94,7 +94,7 @@ impl Buffers<'_> {
         let mut clipped = Vec::with_capacity(scores.len());
         let mut rewards = Vec::with_capacity(scores.len());
         for row in scores.chunks(self.k) {
-            let (c, r) = episode_rewards(row, likelihoods, &self.config.reward);
+            let (c, r) = episode_rewards(row, likelihoods, &self.config.seads.reward);
             clipped.extend(c);
             rewards.extend(r);
         }
@@ -125,7 +125,12 @@ impl Buffers<'_> {
             .flat_map(|&e| clipped[e * k..(e + 1) * k].iter().copied())
             .collect();
         let chosen_labels: Vec<usize> = chosen.iter().map(|&e| labels[eligible[e]]).collect();
-        let new = relabel(self.config.relabel.kind, &chosen_clipped, k, &chosen_labels);
+        let new = relabel(
+            self.config.seads.relabel.kind,
+            &chosen_clipped,
+            k,
+            &chosen_labels,
+        );
         if let Some(observer) = self.observer.as_mut() {
             observer(&Relabelling {
                 batch: which,
@@ -146,7 +151,7 @@ impl Buffers<'_> {
     pub(crate) fn skill_model_batch(&mut self, model: &dyn SkillModel) -> Vec<SkillTransition> {
         let batch = self.update_batch();
         let eligible: Vec<usize> = (0..batch.len()).collect();
-        let (clipped, _) = if self.config.relabel.skill_model_p > 0.0 {
+        let (clipped, _) = if self.config.seads.relabel.skill_model_p > 0.0 {
             self.score(model, &batch)
         } else {
             Default::default()
@@ -156,7 +161,7 @@ impl Buffers<'_> {
             &batch,
             &eligible,
             &clipped,
-            self.config.relabel.skill_model_p,
+            self.config.seads.relabel.skill_model_p,
         );
         batch
             .iter()
@@ -192,7 +197,7 @@ impl Buffers<'_> {
             &batch,
             &eligible,
             &clipped,
-            config.relabel.sac_p,
+            config.seads.relabel.sac_p,
         );
         let mut finals = vec![minimum_reward(self.k); batch.len()];
         for (e, &j) in eligible.iter().enumerate() {
@@ -319,13 +324,11 @@ mod tests {
     }
 
     fn config(sampled: usize, recent: usize, capacity: usize) -> TrainConfig {
-        let mut config = TrainConfig {
-            sampled_episodes: sampled,
-            recent_episodes: recent,
-            buffer_capacity: capacity,
-            ..TrainConfig::default()
-        };
-        config.relabel.sac_p = 1.0;
+        let mut config = TrainConfig::default();
+        config.seads.sampled_episodes = sampled;
+        config.seads.recent_episodes = recent;
+        config.seads.buffer_capacity = capacity;
+        config.seads.relabel.sac_p = 1.0;
         config
     }
 

@@ -2,120 +2,21 @@
 
 use seads_embodiment::{EnvConfig, env_names};
 use seads_nn::ComputeDevice;
-use seads_skillmodel::{RelabelKind, RewardConfig, SkillModelConfig};
 use serde::{Deserialize, Serialize};
 
-use crate::{RlError, SacConfig};
+use crate::sections::{Algorithm, BaselineConfig, HacConfig, MAX_PER_EPOCH, SeadsConfig};
+use crate::{RlError, SacConfig, flat_layout};
 
-/// Relabelling switches (SPEC §3.6; the ablations set the probabilities to 0).
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields, default)]
-pub struct RelabelConfig {
-    /// Assignment (SEADS) or independent maximum.
-    pub kind: RelabelKind,
-    /// Probability that an episode of the forward-model batch may be relabelled.
-    pub skill_model_p: f64,
-    /// Probability that a board-changing episode of the SAC batch may be relabelled.
-    pub sac_p: f64,
-}
-
-impl Default for RelabelConfig {
-    fn default() -> Self {
-        Self {
-            kind: RelabelKind::Assignment,
-            skill_model_p: 1.0,
-            sac_p: 0.5,
-        }
-    }
-}
-
-/// What a run trains.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
-#[serde(rename_all = "lowercase")]
-pub enum Algorithm {
-    /// SEADS: reward-free skills and their forward model (SPEC §3).
-    #[default]
-    Seads,
-    /// The flat SAC baseline with the task reward (SPEC §5.1).
-    Sac,
-    /// The two-level HAC baseline with the task reward (SPEC §5.2).
-    Hac,
-}
-
-impl Algorithm {
-    /// The name in configs and on the command line.
-    pub fn name(self) -> &'static str {
-        match self {
-            Algorithm::Seads => "seads",
-            Algorithm::Sac => "sac",
-            Algorithm::Hac => "hac",
-        }
-    }
-
-    /// Whether it is a task-reward baseline (SAC or HAC).
-    pub fn is_baseline(self) -> bool {
-        self != Algorithm::Seads
-    }
-}
-
-/// Settings of the task-reward baselines (SPEC §5.1); SEADS ignores them.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields, default)]
-pub struct BaselineConfig {
-    /// Transitions kept in the replay buffer (the most recent).
-    pub replay_capacity: usize,
-    /// Environments stepped once per epoch: the new transitions of an epoch.
-    pub samples_per_epoch: usize,
-    /// Gradient steps per epoch N; N < 1 means one step every 1/N epochs.
-    pub updates_per_epoch: f64,
-    /// Test boards per depth 1–5 of each task-success evaluation.
-    pub eval_boards: usize,
-}
-
-impl Default for BaselineConfig {
-    fn default() -> Self {
-        Self {
-            replay_capacity: 1_000_000,
-            samples_per_epoch: 8,
-            updates_per_epoch: 1.0,
-            eval_boards: 20,
-        }
-    }
-}
-
-/// Settings of the HAC baseline (SPEC §5.2) beyond those it shares with SAC: the low level is the
-/// `[sac]` section (its α is α_low), the high level has the same networks and optimiser with
-/// its own α. Choices where the seed is silent follow Levy's HAC (`src/hac.rs`).
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields, default)]
-pub struct HacConfig {
-    /// Temperature τ_RB of the high level's RelaxedBernoulli policy.
-    pub temperature: f64,
-    /// Fixed entropy temperature α_high of the high level.
-    pub alpha_high: f64,
-    /// Low-level steps a subgoal may take, H (the presets: the environment's steps per skill).
-    pub subgoal_horizon: usize,
-    /// Share of subgoals tested: pursued without exploration noise, and penalised when missed.
-    pub subgoal_test_p: f64,
-}
-
-impl Default for HacConfig {
-    fn default() -> Self {
-        Self {
-            temperature: 0.1,
-            alpha_high: 0.001,
-            subgoal_horizon: 10,
-            subgoal_test_p: 0.3,
-        }
-    }
-}
-
-/// Everything a SEADS training run needs. `Default` is the LightsOutCursor preset of the paper.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+/// Everything a training run needs: the run's own settings (environment, seed, budget,
+/// evaluation and checkpoint cadence, threads, numerics, device), the soft actor-critic that
+/// every algorithm trains (`[sac]`; HAC's low level), and the section of the run's algorithm:
+/// `[seads]`, `[sac_baseline]` or `[hac]`. A file holds only its algorithm's section; the other
+/// sections stay at their defaults in memory, and changing one is an error. `Default` is the
+/// LightsOutCursor preset of the paper.
+#[derive(Debug, Clone, PartialEq, Deserialize)]
 #[serde(deny_unknown_fields, default)]
 pub struct TrainConfig {
     /// What to train: SEADS (the default) or a baseline.
-    #[serde(skip_serializing_if = "is_seads")]
     pub algorithm: Algorithm,
     /// Environment name (see `seads envs`).
     pub env: String,
@@ -125,28 +26,9 @@ pub struct TrainConfig {
     pub seed: u64,
     /// Budget in environment steps (transitions of training episodes).
     pub env_steps: u64,
-    /// Number of skills K (default: the number of game moves; the "more skills" ablation sets 30 / 15).
-    pub num_skills: Option<usize>,
-    /// New episodes per epoch.
-    pub episodes_per_epoch: usize,
-    /// Long-term episode buffer capacity.
-    pub buffer_capacity: usize,
-    /// Short-term list of the most recent episodes.
-    pub recent_episodes: usize,
-    /// Episodes drawn from the long-term buffer per update.
-    pub sampled_episodes: usize,
-    /// Soft actor-critic.
-    pub sac: SacConfig,
-    /// Forward model (or VIC discriminator).
-    pub skill_model: SkillModelConfig,
-    /// Intrinsic reward.
-    pub reward: RewardConfig,
-    /// Relabelling.
-    pub relabel: RelabelConfig,
-    /// Evaluate skill coverage every this many epochs (and at the first and last epoch).
+    /// Evaluate every this many epochs (and at the first and last epoch): skill coverage for
+    /// SEADS, task success for the baselines.
     pub eval_every: u64,
-    /// Number of evaluation seeds (444555, 444556, …) for skill coverage.
-    pub eval_seeds: u64,
     /// Write a checkpoint every this many epochs (and at the end).
     pub checkpoint_every: u64,
     /// libtorch intra-op threads per training thread (0: libtorch's default; the presets use 1,
@@ -168,30 +50,20 @@ pub struct TrainConfig {
     /// Where the networks run: `cpu` (the default) or `cuda`, `cuda:N`. Only the CPU is
     /// bit-exact from the seed; a checkpoint from either loads on the other. Left out of the
     /// written config when `cpu`, and set per command by `--device` (resuming may change it).
-    #[serde(skip_serializing_if = "is_cpu")]
     pub device: ComputeDevice,
-    /// The task-reward baselines' settings (`algorithm = "sac"` or `"hac"`).
-    #[serde(skip_serializing_if = "is_default_baseline")]
-    pub baseline: BaselineConfig,
-    /// The HAC baseline's own settings (`algorithm = "hac"`).
-    #[serde(skip_serializing_if = "is_default_hac")]
+    /// Soft actor-critic, for every algorithm (`updates_per_epoch` is SEADS's; the baselines
+    /// set theirs in their own section).
+    pub sac: SacConfig,
+    /// SEADS's section (`algorithm = "seads"`).
+    pub seads: SeadsConfig,
+    /// The SAC baseline's section (`algorithm = "sac"`).
+    pub sac_baseline: BaselineConfig,
+    /// The HAC baseline's section (`algorithm = "hac"`).
     pub hac: HacConfig,
-}
-
-fn is_cpu(device: &ComputeDevice) -> bool {
-    *device == ComputeDevice::Cpu
 }
 
 fn is_seads(algorithm: &Algorithm) -> bool {
     *algorithm == Algorithm::Seads
-}
-
-fn is_default_baseline(baseline: &BaselineConfig) -> bool {
-    *baseline == BaselineConfig::default()
-}
-
-fn is_default_hac(hac: &HacConfig) -> bool {
-    *hac == HacConfig::default()
 }
 
 impl Default for TrainConfig {
@@ -202,23 +74,15 @@ impl Default for TrainConfig {
             env_config: EnvConfig::default(),
             seed: 1,
             env_steps: 500_000,
-            num_skills: None,
-            episodes_per_epoch: 32,
-            buffer_capacity: 2048,
-            recent_episodes: 256,
-            sampled_episodes: 256,
-            sac: SacConfig::default(),
-            skill_model: SkillModelConfig::default(),
-            reward: RewardConfig::default(),
-            relabel: RelabelConfig::default(),
             eval_every: 100,
-            eval_seeds: 20,
             checkpoint_every: 100,
             threads: 1,
             sac_threads_alone: 2,
             portable_numerics: false,
             device: ComputeDevice::Cpu,
-            baseline: BaselineConfig::default(),
+            sac: SacConfig::default(),
+            seads: SeadsConfig::default(),
+            sac_baseline: BaselineConfig::default(),
             hac: HacConfig::default(),
         }
     }
@@ -300,8 +164,9 @@ impl TrainConfig {
     /// A configuration a user wrote (a `--config` file, a run's `config.toml`): it must name its
     /// `env` (or `env` is given here), and what it leaves out comes from that environment's
     /// preset of its `algorithm` (or the given one), never from generic defaults. Unknown
-    /// fields and bad values are errors naming the line. The robot's environments (`uarm-…`)
-    /// have no preset; their runs write the whole configuration, taken as written.
+    /// fields, bad values and another algorithm's section are errors naming the line or the
+    /// field. A file in the flat layout of older versions loads too. The robot's environments
+    /// (`uarm-…`) have no preset; their runs write the whole configuration, taken as written.
     ///
     /// ```
     /// use seads_rl::TrainConfig;
@@ -310,6 +175,9 @@ impl TrainConfig {
     /// // The rest is the environment's preset, not the generic defaults.
     /// assert_eq!(config.sac.alpha, TrainConfig::preset("tileswap-reacher")?.sac.alpha);
     /// assert!(TrainConfig::from_user_toml("", None, None).is_err());
+    /// // A baseline has no SEADS section.
+    /// let text = "env = \"lightsout-cursor\"\nalgorithm = \"sac\"\n[seads]\nnum_skills = 30";
+    /// assert!(TrainConfig::from_user_toml(text, None, None).is_err());
     /// # Ok::<(), seads_rl::RlError>(())
     /// ```
     pub fn from_user_toml(
@@ -317,11 +185,12 @@ impl TrainConfig {
         env: Option<&str>,
         algorithm: Option<Algorithm>,
     ) -> Result<Self, RlError> {
-        // Fields, types and values first, with the user's line numbers.
-        Self::from_toml(text)?;
-        let mut table: toml::Table = text
-            .parse()
-            .map_err(|e| RlError::Config(one_line_toml_error(text, &e)))?;
+        let mut table = parse_table(text)?;
+        if !flat_layout::is_flat(&table) {
+            // Fields and types first, with the user's line numbers.
+            toml::from_str::<Self>(text)
+                .map_err(|e| RlError::Config(one_line_toml_error(text, &e)))?;
+        }
         if let Some(env) = env {
             table.insert("env".into(), toml::Value::String(env.into()));
         }
@@ -331,61 +200,62 @@ impl TrainConfig {
                 toml::Value::String(algorithm.name().into()),
             );
         }
-        let Some(toml::Value::String(env)) = table.get("env") else {
+        let algorithm = algorithm_of(&table)?;
+        if !flat_layout::upgrade(&mut table, algorithm)? {
+            check_sections(&table, algorithm)?;
+        }
+        // The values the file states, before what it leaves out is filled in.
+        Self::from_table(table.clone())?;
+        let Some(toml::Value::String(env)) = table.get("env").cloned() else {
             return Err(RlError::Config(format!(
                 "the configuration names no `env` (one of {}); its preset fills in the rest",
                 env_names().join(", ")
             )));
         };
-        let algorithm = match table.get("algorithm") {
-            Some(value) => value
-                .clone()
-                .try_into::<Algorithm>()
-                .map_err(|e| RlError::Config(format!("algorithm: {e}")))?,
-            None => Algorithm::Seads,
-        };
         // Environments outside the registry (the robot's) have no preset: their runs write the
         // whole configuration, which is taken as written.
         if !env_names().contains(&env.as_str()) && env.starts_with("uarm-") {
-            return Self::from_toml(&toml::to_string(&table).expect("a table serialises"));
+            return Self::from_table(table);
         }
-        let preset = Self::preset_for(env, algorithm)?;
+        let preset = Self::preset_for(&env, algorithm)?;
         let mut merged: toml::Table = preset
             .to_toml()
             .parse()
             .expect("a serialised preset parses");
         merge_toml(&mut merged, &table);
-        let config: Self = merged
-            .try_into()
-            .map_err(|e: toml::de::Error| RlError::Config(e.message().trim().replace('\n', " ")))?;
-        config.validate_values()?;
-        Ok(config)
+        Self::from_table(merged)
     }
 
     /// Parses a complete TOML configuration (fields left out take the generic defaults, which
     /// only the presets rely on: a user's file goes through [`TrainConfig::from_user_toml`]) and
-    /// validates its values (not the environment: see [`TrainConfig::validate`]).
+    /// validates its values (not the environment: see [`TrainConfig::validate`]). The flat
+    /// layout of older versions' files loads too.
     pub fn from_toml(text: &str) -> Result<Self, RlError> {
+        let mut table = parse_table(text)?;
+        let algorithm = algorithm_of(&table)?;
+        if flat_layout::upgrade(&mut table, algorithm)? {
+            return Self::from_table(table);
+        }
+        check_sections(&table, algorithm)?;
         let config: Self =
             toml::from_str(text).map_err(|e| RlError::Config(one_line_toml_error(text, &e)))?;
         config.validate_values()?;
         Ok(config)
     }
 
-    /// The configuration as TOML. A SEADS config leaves out the baselines' sections; a
-    /// baseline's always has its own, defaults included.
+    /// A configuration from a table in the sectioned layout, its values validated.
+    fn from_table(table: toml::Table) -> Result<Self, RlError> {
+        let config: Self = table
+            .try_into()
+            .map_err(|e: toml::de::Error| RlError::Config(e.message().trim().replace('\n', " ")))?;
+        config.validate_values()?;
+        Ok(config)
+    }
+
+    /// The configuration as TOML: the run's settings, `[sac]` and the section of its algorithm
+    /// (with its defaults), in that order.
     pub fn to_toml(&self) -> String {
-        let mut text = toml::to_string(self).expect("a config serialises");
-        let section = |name: &str, body: Result<String, toml::ser::Error>| {
-            format!("\n[{name}]\n{}", body.expect("a config serialises"))
-        };
-        if self.algorithm.is_baseline() && is_default_baseline(&self.baseline) {
-            text += &section("baseline", toml::to_string(&self.baseline));
-        }
-        if self.algorithm == Algorithm::Hac && is_default_hac(&self.hac) {
-            text += &section("hac", toml::to_string(&self.hac));
-        }
-        text
+        toml::to_string(self).expect("a config serialises")
     }
 
     /// Checks every value, and that the environment exists with these options.
@@ -409,7 +279,8 @@ impl TrainConfig {
     /// matrix and the baselines' replay buffer. In `f64`, so that no size overflows.
     pub fn memory_estimate(&self, spec: &seads_embodiment::EnvSpec) -> f64 {
         let f = |v: usize| v as f64;
-        let skills = f(self.num_skills.unwrap_or(spec.num_skills));
+        let seads = &self.seads;
+        let skills = f(seads.num_skills.unwrap_or(spec.num_skills));
         let (obs, act, board) = (f(spec.obs_dim), f(spec.action_dim), f(spec.symbolic_len));
         let steps = f(spec.step_limit.unwrap_or(1).max(1));
         // Weights of a multilayer perceptron from `input` through `hidden` to `output`.
@@ -422,17 +293,17 @@ impl TrainConfig {
         let width = |hidden: &[i64]| hidden.iter().map(|&h| h.max(0) as f64).sum::<f64>();
         let actor = mlp(obs + skills, &self.sac.hidden, 2.0 * act);
         let critic = mlp(obs + skills + act, &self.sac.hidden, 1.0);
-        let forward_model = mlp(board + skills, &self.skill_model.hidden, board);
+        let forward_model = mlp(board + skills, &seads.skill_model.hidden, board);
         let weights = 4.0 * actor + 10.0 * critic + 4.0 * forward_model;
         let activations = f(self.sac.batch_size) * width(&self.sac.hidden) * 3.0
-            + f(self.skill_model.batch_size) * width(&self.skill_model.hidden);
-        let episodes = (f(self.buffer_capacity) + f(self.episodes_per_epoch)) * steps;
+            + f(seads.skill_model.batch_size) * width(&seads.skill_model.hidden);
+        let episodes = (f(seads.buffer_capacity) + f(seads.episodes_per_epoch)) * steps;
         let transitions = if self.algorithm.is_baseline() {
-            f(self.baseline.replay_capacity)
+            f(self.baseline_training().replay_capacity)
         } else {
             0.0
         };
-        let relabelling = 2.0 * f(self.sampled_episodes) * skills;
+        let relabelling = 2.0 * f(seads.sampled_episodes) * skills;
         4.0 * (weights + activations + (episodes + transitions) * (obs + act) + relabelling)
     }
 
@@ -458,7 +329,7 @@ impl TrainConfig {
         Err(RlError::Config(format!(
             "this configuration needs at least {} GiB, more than this machine's {} GiB \
              (lower num_skills, the hidden sizes, buffer_capacity, episodes_per_epoch, the batch \
-             sizes or baseline.replay_capacity)",
+             sizes or the baseline's replay_capacity)",
             gib(need),
             gib(available as f64)
         )))
@@ -469,33 +340,21 @@ impl TrainConfig {
     pub fn validate_values(&self) -> Result<(), RlError> {
         let bad = |m: String| Err(RlError::Config(m));
         self.sac.validate()?;
-        self.skill_model.validate()?;
-        if self.num_skills == Some(0) {
-            return bad("num_skills must be at least 1".into());
-        }
+        self.seads.validate()?;
+        self.sac_baseline.validate("sac_baseline")?;
+        self.hac.validate()?;
         // Counts that set a loop's length or a pool's size: beyond these a run would spawn more
         // threads than a machine has, or never finish an epoch.
-        let caps: [(&str, u64, u64); 6] = [
+        let caps: [(&str, u64, u64); 3] = [
             ("threads", self.threads as u64, MAX_THREADS),
             (
                 "sac_threads_alone",
                 self.sac_threads_alone as u64,
                 MAX_THREADS,
             ),
-            ("eval_seeds", self.eval_seeds, MAX_PER_EPOCH),
             (
                 "sac.updates_per_epoch",
                 self.sac.updates_per_epoch as u64,
-                MAX_PER_EPOCH,
-            ),
-            (
-                "baseline.samples_per_epoch",
-                self.baseline.samples_per_epoch as u64,
-                MAX_PER_EPOCH,
-            ),
-            (
-                "baseline.eval_boards",
-                self.baseline.eval_boards as u64,
                 MAX_PER_EPOCH,
             ),
         ];
@@ -503,12 +362,6 @@ impl TrainConfig {
             if value > most {
                 return bad(format!("{name} must be at most {most}, got {value}"));
             }
-        }
-        if self.baseline.updates_per_epoch > MAX_PER_EPOCH as f64 {
-            return bad(format!(
-                "baseline.updates_per_epoch must be at most {MAX_PER_EPOCH}, got {}",
-                self.baseline.updates_per_epoch
-            ));
         }
         // TOML integers are 64-bit signed: a larger value would be written into config.toml but
         // never read back.
@@ -520,110 +373,52 @@ impl TrainConfig {
                 ));
             }
         }
-        for (name, value) in [
-            ("episodes_per_epoch", self.episodes_per_epoch),
-            ("buffer_capacity", self.buffer_capacity),
-            ("recent_episodes", self.recent_episodes),
-            ("sampled_episodes", self.sampled_episodes),
-        ] {
-            if value == 0 {
-                return bad(format!("{name} must be at least 1"));
-            }
+        if self.eval_every == 0 || self.checkpoint_every == 0 {
+            return bad("eval_every and checkpoint_every must be at least 1".into());
         }
-        if self.sampled_episodes > self.buffer_capacity
-            || self.recent_episodes > self.buffer_capacity
-        {
-            return bad(
-                "sampled_episodes and recent_episodes must not exceed buffer_capacity".into(),
-            );
-        }
-        if self.eval_every == 0 || self.checkpoint_every == 0 || self.eval_seeds == 0 {
-            return bad("eval_every, eval_seeds and checkpoint_every must be at least 1".into());
-        }
-        let b = &self.baseline;
-        if b.replay_capacity == 0 || b.samples_per_epoch == 0 || b.eval_boards == 0 {
-            return bad(
-                "baseline.replay_capacity, baseline.samples_per_epoch and baseline.eval_boards \
-                 must be at least 1"
-                    .into(),
-            );
-        }
-        if !(b.updates_per_epoch.is_finite() && b.updates_per_epoch > 0.0) {
-            return bad(format!(
-                "baseline.updates_per_epoch must be positive, got {}",
-                b.updates_per_epoch
-            ));
-        }
-        for (name, p) in [
-            ("relabel.skill_model_p", self.relabel.skill_model_p),
-            ("relabel.sac_p", self.relabel.sac_p),
-            ("hac.subgoal_test_p", self.hac.subgoal_test_p),
-        ] {
-            if !(0.0..=1.0).contains(&p) {
-                return bad(format!("{name} must lie in [0, 1], got {p}"));
-            }
-        }
-        for (name, v) in [
-            ("hac.temperature", self.hac.temperature),
-            ("hac.alpha_high", self.hac.alpha_high),
-        ] {
-            if !(v.is_finite() && v > 0.0) {
-                return bad(format!("{name} must be positive, got {v}"));
-            }
-        }
-        if self.hac.subgoal_horizon == 0 {
-            return bad("hac.subgoal_horizon must be at least 1".into());
-        }
-        self.check_algorithm_fields()
+        self.check_other_sections()
     }
 
-    /// A setting of another algorithm than the run's, changed from its default, is a mistake:
-    /// SEADS's skills, skill model, reward and relabelling mean nothing to a baseline, and the
-    /// baselines' sections nothing to SEADS.
-    fn check_algorithm_fields(&self) -> Result<(), RlError> {
-        let d = Self::default();
-        let seads_only = [
-            ("num_skills", self.num_skills == d.num_skills),
+    /// The sections of the other algorithms stay at their defaults: they are not written with
+    /// the run, so a change there would be lost. SAC's `updates_per_epoch` is SEADS's (the
+    /// baselines set theirs in their own section).
+    fn check_other_sections(&self) -> Result<(), RlError> {
+        let changed = [
+            (Algorithm::Seads, self.seads == SeadsConfig::default()),
             (
-                "episodes_per_epoch",
-                self.episodes_per_epoch == d.episodes_per_epoch,
+                Algorithm::Sac,
+                self.sac_baseline == BaselineConfig::default(),
             ),
-            ("buffer_capacity", self.buffer_capacity == d.buffer_capacity),
-            ("recent_episodes", self.recent_episodes == d.recent_episodes),
-            (
-                "sampled_episodes",
-                self.sampled_episodes == d.sampled_episodes,
-            ),
-            ("eval_seeds", self.eval_seeds == d.eval_seeds),
-            ("skill_model", self.skill_model == d.skill_model),
-            ("reward", self.reward == d.reward),
-            ("relabel", self.relabel == d.relabel),
-            (
-                "sac.updates_per_epoch",
-                self.sac.updates_per_epoch == d.sac.updates_per_epoch,
-            ),
-        ];
-        let (name, others): (&str, Vec<(&str, bool)>) = match self.algorithm {
-            Algorithm::Seads => (
-                "SEADS",
-                vec![
-                    ("baseline", is_default_baseline(&self.baseline)),
-                    ("hac", is_default_hac(&self.hac)),
-                ],
-            ),
-            Algorithm::Sac => {
-                let mut v = seads_only.to_vec();
-                v.push(("hac", is_default_hac(&self.hac)));
-                ("the SAC baseline", v)
-            }
-            Algorithm::Hac => ("the HAC baseline", seads_only.to_vec()),
-        };
-        match others.iter().find(|(_, default)| !default) {
-            Some((field, _)) => Err(RlError::Config(format!(
-                "{field} is not a setting of {name} (algorithm = {:?}); remove it",
+            (Algorithm::Hac, self.hac == HacConfig::default()),
+        ]
+        .into_iter()
+        .find(|&(a, default)| a != self.algorithm && !default);
+        if let Some((other, _)) = changed {
+            return Err(RlError::Config(format!(
+                "[{}] is the section of algorithm {:?}, not of this run's {:?}; remove it",
+                other.section(),
+                other.name(),
                 self.algorithm.name()
-            ))),
-            None => Ok(()),
+            )));
+        }
+        if self.algorithm.is_baseline()
+            && self.sac.updates_per_epoch != SacConfig::default().updates_per_epoch
+        {
+            return Err(RlError::Config(format!(
+                "sac.updates_per_epoch is SEADS's; the {} baseline's is {}.updates_per_epoch",
+                self.algorithm.name(),
+                self.algorithm.section()
+            )));
+        }
+        Ok(())
+    }
+
+    /// How a baseline collects and learns: `[sac_baseline]`, or HAC's share of `[hac]` (SEADS:
+    /// the SAC baseline's defaults, unused).
+    pub fn baseline_training(&self) -> BaselineConfig {
+        match self.algorithm {
+            Algorithm::Hac => self.hac.training(),
+            Algorithm::Seads | Algorithm::Sac => self.sac_baseline.clone(),
         }
     }
 }
@@ -658,11 +453,6 @@ pub fn merge_toml(base: &mut toml::Table, layer: &toml::Table) {
 /// The most threads a configuration may ask for (libtorch's and the environments'): more than
 /// any machine this runs on has cores.
 const MAX_THREADS: u64 = 1024;
-
-/// The most evaluations, updates, samples or boards a configuration may ask for per epoch (or
-/// per evaluation): a million, far beyond the paper's settings (tens to thousands), far below
-/// what would never end.
-const MAX_PER_EPOCH: u64 = 1_000_000;
 
 /// Fields that a resumed or evaluated run may change: the budget (`--env-steps`) and the thread
 /// counts, which sweeps and the robot set per task and which do not change a run's numbers (a
@@ -709,6 +499,87 @@ pub fn config_difference(
         c.to_toml().parse().expect("a serialised config parses")
     };
     walk("", &table(this), &table(that))
+}
+
+/// A configuration's text as a table.
+fn parse_table(text: &str) -> Result<toml::Table, RlError> {
+    text.parse()
+        .map_err(|e| RlError::Config(one_line_toml_error(text, &e)))
+}
+
+/// The algorithm a configuration's table names (SEADS where it names none).
+fn algorithm_of(table: &toml::Table) -> Result<Algorithm, RlError> {
+    match table.get("algorithm") {
+        Some(value) => value
+            .clone()
+            .try_into::<Algorithm>()
+            .map_err(|e| RlError::Config(format!("algorithm: {}", e.message().trim()))),
+        None => Ok(Algorithm::Seads),
+    }
+}
+
+/// A file holds the section of its algorithm only: another algorithm's section is an error.
+fn check_sections(table: &toml::Table, algorithm: Algorithm) -> Result<(), RlError> {
+    for other in Algorithm::ALL.into_iter().filter(|&a| a != algorithm) {
+        if table.contains_key(other.section()) {
+            return Err(RlError::Config(format!(
+                "[{}] is the section of algorithm {:?}, not of this run's {:?}; remove it",
+                other.section(),
+                other.name(),
+                algorithm.name()
+            )));
+        }
+    }
+    Ok(())
+}
+
+/// What [`TrainConfig`] writes: its fields, with the section of its algorithm only.
+#[derive(Serialize)]
+struct Written<'a> {
+    #[serde(skip_serializing_if = "is_seads")]
+    algorithm: Algorithm,
+    env: &'a str,
+    env_config: &'a EnvConfig,
+    seed: u64,
+    env_steps: u64,
+    eval_every: u64,
+    checkpoint_every: u64,
+    threads: usize,
+    sac_threads_alone: usize,
+    portable_numerics: bool,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    device: Option<&'a ComputeDevice>,
+    sac: &'a SacConfig,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    seads: Option<&'a SeadsConfig>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    sac_baseline: Option<&'a BaselineConfig>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    hac: Option<&'a HacConfig>,
+}
+
+impl Serialize for TrainConfig {
+    fn serialize<S: serde::Serializer>(&self, serializer: S) -> Result<S::Ok, S::Error> {
+        let a = self.algorithm;
+        Written {
+            algorithm: a,
+            env: &self.env,
+            env_config: &self.env_config,
+            seed: self.seed,
+            env_steps: self.env_steps,
+            eval_every: self.eval_every,
+            checkpoint_every: self.checkpoint_every,
+            threads: self.threads,
+            sac_threads_alone: self.sac_threads_alone,
+            portable_numerics: self.portable_numerics,
+            device: (self.device != ComputeDevice::Cpu).then_some(&self.device),
+            sac: &self.sac,
+            seads: (a == Algorithm::Seads).then_some(&self.seads),
+            sac_baseline: (a == Algorithm::Sac).then_some(&self.sac_baseline),
+            hac: (a == Algorithm::Hac).then_some(&self.hac),
+        }
+        .serialize(serializer)
+    }
 }
 
 fn one_line_toml_error(text: &str, e: &toml::de::Error) -> String {
@@ -867,28 +738,28 @@ mod tests {
             (seed, env_steps) in (any::<u64>(), any::<u64>()),
         ) {
             let mut config = TrainConfig::preset("lightsout-cursor").unwrap();
-            config.num_skills = Some(num_skills);
+            config.seads.num_skills = Some(num_skills);
             config.sac.hidden = sac_hidden;
-            config.skill_model.hidden = model_hidden;
-            config.episodes_per_epoch = episodes;
-            config.buffer_capacity = capacity;
-            config.sampled_episodes = sampled;
-            config.recent_episodes = sampled.min(capacity);
+            config.seads.skill_model.hidden = model_hidden;
+            config.seads.episodes_per_epoch = episodes;
+            config.seads.buffer_capacity = capacity;
+            config.seads.sampled_episodes = sampled;
+            config.seads.recent_episodes = sampled.min(capacity);
             config.sac.batch_size = sac_batch;
-            config.skill_model.batch_size = model_batch;
+            config.seads.skill_model.batch_size = model_batch;
             config.sac.lr = lr;
             config.sac.alpha = alpha;
             config.sac.gamma = gamma;
-            config.relabel.sac_p = p;
+            config.seads.relabel.sac_p = p;
             config.threads = threads;
-            config.eval_seeds = eval_seeds as u64;
+            config.seads.eval_seeds = eval_seeds as u64;
             config.seed = seed;
             config.env_steps = env_steps;
             if baseline {
                 config = TrainConfig { algorithm: Algorithm::Sac, ..config };
-                config.baseline.replay_capacity = replay;
-                config.baseline.samples_per_epoch = samples;
-                config.baseline.eval_boards = boards;
+                config.sac_baseline.replay_capacity = replay;
+                config.sac_baseline.samples_per_epoch = samples;
+                config.sac_baseline.eval_boards = boards;
             } else {
                 config.sac.updates_per_epoch = updates;
             }
@@ -902,8 +773,8 @@ mod tests {
                 prop_assert!(threads as u64 <= MAX_THREADS);
                 prop_assert!((eval_seeds as u64) <= MAX_PER_EPOCH);
                 prop_assert!(config.sac.updates_per_epoch as u64 <= MAX_PER_EPOCH);
-                prop_assert!(config.baseline.samples_per_epoch as u64 <= MAX_PER_EPOCH);
-                prop_assert!(config.baseline.eval_boards as u64 <= MAX_PER_EPOCH);
+                prop_assert!(config.sac_baseline.samples_per_epoch as u64 <= MAX_PER_EPOCH);
+                prop_assert!(config.sac_baseline.eval_boards as u64 <= MAX_PER_EPOCH);
                 prop_assert!(i64::try_from(seed).is_ok() && i64::try_from(env_steps).is_ok());
                 // What is accepted is written and read back as it was.
                 let back = TrainConfig::from_toml(&config.to_toml());
@@ -920,9 +791,9 @@ mod tests {
         b.threads = 4;
         b.sac_threads_alone = 0;
         assert_eq!(config_difference(&a, &b), None);
-        b.skill_model.lr = 0.5;
+        b.seads.skill_model.lr = 0.5;
         let (field, now, then) = config_difference(&b, &a).unwrap();
-        assert_eq!(field, "skill_model.lr");
+        assert_eq!(field, "seads.skill_model.lr");
         assert_eq!((now.as_str(), then.as_str()), ("0.5", "0.001"));
     }
 }

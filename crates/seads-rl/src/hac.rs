@@ -273,7 +273,7 @@ impl Hac {
         let (high, low) = levels(&config, &spec)?;
         let d = spec.symbolic_len;
         let goal = game_goal(&spec)?;
-        let capacity = config.baseline.replay_capacity;
+        let capacity = config.hac.replay_capacity;
         let n = episodes.len();
         let progress = Progress {
             shared,
@@ -455,7 +455,7 @@ impl Hac {
         let start = Instant::now();
         let due = updates_due(
             self.progress.shared.epoch,
-            self.config.baseline.updates_per_epoch,
+            self.config.hac.updates_per_epoch,
         );
         let batch_size = self.config.sac.batch_size;
         let mut losses = LossMean::default();
@@ -754,7 +754,7 @@ impl Learner for Hac {
         Ok(stats)
     }
     fn metrics(&mut self, stats: &TaskEpochStats, wall_s: f64) -> Result<TaskMetrics, RlError> {
-        let results = self.task_success(self.config.baseline.eval_boards)?;
+        let results = self.task_success(self.config.hac.eval_boards)?;
         let p = &mut self.progress;
         let mut line = TaskMetrics::new(&results, &p.shared, wall_s, stats);
         let (attempts, reached) = (p.attempts - p.reported.0, p.reached - p.reported.1);

@@ -18,8 +18,9 @@
 //! // The paper's LightsOutCursor settings, shrunk so that the example runs in seconds.
 //! let mut config = TrainConfig::preset("lightsout-cursor")?;
 //! config.sac.hidden = vec![32, 32];
-//! config.skill_model.hidden = vec![32, 32];
-//! (config.sampled_episodes, config.recent_episodes, config.eval_seeds) = (32, 16, 2);
+//! config.seads.skill_model.hidden = vec![32, 32];
+//! (config.seads.sampled_episodes, config.seads.recent_episodes) = (32, 16);
+//! config.seads.eval_seeds = 2;
 //! let mut trainer = Trainer::new(config)?;
 //! for _ in 0..3 {
 //!     let stats = trainer.run_epoch()?; // collect 32 episodes, relabel, update the model and SAC
@@ -39,6 +40,7 @@ mod buffers;
 mod checkpoint;
 mod config;
 mod episode;
+mod flat_layout;
 mod hac;
 mod in_words;
 mod learner;
@@ -50,6 +52,7 @@ mod relaxed;
 mod replay;
 mod run;
 mod sac;
+mod sections;
 mod seeds;
 mod stacked;
 mod stacked_population;
@@ -63,11 +66,9 @@ use std::path::Path;
 
 pub use agent::{Agent, AgentPolicy, find_checkpoint, load_policy};
 pub use buffers::{RelabelBatch, Relabelling};
-pub use config::{
-    Algorithm, BaselineConfig, HacConfig, RelabelConfig, TrainConfig, machine_memory_bytes,
-    merge_toml,
-};
+pub use config::{TrainConfig, machine_memory_bytes, merge_toml};
 pub use episode::{Episode, run_episodes, skill_coverage};
+pub use flat_layout::upgrade as upgrade_flat_layout;
 pub use hac::{Hac, HacPolicy};
 pub use in_words::{BaselineInWords, InWords};
 pub use learner::{Hook, Learner, Moment};
@@ -79,6 +80,7 @@ pub use relaxed::RelaxedBernoulli;
 pub use run::{Run, RunEvent, load_config, raise_budget};
 pub use sac::{Sac, SacConfig, SacLosses, TransitionBatch, checkpoint_files};
 pub use seads_nn::{ComputeDevice, DeviceError};
+pub use sections::{Algorithm, BaselineConfig, HacConfig, RelabelConfig, SeadsConfig};
 pub use seeds::{Purpose, derived_seed, stream};
 pub use stacked_population::StackedPopulation;
 pub use task_episodes::{TaskEpochStats, TaskTimings, updates_due};

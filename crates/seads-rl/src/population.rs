@@ -46,11 +46,14 @@ impl PopulationKey {
             ("algorithm", c.algorithm.name().to_owned()),
             ("env", c.env.clone()),
             ("env_config", env_config),
-            ("num_skills", format!("{:?}", c.num_skills)),
+            ("num_skills", format!("{:?}", c.seads.num_skills)),
             ("sac.hidden", format!("{:?}", c.sac.hidden)),
             (
                 "skill_model",
-                format!("{:?} {:?}", c.skill_model.kind, c.skill_model.hidden),
+                format!(
+                    "{:?} {:?}",
+                    c.seads.skill_model.kind, c.seads.skill_model.hidden
+                ),
             ),
             ("portable_numerics", c.portable_numerics.to_string()),
             ("device", c.device.to_string()),
@@ -219,7 +222,7 @@ mod tests {
     fn seeds_and_rates_share_a_key_shapes_and_environments_do_not() {
         let a = TrainConfig::preset("lightsout-cursor").unwrap();
         let mut b = a.clone();
-        (b.seed, b.sac.lr, b.relabel.sac_p) = (7, 1e-3, 0.0);
+        (b.seed, b.sac.lr, b.seads.relabel.sac_p) = (7, 1e-3, 0.0);
         assert_eq!(PopulationKey::of(&a), PopulationKey::of(&b));
         assert_eq!(PopulationKey::mismatch(&a, &b), None);
         b.sac.hidden = vec![128, 128];

@@ -143,7 +143,7 @@ impl TaskSac {
             derived_seed(config.seed, Purpose::SacInit, 0),
         );
         let replay = Replay::new(
-            config.baseline.replay_capacity,
+            config.sac_baseline.replay_capacity,
             spec.obs_dim,
             spec.action_dim,
         );
@@ -225,7 +225,10 @@ impl TaskSac {
         let start = Instant::now();
         let mut losses = LossMean::default();
         if self.replay.len() >= self.config.sac.batch_size {
-            for _ in 0..updates_due(self.progress.epoch, self.config.baseline.updates_per_epoch) {
+            for _ in 0..updates_due(
+                self.progress.epoch,
+                self.config.sac_baseline.updates_per_epoch,
+            ) {
                 let streams = &mut self.progress.streams;
                 let batch = self
                     .replay
@@ -298,7 +301,7 @@ impl Learner for TaskSac {
         Ok(stats)
     }
     fn metrics(&mut self, stats: &TaskEpochStats, wall_s: f64) -> Result<TaskMetrics, RlError> {
-        let results = self.task_success(self.config.baseline.eval_boards)?;
+        let results = self.task_success(self.config.sac_baseline.eval_boards)?;
         Ok(TaskMetrics::new(&results, &self.progress, wall_s, stats))
     }
     fn save(&self, dir: &Path) -> Result<(), RlError> {

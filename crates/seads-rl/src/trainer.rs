@@ -131,9 +131,9 @@ impl Trainer {
             tch::set_num_threads(config.threads as i32);
         }
         let spec = template.spec().clone();
-        let k = config.num_skills.unwrap_or(spec.num_skills);
+        let k = config.seads.num_skills.unwrap_or(spec.num_skills);
         // Seeded before every epoch (`train_env_seed`).
-        let envs = (0..config.episodes_per_epoch)
+        let envs = (0..config.seads.episodes_per_epoch)
             .map(|_| template.box_clone())
             .collect();
         let device = config.device.resolve()?;
@@ -145,7 +145,7 @@ impl Trainer {
             device,
             derived_seed(config.seed, Purpose::SacInit, 0),
         );
-        let model = config.skill_model.build(
+        let model = config.seads.skill_model.build(
             spec.symbolic_len,
             k,
             device,
@@ -397,7 +397,7 @@ impl Trainer {
     /// test-split resets, averaged over the evaluation seeds.
     pub fn skill_coverage(&mut self) -> Result<f64, RlError> {
         let start = Instant::now();
-        let seeds: Vec<u64> = (0..self.config.eval_seeds)
+        let seeds: Vec<u64> = (0..self.config.seads.eval_seeds)
             .map(|i| COVERAGE_SEED + i)
             .collect();
         let per_seed = skill_coverage(self.eval_env.as_ref(), &self.sac, self.k, &seeds)?;
@@ -550,7 +550,7 @@ impl Prepare<'_> {
         self.timings.relabel += start.elapsed().as_secs_f64();
 
         let start = Instant::now();
-        let config = &self.buffers.config.skill_model;
+        let config = &self.buffers.config.seads.skill_model;
         let mut loss = 0.0;
         for _ in 0..config.updates_per_epoch {
             let minibatch: Vec<SkillTransition> = (0..config.batch_size)

@@ -20,12 +20,14 @@ fn small_of(algorithm: Algorithm, seed: u64, steps: u64) -> TrainConfig {
     config.env_steps = steps;
     config.sac.hidden = vec![32, 32];
     config.sac.batch_size = 32;
-    config.baseline.eval_boards = 2;
+    config.sac_baseline.eval_boards = 2;
     config.eval_every = 20;
     config.checkpoint_every = 20;
     config.portable_numerics = true;
     // Subgoals of 7 steps in episodes of 10·S: checkpoints fall inside subgoal attempts.
     if algorithm == Algorithm::Hac {
+        config.sac_baseline = Default::default();
+        config.hac.eval_boards = 2;
         config.hac.subgoal_horizon = 7;
     }
     config
@@ -180,8 +182,8 @@ fn presets_carry_the_seeds_best_settings() {
     ];
     assert_eq!(
         TrainConfig::sac_presets().len(),
-        9,
-        "and LightsOut3DJaco, sliding-cursor and -reacher"
+        12,
+        "and LightsOut3DJaco, sliding-cursor and -reacher, and the three -reacher3"
     );
     for (env, n, alpha) in best {
         let c = TrainConfig::preset_for(env, Algorithm::Sac).unwrap();
@@ -194,12 +196,15 @@ fn presets_carry_the_seeds_best_settings() {
             (256, 3e-4, 0.99, 0.005)
         );
         assert_eq!(
-            (c.baseline.updates_per_epoch, c.sac.alpha),
+            (c.sac_baseline.updates_per_epoch, c.sac.alpha),
             (n, alpha),
             "{env}"
         );
         assert_eq!(
-            (c.baseline.replay_capacity, c.baseline.samples_per_epoch),
+            (
+                c.sac_baseline.replay_capacity,
+                c.sac_baseline.samples_per_epoch
+            ),
             (1_000_000, 8)
         );
         let budget = if env.ends_with("cursor") {
@@ -211,21 +216,29 @@ fn presets_carry_the_seeds_best_settings() {
     }
 }
 
-/// A baseline's config.toml names all its settings, defaults included, and reads back equal; a
-/// SEADS config has no baselines' section.
+/// A config.toml holds the section of its algorithm only, defaults included, and reads back
+/// equal.
 #[test]
 fn configs_round_trip_through_toml() {
     let sac = TrainConfig::preset_for("tileswap-cursor", Algorithm::Sac).unwrap();
     let text = sac.to_toml();
     assert!(
-        text.contains("[baseline]") && text.contains("updates_per_epoch = 1.0"),
+        text.contains("[sac_baseline]") && text.contains("updates_per_epoch = 1.0"),
+        "{text}"
+    );
+    assert!(
+        !text.contains("[seads") && !text.contains("[hac]"),
         "{text}"
     );
     assert_eq!(TrainConfig::from_toml(&text).unwrap(), sac);
     let seads = TrainConfig::preset("tileswap-cursor").unwrap();
     let text = seads.to_toml();
     assert!(
-        !text.contains("baseline") && !text.contains("algorithm"),
+        text.contains("[seads]") && text.contains("[seads.relabel]"),
+        "{text}"
+    );
+    assert!(
+        !text.contains("baseline") && !text.contains("[hac]") && !text.contains("algorithm"),
         "{text}"
     );
     assert_eq!(TrainConfig::from_toml(&text).unwrap(), seads);
@@ -243,11 +256,15 @@ fn hac_presets_carry_the_seeds_best_settings() {
         ("lightsout-jaco", 0.1, 0.001, 0.001),
         ("tileswap-jaco", 0.1, 0.0001, 0.001),
     ];
-    // The paper's seven, and the sliding puzzle's two with its TileSwap counterparts' settings.
-    assert_eq!(TrainConfig::hac_presets().len(), 9);
+    // The paper's seven, the sliding puzzle's two with its TileSwap counterparts' settings, and
+    // the three-link arm's three with the two-link Reacher's.
+    assert_eq!(TrainConfig::hac_presets().len(), 12);
     for (sliding, tileswap) in [
         ("sliding-cursor", "tileswap-cursor"),
         ("sliding-reacher", "tileswap-reacher"),
+        ("lightsout-reacher3", "lightsout-reacher"),
+        ("tileswap-reacher3", "tileswap-reacher"),
+        ("sliding-reacher3", "tileswap-reacher"),
     ] {
         let a = TrainConfig::preset_for(sliding, Algorithm::Hac).unwrap();
         let b = TrainConfig::preset_for(tileswap, Algorithm::Hac).unwrap();
@@ -272,21 +289,26 @@ fn hac_presets_carry_the_seeds_best_settings() {
         assert_eq!(c.hac.subgoal_horizon, horizon);
         let sac = TrainConfig::preset_for(env, Algorithm::Sac).unwrap();
         assert_eq!(
-            c.baseline, sac.baseline,
+            c.hac.training(),
+            sac.sac_baseline,
             "{env}: N and the buffer as for SAC"
         );
         assert_eq!(c.env_steps, sac.env_steps);
     }
 }
 
-/// A HAC config.toml names both baseline sections, defaults included, and reads back equal.
+/// A HAC config.toml names all of `[hac]`, defaults included, and reads back equal.
 #[test]
 fn hac_configs_round_trip_through_toml() {
     let mut hac = TrainConfig::preset_for("lightsout-cursor", Algorithm::Hac).unwrap();
     hac.hac = Default::default();
     let text = hac.to_toml();
     assert!(
-        text.contains("[hac]") && text.contains("[baseline]"),
+        text.contains("[hac]") && text.contains("replay_capacity = 1000000"),
+        "{text}"
+    );
+    assert!(
+        !text.contains("baseline") && !text.contains("[seads"),
         "{text}"
     );
     assert_eq!(TrainConfig::from_toml(&text).unwrap(), hac);
@@ -313,25 +335,46 @@ fn bad_baseline_settings_are_refused() {
         "hac.subgoal_horizon",
     );
     refused(
+        "algorithm = \"sac\"\n[sac_baseline]\nupdates_per_epoch = 0.0",
+        "sac_baseline.updates_per_epoch must be positive",
+    );
+    refused(
+        "algorithm = \"hac\"\n[hac]\neval_boards = 0",
+        "hac.eval_boards",
+    );
+    refused(
+        "algorithm = \"sac\"\n[seads]\nnum_skills = 30",
+        "[seads] is the section of algorithm \"seads\", not of this run's \"sac\"",
+    );
+    refused(
+        "algorithm = \"hac\"\n[seads.relabel]\nsac_p = 0.0",
+        "[seads] is the section of algorithm \"seads\", not of this run's \"hac\"",
+    );
+    refused("[hac]\ntemperature = 0.5", "[hac] is the section");
+    refused(
+        "algorithm = \"sac\"\n[hac]\ntemperature = 0.5",
+        "[hac] is the section of algorithm \"hac\", not of this run's \"sac\"",
+    );
+    refused(
+        "[sac_baseline]\nsamples_per_epoch = 4",
+        "[sac_baseline] is the section",
+    );
+    refused(
+        "algorithm = \"sac\"\n[sac]\nupdates_per_epoch = 4",
+        "sac.updates_per_epoch is SEADS's",
+    );
+    // The flat layout of older files: the same settings in the wrong place are refused too.
+    refused(
         "algorithm = \"sac\"\n[baseline]\nupdates_per_epoch = 0.0",
-        "updates_per_epoch",
+        "sac_baseline.updates_per_epoch must be positive",
     );
     refused(
         "algorithm = \"sac\"\nnum_skills = 30",
-        "num_skills is not a setting of the SAC",
+        "[seads] is the section",
     );
     refused(
         "algorithm = \"hac\"\n[relabel]\nsac_p = 0.0",
-        "relabel is not a setting of the HAC",
-    );
-    refused("[hac]\ntemperature = 0.5", "hac is not a setting of SEADS");
-    refused(
-        "algorithm = \"sac\"\n[hac]\ntemperature = 0.5",
-        "hac is not a setting of the SAC",
-    );
-    refused(
-        "[baseline]\nsamples_per_epoch = 4",
-        "baseline is not a setting of SEADS",
+        "[seads] is the section",
     );
 }
 

@@ -414,11 +414,11 @@ fn bad_configurations_are_rejected_with_a_reason() {
         ("sac.hidden", |c| c.sac.hidden = vec![64, -1]),
         ("sac.alpha", |c| c.sac.alpha = 0.0),
         ("sac.gamma", |c| c.sac.gamma = 1.5),
-        ("skill_model.lr", |c| c.skill_model.lr = -1.0),
-        ("relabel.sac_p", |c| c.relabel.sac_p = 2.0),
-        ("episodes_per_epoch", |c| c.episodes_per_epoch = 0),
+        ("skill_model.lr", |c| c.seads.skill_model.lr = -1.0),
+        ("relabel.sac_p", |c| c.seads.relabel.sac_p = 2.0),
+        ("episodes_per_epoch", |c| c.seads.episodes_per_epoch = 0),
         ("buffer_capacity", |c| {
-            c.sampled_episodes = c.buffer_capacity + 1
+            c.seads.sampled_episodes = c.seads.buffer_capacity + 1
         }),
     ];
     for (needle, edit) in cases {
@@ -489,4 +489,93 @@ fn presets_parse_and_round_trip() {
         TrainConfig::default(),
         TrainConfig::preset("lightsout-cursor").unwrap()
     );
+}
+
+/// Every run configuration committed with a study (and the test data's) loads, whichever layout
+/// it was written in, and keeps every value it states: a flat file's SEADS keys reappear in
+/// `[seads]`, its `[baseline]` in the baseline's own section (the SEADS keys a baseline's flat
+/// file carried at their defaults are dropped).
+#[test]
+fn every_committed_run_config_loads() {
+    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../..");
+    let mut files = Vec::new();
+    for dir in ["docs/results", "data", "crates/seads-py/tests/data"] {
+        collect_configs(&root.join(dir), &mut files);
+    }
+    assert!(
+        files.len() > 200,
+        "found only {} config.toml files",
+        files.len()
+    );
+    let mut flat = 0;
+    for path in &files {
+        let text = std::fs::read_to_string(path).unwrap();
+        let config =
+            TrainConfig::from_toml(&text).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+        let written: toml::Table = config.to_toml().parse().unwrap();
+        let stated: toml::Table = text.parse().unwrap();
+        let seads_keys = [
+            "num_skills",
+            "episodes_per_epoch",
+            "buffer_capacity",
+            "recent_episodes",
+            "sampled_episodes",
+            "eval_seeds",
+            "skill_model",
+            "reward",
+            "relabel",
+        ];
+        flat += usize::from(stated.contains_key("baseline") || stated.contains_key("relabel"));
+        for (key, value) in &stated {
+            let section = if seads_keys.contains(&key.as_str()) {
+                Some("seads")
+            } else if key == "baseline" {
+                Some(config.algorithm.section())
+            } else {
+                None
+            };
+            let found = match section {
+                // A baseline's flat file carried SEADS's keys at their defaults.
+                Some("seads") if config.algorithm != seads_rl::Algorithm::Seads => continue,
+                Some(s) if key == "baseline" => written.get(s),
+                Some(s) => written.get(s).and_then(|t| t.get(key)),
+                None => written.get(key),
+            };
+            let found = found.unwrap_or_else(|| panic!("{}: {key} is lost", path.display()));
+            assert!(
+                contains(found, value),
+                "{}: {key} = {value} reads back as {found}",
+                path.display()
+            );
+        }
+        assert_eq!(TrainConfig::from_toml(&config.to_toml()).unwrap(), config);
+    }
+    assert!(flat > 100, "only {flat} files in the flat layout");
+}
+
+fn collect_configs(dir: &std::path::Path, out: &mut Vec<std::path::PathBuf>) {
+    let Ok(entries) = std::fs::read_dir(dir) else {
+        return;
+    };
+    for entry in entries.flatten() {
+        let path = entry.path();
+        if path.is_dir() {
+            collect_configs(&path, out);
+        } else if path.file_name().is_some_and(|n| n == "config.toml") {
+            out.push(path);
+        }
+    }
+}
+
+/// Whether `stated` is part of `found`: tables key by key, numbers by value (an integer may come
+/// back as a float), anything else equal.
+fn contains(found: &toml::Value, stated: &toml::Value) -> bool {
+    use toml::Value::{Float, Integer, Table};
+    match (found, stated) {
+        (Table(f), Table(s)) => s
+            .iter()
+            .all(|(k, v)| f.get(k).is_some_and(|fv| contains(fv, v))),
+        (Float(f), Integer(s)) => *f == *s as f64,
+        (f, s) => f == s,
+    }
 }

@@ -56,7 +56,7 @@ pub use error::{BoxError, Context, Result, StudyError};
 /// The number of skills K of a run: its `num_skills`, else the moves of its environment's game
 /// (for a robot run, whose environment is not in the registry, the tablet's LightsOut 5×5).
 pub fn run_skills(config: &seads_rl::TrainConfig) -> usize {
-    config.num_skills.unwrap_or_else(|| {
+    config.seads.num_skills.unwrap_or_else(|| {
         match seads_embodiment::make_env(&config.env, &config.env_config) {
             Ok(env) => env.spec().num_skills,
             Err(_) => seads_uarm::BOARD_SIZE * seads_uarm::BOARD_SIZE,

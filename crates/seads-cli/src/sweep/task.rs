@@ -207,7 +207,7 @@ fn evaluate(sweep: &Sweep, run: &Path, device: ComputeDevice) -> Result<()> {
         return evaluate_baseline(sweep, run, &config);
     }
     let plan = &sweep.evaluation;
-    if config.skill_model.kind == SkillModelKind::Vic {
+    if config.seads.skill_model.kind == SkillModelKind::Vic {
         outln!(
             "{}: a VIC agent cannot plan; no task evaluation",
             run.display()

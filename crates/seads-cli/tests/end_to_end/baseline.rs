@@ -10,10 +10,10 @@ use crate::common::*;
 /// checkpoints every 10 epochs.
 fn tiny_config(dir: &Path, algorithm: &str) -> PathBuf {
     let path = dir.join(format!("{algorithm}.toml"));
-    let hac = if algorithm == "hac" {
-        "[hac]\nsubgoal_horizon = 4\n"
+    let (section, hac) = if algorithm == "hac" {
+        ("hac", "subgoal_horizon = 4\n")
     } else {
-        ""
+        ("sac_baseline", "")
     };
     std::fs::write(
         &path,
@@ -32,10 +32,9 @@ hidden = [16, 16]
 batch_size = 16
 alpha = 0.1
 
-[baseline]
+[{section}]
 replay_capacity = 100
 eval_boards = 1
-
 {hac}"#
         ),
     )
@@ -139,16 +138,21 @@ fn bad_baseline_settings_are_bad_input() {
             "hac.temperature",
         ),
         (
-            "algorithm = \"sac\"\n[baseline]\nupdates_per_epoch = -1.0\n",
-            "updates_per_epoch",
+            "algorithm = \"sac\"\n[sac_baseline]\nupdates_per_epoch = -1.0\n",
+            "sac_baseline.updates_per_epoch must be positive",
         ),
+        (
+            "algorithm = \"sac\"\n[seads]\nnum_skills = 30\n",
+            "[seads] is the section of algorithm \"seads\", not of this run's \"sac\"",
+        ),
+        (
+            "[sac_baseline]\nupdates_per_epoch = 0.5\n",
+            "[sac_baseline] is the section",
+        ),
+        // A file of the older, flat layout is read the same way.
         (
             "algorithm = \"sac\"\nnum_skills = 30\n",
-            "num_skills is not a setting",
-        ),
-        (
-            "[baseline]\nupdates_per_epoch = 0.5\n",
-            "baseline is not a setting of SEADS",
+            "[seads] is the section",
         ),
     ] {
         let config = dir.path().join("bad.toml");
@@ -298,15 +302,15 @@ max_expanded = 500
 
 [[variant]]
 name = "seads"
-overrides = { sampled_episodes = 16, recent_episodes = 16, episodes_per_epoch = 8, skill_model = { hidden = [16, 16] } }
+overrides = { seads = { sampled_episodes = 16, recent_episodes = 16, episodes_per_epoch = 8, skill_model = { hidden = [16, 16] } } }
 
 [[variant]]
 name = "sac"
-overrides = { algorithm = "sac", baseline = { replay_capacity = 100, eval_boards = 1 } }
+overrides = { algorithm = "sac", sac_baseline = { replay_capacity = 100, eval_boards = 1 } }
 
 [[variant]]
 name = "hac"
-overrides = { algorithm = "hac", baseline = { replay_capacity = 100, eval_boards = 1 }, hac = { subgoal_horizon = 4 } }
+overrides = { algorithm = "hac", hac = { replay_capacity = 100, eval_boards = 1, subgoal_horizon = 4 } }
 "#,
     )
     .unwrap();
@@ -315,7 +319,7 @@ overrides = { algorithm = "hac", baseline = { replay_capacity = 100, eval_boards
     let sac = sweep.join("runs/lightsout-cursor/sac/seed-1");
     let config = std::fs::read_to_string(sac.join("config.toml")).unwrap();
     assert!(
-        config.contains("algorithm = \"sac\"") && config.contains("[baseline]"),
+        config.contains("algorithm = \"sac\"") && config.contains("[sac_baseline]"),
         "{config}"
     );
     seads_ok(&["sweep", "run", s(&sweep), "--quiet"]);

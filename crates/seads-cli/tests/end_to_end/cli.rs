@@ -164,6 +164,9 @@ fn envs_json_lists_every_environment() {
             "lightsout-reacher",
             "tileswap-reacher",
             "sliding-reacher",
+            "lightsout-reacher3",
+            "tileswap-reacher3",
+            "sliding-reacher3",
             "lightsout-jaco",
             "tileswap-jaco",
             "lightsout3d-jaco"
@@ -175,6 +178,9 @@ fn envs_json_lists_every_environment() {
     // The 8-puzzle under the Cursor: its position (2), 81 one-hot bits, the time left.
     assert_eq!(obs_dim("sliding-cursor"), 84);
     assert_eq!(v[2]["title"], "SlidingCursor");
+    // The three-link arm: its joint angles and velocities (6), 25 lights, the time left.
+    assert_eq!(obs_dim("lightsout-reacher3"), 32);
+    assert_eq!(v[6]["title"], "LightsOutReacher3");
 }
 
 #[test]
@@ -1037,8 +1043,8 @@ fn a_vic_run_is_plotted_and_reported_without_planning() {
     let dir = tempfile::tempdir().unwrap();
     let config = tiny_config(dir.path());
     let text = std::fs::read_to_string(&config).unwrap().replace(
-        "[skill_model]\nkind = \"forward\"",
-        "[skill_model]\nkind = \"vic\"",
+        "[seads.skill_model]\nkind = \"forward\"",
+        "[seads.skill_model]\nkind = \"vic\"",
     );
     assert!(text.contains("kind = \"vic\""));
     std::fs::write(&config, text).unwrap();

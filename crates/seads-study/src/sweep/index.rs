@@ -5,6 +5,7 @@ use std::path::{Path, PathBuf};
 
 use crate::error::{fail, failure};
 use crate::{Context as _, Result};
+use seads_rl::TrainConfig;
 use serde::{Deserialize, Serialize};
 
 use super::manifest::{EvaluationPlan, Manifest};
@@ -182,7 +183,10 @@ impl Sweep {
             let config = out.join(run.rel_dir()).join("config.toml");
             let planned = run.config.to_toml();
             match std::fs::read_to_string(&config) {
-                Ok(text) if text == planned => {}
+                // Written by this version, or by an older one in its layout.
+                Ok(text)
+                    if text == planned
+                        || TrainConfig::from_toml(&text).is_ok_and(|c| c == run.config) => {}
                 Ok(_) => fail!(
                     "{} differs from the manifest's configuration; it was changed after planning",
                     config.display()

@@ -7,7 +7,7 @@ use std::collections::BTreeMap;
 use crate::Result;
 use crate::error::{fail, failure};
 use seads_embodiment::env_names;
-use seads_rl::TrainConfig;
+use seads_rl::{Algorithm, TrainConfig};
 use serde::{Deserialize, Serialize};
 
 /// A study, as written in `experiments/*.toml`.
@@ -244,10 +244,10 @@ impl Manifest {
             .flatten()
             .filter_map(|layer| layer.get("algorithm").and_then(|v| v.as_str()))
             .next_back();
-        let presets = match named {
-            Some("sac") => TrainConfig::sac_presets(),
-            Some("hac") => TrainConfig::hac_presets(),
-            _ => TrainConfig::presets(),
+        let (presets, algorithm) = match named {
+            Some("sac") => (TrainConfig::sac_presets(), Algorithm::Sac),
+            Some("hac") => (TrainConfig::hac_presets(), Algorithm::Hac),
+            _ => (TrainConfig::presets(), Algorithm::Seads),
         };
         let preset = presets
             .iter()
@@ -271,7 +271,11 @@ impl Manifest {
                     );
                 }
             }
-            seads_rl::merge_toml(&mut table, layer);
+            // A manifest of an older version overrides in the flat layout.
+            let mut layer = layer.clone();
+            seads_rl::upgrade_flat_layout(&mut layer, algorithm)
+                .map_err(|e| failure!("variant {:?}: {what}: {e}", variant.name))?;
+            seads_rl::merge_toml(&mut table, &layer);
         }
         table.insert("seed".into(), toml::Value::Integer(seed as i64));
         let config: TrainConfig =
@@ -341,19 +345,19 @@ env_overrides = { "lightsout-cursor" = { num_skills = 30 }, "tileswap-cursor" = 
             assert_eq!(run.config.sac, preset.sac);
             match run.variant.as_str() {
                 "no-relabelling" => {
-                    assert_eq!(run.config.relabel.sac_p, 0.0);
-                    assert_eq!(run.config.relabel.skill_model_p, 0.0);
-                    assert_eq!(run.config.relabel.kind, preset.relabel.kind);
+                    assert_eq!(run.config.seads.relabel.sac_p, 0.0);
+                    assert_eq!(run.config.seads.relabel.skill_model_p, 0.0);
+                    assert_eq!(run.config.seads.relabel.kind, preset.seads.relabel.kind);
                 }
                 "more-skills" => assert_eq!(
-                    run.config.num_skills,
+                    run.config.seads.num_skills,
                     Some(if run.env == "lightsout-cursor" {
                         30
                     } else {
                         15
                     })
                 ),
-                _ => assert_eq!(run.config.relabel, preset.relabel),
+                _ => assert_eq!(run.config.seads.relabel, preset.seads.relabel),
             }
         }
     }
@@ -379,7 +383,7 @@ env_overrides = { "lightsout-cursor" = { num_skills = 30 }, "tileswap-cursor" = 
             ),
             (
                 SMALL.replace("sac_p = 0.0 }", "sac_p = 2.0 }"),
-                "relabel.sac_p must lie in [0, 1]",
+                "seads.relabel.sac_p must lie in [0, 1]",
             ),
             (
                 SMALL.replace("env_steps = 1000", "seed = 3"),
@@ -412,6 +416,40 @@ env_overrides = { "lightsout-cursor" = { num_skills = 30 }, "tileswap-cursor" = 
             let e = Manifest::parse(&text, "m.toml").unwrap_err().to_string();
             assert!(e.contains(expected), "{e:?} should say {expected:?}");
             assert!(!e.contains('\n'), "{e:?} is one line");
+        }
+    }
+
+    /// Every manifest of `experiments/` and every study's committed copy (whichever layout its
+    /// overrides were written in) expands into valid runs.
+    #[test]
+    fn every_shipped_and_committed_manifest_expands() {
+        let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../..");
+        let mut files = Vec::new();
+        for entry in std::fs::read_dir(root.join("experiments")).unwrap() {
+            files.push(entry.unwrap().path());
+        }
+        let mut stack = vec![root.join("docs/results")];
+        while let Some(dir) = stack.pop() {
+            for entry in std::fs::read_dir(dir).unwrap() {
+                let path = entry.unwrap().path();
+                if path.is_dir() {
+                    stack.push(path);
+                } else if path.file_name().is_some_and(|n| n == "manifest.toml") {
+                    files.push(path);
+                }
+            }
+        }
+        let manifests: Vec<_> = files
+            .iter()
+            .filter(|p| p.extension().is_some_and(|e| e == "toml"))
+            .collect();
+        assert!(manifests.len() > 20, "{}", manifests.len());
+        for path in manifests {
+            let text = std::fs::read_to_string(path).unwrap();
+            let runs = Manifest::parse(&text, "m.toml")
+                .and_then(|m| m.expand())
+                .unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+            assert!(!runs.is_empty(), "{}", path.display());
         }
     }
 
@@ -486,35 +524,37 @@ env_overrides = { "lightsout-cursor" = { num_skills = 30 }, "tileswap-cursor" = 
                     v if m.name == "sac-grid" => {
                         // n<N>-a<alpha>, N with "_" for ".".
                         let (n, a) = v[1..].split_once("-a").unwrap();
-                        expected.baseline.updates_per_epoch = n.replace('_', ".").parse().unwrap();
+                        expected.sac_baseline.updates_per_epoch =
+                            n.replace('_', ".").parse().unwrap();
                         expected.sac.alpha = a.parse().unwrap();
                     }
                     "no-second-best-norm" => {
-                        expected.reward.normalisation = seads_skillmodel::Normalisation::LogK;
+                        expected.seads.reward.normalisation = seads_skillmodel::Normalisation::LogK;
                     }
-                    "no-novelty-bonus" => expected.reward.novelty_bonus = false,
+                    "no-novelty-bonus" => expected.seads.reward.novelty_bonus = false,
                     "no-relabelling" => {
-                        expected.relabel.skill_model_p = 0.0;
-                        expected.relabel.sac_p = 0.0;
+                        expected.seads.relabel.skill_model_p = 0.0;
+                        expected.seads.relabel.sac_p = 0.0;
                     }
-                    "no-forward-model-relabelling" => expected.relabel.skill_model_p = 0.0,
-                    "no-sac-relabelling" => expected.relabel.sac_p = 0.0,
+                    "no-forward-model-relabelling" => expected.seads.relabel.skill_model_p = 0.0,
+                    "no-sac-relabelling" => expected.seads.relabel.sac_p = 0.0,
                     "more-skills" => {
-                        expected.num_skills = Some(if run.env.starts_with("lightsout") {
+                        expected.seads.num_skills = Some(if run.env.starts_with("lightsout") {
                             30
                         } else {
                             15
                         });
                     }
                     v if v.starts_with("vic") => {
-                        expected.skill_model.kind = seads_skillmodel::SkillModelKind::Vic;
-                        expected.reward.novelty_bonus = false;
+                        expected.seads.skill_model.kind = seads_skillmodel::SkillModelKind::Vic;
+                        expected.seads.reward.novelty_bonus = false;
                         if v != "vic-sbn" {
-                            expected.reward.normalisation = seads_skillmodel::Normalisation::LogK;
+                            expected.seads.reward.normalisation =
+                                seads_skillmodel::Normalisation::LogK;
                         }
                         if v != "vic-relabelling" {
-                            expected.relabel.skill_model_p = 0.0;
-                            expected.relabel.sac_p = 0.0;
+                            expected.seads.relabel.skill_model_p = 0.0;
+                            expected.seads.relabel.sac_p = 0.0;
                         }
                     }
                     v if v.starts_with("size-") => expected.env_config = c.env_config.clone(),

@@ -1,0 +1,308 @@
+//! The algorithms and their sections of a run's configuration: `[seads]`, `[sac_baseline]` and
+//! `[hac]`, each with the paper's defaults and its own checks. A run's file holds the section of
+//! its algorithm only (`config.rs`).
+
+use seads_skillmodel::{RelabelKind, RewardConfig, SkillModelConfig};
+use serde::{Deserialize, Serialize};
+
+use crate::RlError;
+
+/// What a run trains.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Algorithm {
+    /// SEADS: reward-free skills and their forward model (SPEC §3).
+    #[default]
+    Seads,
+    /// The flat SAC baseline with the task reward (SPEC §5.1).
+    Sac,
+    /// The two-level HAC baseline with the task reward (SPEC §5.2).
+    Hac,
+}
+
+impl Algorithm {
+    /// The name in configs and on the command line.
+    pub fn name(self) -> &'static str {
+        match self {
+            Algorithm::Seads => "seads",
+            Algorithm::Sac => "sac",
+            Algorithm::Hac => "hac",
+        }
+    }
+
+    /// Whether it is a task-reward baseline (SAC or HAC).
+    pub fn is_baseline(self) -> bool {
+        self != Algorithm::Seads
+    }
+
+    /// The name of its section in a configuration file.
+    pub fn section(self) -> &'static str {
+        match self {
+            Algorithm::Seads => "seads",
+            Algorithm::Sac => "sac_baseline",
+            Algorithm::Hac => "hac",
+        }
+    }
+
+    /// Every algorithm.
+    pub const ALL: [Algorithm; 3] = [Algorithm::Seads, Algorithm::Sac, Algorithm::Hac];
+}
+
+/// SEADS's own settings (`[seads]`, SPEC §3): skills, episode buffers, the skill model, the
+/// intrinsic reward and relabelling. Its SAC is the shared `[sac]` section.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct SeadsConfig {
+    /// Number of skills K (default: the number of game moves; the "more skills" ablation sets
+    /// 30 / 15).
+    pub num_skills: Option<usize>,
+    /// New episodes per epoch.
+    pub episodes_per_epoch: usize,
+    /// Long-term episode buffer capacity.
+    pub buffer_capacity: usize,
+    /// Short-term list of the most recent episodes.
+    pub recent_episodes: usize,
+    /// Episodes drawn from the long-term buffer per update.
+    pub sampled_episodes: usize,
+    /// Number of evaluation seeds (444555, 444556, …) for skill coverage.
+    pub eval_seeds: u64,
+    /// Forward model (or VIC discriminator).
+    pub skill_model: SkillModelConfig,
+    /// Intrinsic reward.
+    pub reward: RewardConfig,
+    /// Relabelling.
+    pub relabel: RelabelConfig,
+}
+
+impl Default for SeadsConfig {
+    fn default() -> Self {
+        Self {
+            num_skills: None,
+            episodes_per_epoch: 32,
+            buffer_capacity: 2048,
+            recent_episodes: 256,
+            sampled_episodes: 256,
+            eval_seeds: 20,
+            skill_model: SkillModelConfig::default(),
+            reward: RewardConfig::default(),
+            relabel: RelabelConfig::default(),
+        }
+    }
+}
+
+impl SeadsConfig {
+    /// Checks every value.
+    pub fn validate(&self) -> Result<(), RlError> {
+        let bad = |m: String| Err(RlError::Config(m));
+        self.skill_model.validate()?;
+        if self.num_skills == Some(0) {
+            return bad("seads.num_skills must be at least 1".into());
+        }
+        if self.eval_seeds == 0 {
+            return bad("seads.eval_seeds must be at least 1".into());
+        }
+        if self.eval_seeds > MAX_PER_EPOCH {
+            return bad(format!(
+                "seads.eval_seeds must be at most {MAX_PER_EPOCH}, got {}",
+                self.eval_seeds
+            ));
+        }
+        for (name, value) in [
+            ("episodes_per_epoch", self.episodes_per_epoch),
+            ("buffer_capacity", self.buffer_capacity),
+            ("recent_episodes", self.recent_episodes),
+            ("sampled_episodes", self.sampled_episodes),
+        ] {
+            if value == 0 {
+                return bad(format!("seads.{name} must be at least 1"));
+            }
+        }
+        if self.sampled_episodes > self.buffer_capacity
+            || self.recent_episodes > self.buffer_capacity
+        {
+            return bad(
+                "seads.sampled_episodes and seads.recent_episodes must not exceed \
+                 seads.buffer_capacity"
+                    .into(),
+            );
+        }
+        for (name, p) in [
+            ("seads.relabel.skill_model_p", self.relabel.skill_model_p),
+            ("seads.relabel.sac_p", self.relabel.sac_p),
+        ] {
+            check_probability(name, p)?;
+        }
+        Ok(())
+    }
+}
+
+/// Relabelling switches (SPEC §3.6; the ablations set the probabilities to 0).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct RelabelConfig {
+    /// Assignment (SEADS) or independent maximum.
+    pub kind: RelabelKind,
+    /// Probability that an episode of the forward-model batch may be relabelled.
+    pub skill_model_p: f64,
+    /// Probability that a board-changing episode of the SAC batch may be relabelled.
+    pub sac_p: f64,
+}
+
+impl Default for RelabelConfig {
+    fn default() -> Self {
+        Self {
+            kind: RelabelKind::Assignment,
+            skill_model_p: 1.0,
+            sac_p: 0.5,
+        }
+    }
+}
+
+/// How a task-reward baseline collects and learns (SPEC §5.1): the flat SAC baseline's section
+/// `[sac_baseline]`, and the part of `[hac]` that HAC shares with it ([`HacConfig::training`]).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct BaselineConfig {
+    /// Transitions kept in the replay buffer (the most recent).
+    pub replay_capacity: usize,
+    /// Environments stepped once per epoch: the new transitions of an epoch.
+    pub samples_per_epoch: usize,
+    /// Gradient steps per epoch N; N < 1 means one step every 1/N epochs.
+    pub updates_per_epoch: f64,
+    /// Test boards per depth 1–5 of each task-success evaluation.
+    pub eval_boards: usize,
+}
+
+impl Default for BaselineConfig {
+    fn default() -> Self {
+        Self {
+            replay_capacity: 1_000_000,
+            samples_per_epoch: 8,
+            updates_per_epoch: 1.0,
+            eval_boards: 20,
+        }
+    }
+}
+
+impl BaselineConfig {
+    /// Checks every value; `section` names the section in messages.
+    pub fn validate(&self, section: &str) -> Result<(), RlError> {
+        let bad = |m: String| Err(RlError::Config(m));
+        if self.replay_capacity == 0 || self.samples_per_epoch == 0 || self.eval_boards == 0 {
+            return bad(format!(
+                "{section}.replay_capacity, {section}.samples_per_epoch and \
+                 {section}.eval_boards must be at least 1"
+            ));
+        }
+        for (name, value) in [
+            ("samples_per_epoch", self.samples_per_epoch),
+            ("eval_boards", self.eval_boards),
+        ] {
+            if value as u64 > MAX_PER_EPOCH {
+                return bad(format!(
+                    "{section}.{name} must be at most {MAX_PER_EPOCH}, got {value}"
+                ));
+            }
+        }
+        let n = self.updates_per_epoch;
+        if !(n.is_finite() && n > 0.0) {
+            return bad(format!(
+                "{section}.updates_per_epoch must be positive, got {n}"
+            ));
+        }
+        if n > MAX_PER_EPOCH as f64 {
+            return bad(format!(
+                "{section}.updates_per_epoch must be at most {MAX_PER_EPOCH}, got {n}"
+            ));
+        }
+        Ok(())
+    }
+}
+
+/// The HAC baseline's section `[hac]` (SPEC §5.2): how it collects and learns, as the SAC
+/// baseline does, and its high level. The low level is the `[sac]` section (its α is α_low);
+/// the high level has the same networks and optimiser with its own α. Choices where the seed is
+/// silent follow Levy's HAC (`src/hac.rs`).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct HacConfig {
+    /// Low-level transitions kept in the replay buffer (the most recent).
+    pub replay_capacity: usize,
+    /// Environments stepped once per epoch.
+    pub samples_per_epoch: usize,
+    /// Gradient steps of each level per epoch N; N < 1 means one step every 1/N epochs.
+    pub updates_per_epoch: f64,
+    /// Test boards per depth 1–5 of each task-success evaluation.
+    pub eval_boards: usize,
+    /// Temperature τ_RB of the high level's RelaxedBernoulli policy.
+    pub temperature: f64,
+    /// Fixed entropy temperature α_high of the high level.
+    pub alpha_high: f64,
+    /// Low-level steps a subgoal may take, H (the presets: the environment's steps per skill).
+    pub subgoal_horizon: usize,
+    /// Share of subgoals tested: pursued without exploration noise, and penalised when missed.
+    pub subgoal_test_p: f64,
+}
+
+impl Default for HacConfig {
+    fn default() -> Self {
+        let training = BaselineConfig::default();
+        Self {
+            replay_capacity: training.replay_capacity,
+            samples_per_epoch: training.samples_per_epoch,
+            updates_per_epoch: training.updates_per_epoch,
+            eval_boards: training.eval_boards,
+            temperature: 0.1,
+            alpha_high: 0.001,
+            subgoal_horizon: 10,
+            subgoal_test_p: 0.3,
+        }
+    }
+}
+
+impl HacConfig {
+    /// How HAC collects and learns, in the SAC baseline's terms.
+    pub fn training(&self) -> BaselineConfig {
+        BaselineConfig {
+            replay_capacity: self.replay_capacity,
+            samples_per_epoch: self.samples_per_epoch,
+            updates_per_epoch: self.updates_per_epoch,
+            eval_boards: self.eval_boards,
+        }
+    }
+
+    /// Checks every value.
+    pub fn validate(&self) -> Result<(), RlError> {
+        self.training().validate("hac")?;
+        check_probability("hac.subgoal_test_p", self.subgoal_test_p)?;
+        for (name, v) in [
+            ("hac.temperature", self.temperature),
+            ("hac.alpha_high", self.alpha_high),
+        ] {
+            if !(v.is_finite() && v > 0.0) {
+                return Err(RlError::Config(format!("{name} must be positive, got {v}")));
+            }
+        }
+        if self.subgoal_horizon == 0 {
+            return Err(RlError::Config(
+                "hac.subgoal_horizon must be at least 1".into(),
+            ));
+        }
+        Ok(())
+    }
+}
+
+fn check_probability(name: &str, p: f64) -> Result<(), RlError> {
+    if (0.0..=1.0).contains(&p) {
+        Ok(())
+    } else {
+        Err(RlError::Config(format!(
+            "{name} must lie in [0, 1], got {p}"
+        )))
+    }
+}
+
+/// The most evaluations, updates, samples or boards a configuration may ask for per epoch (or
+/// per evaluation): a million, far beyond the paper's settings (tens to thousands), far below
+/// what would never end.
+pub(crate) const MAX_PER_EPOCH: u64 = 1_000_000;
