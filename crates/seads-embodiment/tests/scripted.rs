@@ -42,10 +42,10 @@ fn envs_of(manipulator: &str) -> Vec<&'static str> {
 }
 
 /// Runs `controller` from a fresh reset until the skill ends; returns the move it made.
-fn run_skill(
+fn run_skill<const A: usize>(
     env: &mut dyn Environment,
     seed: u64,
-    mut controller: impl FnMut(&[f32]) -> [f32; 3],
+    mut controller: impl FnMut(&[f32]) -> [f32; A],
 ) -> Option<MoveId> {
     env.seed(seed);
     env.reset().unwrap();
@@ -63,7 +63,10 @@ fn run_skill(
 
 /// Aims `controller` at every move that changes the reset board (all of them but in games
 /// whose moves depend on the state), on every seed; each must be made.
-fn check_all_moves(name: &str, controller: impl Fn(Layout, MoveId, [f64; 2], &[f32]) -> [f32; 3]) {
+fn check_all_moves<const A: usize>(
+    name: &str,
+    controller: impl Fn(Layout, MoveId, [f64; 2], &[f32]) -> [f32; A],
+) {
     let mut env = make_env(name, &EnvConfig::default()).unwrap();
     let spec = env.spec().clone();
     let game = spec.game.build(spec.board_size).unwrap();
@@ -163,6 +166,76 @@ fn reacher_controller(
 fn reacher_produces_every_move() {
     for name in envs_of("-reacher") {
         check_all_moves(name, reacher_controller);
+    }
+}
+
+/// Reacher3: inverse kinematics with the last link along a direction near the target's bearing
+/// (the first of a few offsets, and elbow sides, that keeps both limited joints well inside
+/// ±160°), a PD law on the three joints, and a push when the fingertip is well inside the
+/// target's region and nearly still.
+fn reacher3_controller(
+    layout: Layout,
+    target_move: MoveId,
+    target: [f64; 2],
+    obs: &[f32],
+) -> [f32; 4] {
+    const L: f64 = 0.08;
+    use std::f64::consts::{PI, TAU};
+    let q: [f64; 3] = std::array::from_fn(|i| obs[i] as f64);
+    let qd: [f64; 3] = std::array::from_fn(|i| obs[3 + i] as f64);
+    let wrap = |a: f64| a - (a / TAU).round() * TAU;
+    let p = [target[0] * 0.3 - 0.15, target[1] * 0.3 - 0.15];
+    let bearing = p[1].atan2(p[0]);
+    let offsets = [0.0, 0.5, -0.5, 1.0, -1.0, 1.5, -1.5, 2.0, -2.0, PI];
+    let goal = offsets
+        .iter()
+        .flat_map(|d| [1.0, -1.0].map(move |side| (bearing + d, side)))
+        .find_map(|(phi, side): (f64, f64)| {
+            let w = [p[0] - L * phi.cos(), p[1] - L * phi.sin()];
+            let c2 = (w[0] * w[0] + w[1] * w[1] - 2.0 * L * L) / (2.0 * L * L);
+            if c2.abs() > 1.0 {
+                return None;
+            }
+            let q2 = side * c2.acos();
+            let q1 = w[1].atan2(w[0]) - (L * q2.sin()).atan2(L + L * q2.cos());
+            let q3 = wrap(phi - q1 - q2);
+            (q2.abs() < 2.5 && q3.abs() < 2.5).then_some([q1, q2, q3])
+        })
+        .expect("every field and pivot of the board is within reach");
+    let gains = [(1.0, 0.1), (1.0, 0.05), (1.0, 0.03)];
+    let u: [f64; 3] = std::array::from_fn(|j| {
+        let error = if j == 0 {
+            wrap(goal[0] - q[0])
+        } else {
+            goal[j] - q[j]
+        };
+        (gains[j].0 * error - gains[j].1 * qd[j]).clamp(-1.0, 1.0)
+    });
+    let tip = |q: [f64; 3]| {
+        let (mut angle, mut at) = (0.0, [0.0f64; 2]);
+        for a in q {
+            angle += a;
+            at = [at[0] + L * angle.cos(), at[1] + L * angle.sin()];
+        }
+        ((at[0] + 0.15) / 0.3, (at[1] + 0.15) / 0.3)
+    };
+    let margin = 0.01;
+    let next: [f64; 3] = std::array::from_fn(|j| q[j] + 0.04 * qd[j]);
+    let inside = [tip(q), tip(next)].iter().all(|&(tu, tv)| {
+        [(-1.0, -1.0), (-1.0, 1.0), (1.0, -1.0), (1.0, 1.0)]
+            .iter()
+            .all(|(du, dv)| layout.locate(tu + du * margin, tv + dv * margin) == Some(target_move))
+    });
+    let still =
+        qd.iter().map(|v| v.abs()).sum::<f64>() < 0.3 && q[1..].iter().all(|a| a.abs() < 2.95);
+    let push = if inside && still { 1.0 } else { -1.0 };
+    [u[0] as f32, u[1] as f32, u[2] as f32, push]
+}
+
+#[test]
+fn reacher3_produces_every_move() {
+    for name in envs_of("-reacher3") {
+        check_all_moves(name, reacher3_controller);
     }
 }
 
