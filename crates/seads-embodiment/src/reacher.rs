@@ -130,6 +130,17 @@ impl Reacher {
     }
 }
 
+/// Touches the board under the fingertip `tip` (world plane, m) when the push action `push` is
+/// on and the fingertip is over the board (the Reacher's and the Reacher3's push).
+pub(crate) fn push_at_fingertip(push: f32, tip: [f64; 2], touch: &mut dyn FnMut(Touch) -> Push) {
+    if push > PUSH_THRESHOLD {
+        let [u, v] = to_board(tip);
+        if (0.0..=1.0).contains(&u) && (0.0..=1.0).contains(&v) {
+            touch(Touch::At { u, v });
+        }
+    }
+}
+
 /// World plane (m) → normalised board coordinates (no flip: row 0 at y ≈ −0.15).
 pub(crate) fn to_board(p: [f64; 2]) -> [f64; 2] {
     [
@@ -168,12 +179,7 @@ impl Manipulator for Reacher {
         for _ in 0..SUBSTEPS {
             self.physics_step(u);
         }
-        if action[2] > PUSH_THRESHOLD {
-            let [bu, bv] = to_board(self.links().1);
-            if (0.0..=1.0).contains(&bu) && (0.0..=1.0).contains(&bv) {
-                touch(Touch::At { u: bu, v: bv });
-            }
-        }
+        push_at_fingertip(action[2], self.links().1, touch);
         self.q.iter().chain(&self.qd).all(|x| x.is_finite())
     }
 
@@ -284,33 +290,13 @@ mod tests {
     /// (`scripts/reference/reacher3_mujoco.py`).
     #[test]
     fn steps_match_mujoco() {
-        let text = include_str!("../../../data/reference/reacher3/steps.json");
-        let data: serde_json::Value = serde_json::from_str(text).unwrap();
-        let two = |v: &serde_json::Value| [v[0].as_f64().unwrap(), v[1].as_f64().unwrap()];
-        let steps = data["two_link"]["steps"].as_array().unwrap();
-        let limited = steps
-            .iter()
-            .filter(|s| two(&s["q"])[1].abs() > WRIST_LIMIT)
-            .count();
-        assert!(limited >= 50 && steps.len() - limited >= 50, "{limited}");
-        for step in steps {
-            let mut arm = Reacher {
-                q: two(&step["q"]),
-                qd: two(&step["qd"]),
-            };
-            arm.physics_step(two(&step["u"]));
-            let (q, qd) = (two(&step["q_next"]), two(&step["qd_next"]));
-            for i in 0..2 {
-                assert!(
-                    (arm.q[i] - q[i]).abs() < 1e-9 && (arm.qd[i] - qd[i]).abs() < 1e-7,
-                    "{step}: joint {i}: q {} against {}, q̇ {} against {}",
-                    arm.q[i],
-                    q[i],
-                    arm.qd[i],
-                    qd[i]
-                );
-            }
-        }
+        let starts = mujoco::check_steps("two_link", |q, qd, u| {
+            let mut arm = Reacher { q, qd };
+            arm.physics_step(u);
+            (arm.q, arm.qd)
+        });
+        let limited = starts.iter().filter(|q| q[1].abs() > WRIST_LIMIT).count();
+        assert!(limited >= 50 && starts.len() - limited >= 50, "{limited}");
     }
 
     #[test]
@@ -334,5 +320,43 @@ mod tests {
         assert!((impedance(0.0005) - 0.925).abs() < 1e-15);
         assert!((impedance(0.0004) - 0.916).abs() < 1e-12);
         assert_eq!(impedance(0.2), 0.95);
+    }
+}
+
+/// MuJoCo's own single physics steps of the planar arms (`data/reference/reacher3/steps.json`,
+/// written by `scripts/reference/reacher3_mujoco.py`), for the Reacher's and the Reacher3's tests.
+#[cfg(test)]
+pub(crate) mod mujoco {
+    /// Runs `step` from every recorded state of `model` (`two_link`, `three_link`) and checks
+    /// that it lands where MuJoCo's step did: angles within 10⁻⁹ rad, velocities within
+    /// 10⁻⁷ rad/s (MuJoCo's solver stops at its tolerance). Returns the recorded start angles.
+    pub(crate) fn check_steps<const K: usize>(
+        model: &str,
+        mut step: impl FnMut([f64; K], [f64; K], [f64; K]) -> ([f64; K], [f64; K]),
+    ) -> Vec<[f64; K]> {
+        let text = include_str!("../../../data/reference/reacher3/steps.json");
+        let data: serde_json::Value = serde_json::from_str(text).unwrap();
+        let joints =
+            |v: &serde_json::Value| -> [f64; K] { std::array::from_fn(|i| v[i].as_f64().unwrap()) };
+        let steps = data[model]["steps"].as_array().unwrap();
+        assert!(steps.len() >= 100, "{model}: {} steps", steps.len());
+        let mut starts = Vec::new();
+        for recorded in steps {
+            let q0 = joints(&recorded["q"]);
+            let (q, qd) = step(q0, joints(&recorded["qd"]), joints(&recorded["u"]));
+            let (q_ref, qd_ref) = (joints(&recorded["q_next"]), joints(&recorded["qd_next"]));
+            for i in 0..K {
+                assert!(
+                    (q[i] - q_ref[i]).abs() < 1e-9 && (qd[i] - qd_ref[i]).abs() < 1e-7,
+                    "{recorded}: joint {i}: q {} against {}, q̇ {} against {}",
+                    q[i],
+                    q_ref[i],
+                    qd[i],
+                    qd_ref[i]
+                );
+            }
+            starts.push(q0);
+        }
+        starts
     }
 }

@@ -13,9 +13,9 @@ use std::f64::consts::TAU;
 use rand::RngExt;
 use rand_chacha::ChaCha8Rng;
 
-use crate::cursor::PUSH_THRESHOLD;
 use crate::reacher::{
-    BOARD_HALF, DAMPING, GEAR, H, IMP_MAX, SUBSTEPS, TIME_CONST, WRIST_LIMIT, impedance, to_board,
+    BOARD_HALF, DAMPING, GEAR, H, IMP_MAX, SUBSTEPS, TIME_CONST, WRIST_LIMIT, impedance,
+    push_at_fingertip, to_board,
 };
 use crate::{Manipulator, Push, Shape, Touch};
 
@@ -60,7 +60,7 @@ const LINKS: [Link; N] = [
 
 /// MuJoCo's constraint regulariser weights of the limited joints (elbow, wrist): (M⁻¹)ⱼⱼ at
 /// q = 0.
-const INV_WEIGHT0: [f64; 2] = [43_824.606_405_652_47, 77_803.932_806_861_6];
+const INV_WEIGHT0: [f64; LIMITED] = [43_824.606_405_652_47, 77_803.932_806_861_6];
 
 /// Joint state of the three-link arm: angles q (shoulder, elbow, wrist) and velocities q̇.
 #[derive(Debug, Clone, Copy, Default, PartialEq)]
@@ -133,8 +133,9 @@ fn times(m: &Matrix, v: &[f64; N]) -> [f64; N] {
     std::array::from_fn(|i| (0..N).map(|j| m[i][j] * v[j]).sum())
 }
 
-/// An active soft limit: the joint, the sign of its Jacobian row, the violation (≤ 0) and the
-/// row's reference acceleration and regulariser.
+/// An active soft limit: the joint, the sign of its Jacobian row, and the row's reference
+/// acceleration and regulariser.
+#[derive(Clone, Copy, Default)]
 struct Limit {
     joint: usize,
     sign: f64,
@@ -142,40 +143,44 @@ struct Limit {
     r: f64,
 }
 
-/// The limit forces λ ≥ 0 that minimise ½ λᵀ(A + R)λ − λᵀb, with A = J M⁻¹ Jᵀ and
-/// b = a_ref − J a₀: the problem MuJoCo's solver minimises, solved exactly by trying the
-/// active sets of its (at most two) rows. The problem is strictly convex, so the one set whose
-/// solution satisfies the optimality conditions is the answer.
-fn limit_forces(limits: &[Limit], minv: &Matrix, a0: &[f64; N]) -> Vec<f64> {
+/// Joints with a soft limit: the elbow and the wrist.
+const LIMITED: usize = N - 1;
+
+/// The limit forces λ ≥ 0 of the active `limits` that minimise ½ λᵀ(A + R)λ − λᵀb, with
+/// A = J M⁻¹ Jᵀ and b = a_ref − J a₀: the problem MuJoCo's solver minimises, solved exactly by
+/// trying the active sets of its (at most two) rows. The problem is strictly convex, so the one
+/// set whose solution satisfies the optimality conditions is the answer.
+fn limit_forces(limits: &[Limit], minv: &Matrix, a0: &[f64; N]) -> [f64; LIMITED] {
     let n = limits.len();
     let a = |i: usize, j: usize| {
         let (x, y) = (&limits[i], &limits[j]);
         x.sign * y.sign * minv[x.joint][y.joint] + if i == j { x.r } else { 0.0 }
     };
-    let b: Vec<f64> = limits
-        .iter()
-        .map(|l| l.a_ref - l.sign * a0[l.joint])
-        .collect();
-    // Every subset of rows held active, the largest first.
+    let b = |i: usize| limits[i].a_ref - limits[i].sign * a0[limits[i].joint];
+    // Every subset of rows held active (bit i: row i), the largest first.
     for set in (0..1usize << n).rev() {
-        let active: Vec<usize> = (0..n).filter(|i| set >> i & 1 == 1).collect();
-        let mut lambda = vec![0.0; n];
-        match active[..] {
+        let active = |i: usize| set >> i & 1 == 1;
+        let (mut rows, mut count) = ([0usize; LIMITED], 0);
+        for i in (0..n).filter(|&i| active(i)) {
+            rows[count] = i;
+            count += 1;
+        }
+        let mut lambda = [0.0; LIMITED];
+        match rows[..count] {
             [] => {}
-            [i] => lambda[i] = b[i] / a(i, i),
+            [i] => lambda[i] = b(i) / a(i, i),
             [i, j] => {
                 let det = a(i, i) * a(j, j) - a(i, j) * a(j, i);
-                lambda[i] = (a(j, j) * b[i] - a(i, j) * b[j]) / det;
-                lambda[j] = (a(i, i) * b[j] - a(j, i) * b[i]) / det;
+                lambda[i] = (a(j, j) * b(i) - a(i, j) * b(j)) / det;
+                lambda[j] = (a(i, i) * b(j) - a(j, i) * b(i)) / det;
             }
             _ => unreachable!("at most two limited joints"),
         }
         let optimal = (0..n).all(|i| {
-            let slack = (0..n).map(|j| a(i, j) * lambda[j]).sum::<f64>() - b[i];
-            if active.contains(&i) {
+            if active(i) {
                 lambda[i] >= 0.0
             } else {
-                slack >= 0.0
+                (0..n).map(|j| a(i, j) * lambda[j]).sum::<f64>() >= b(i)
             }
         });
         if optimal {
@@ -183,7 +188,7 @@ fn limit_forces(limits: &[Limit], minv: &Matrix, a0: &[f64; N]) -> Vec<f64> {
         }
     }
     // Unreachable for a positive-definite problem; NaN states end here and stay NaN.
-    vec![f64::NAN; n]
+    [f64::NAN; LIMITED]
 }
 
 impl Reacher3 {
@@ -202,29 +207,31 @@ impl Reacher3 {
         let minv = inverse(&mass);
         let a0 = times(&minv, &smooth);
 
-        let limits: Vec<Limit> = (1..N)
-            .filter_map(|joint| {
-                let q = self.q[joint];
-                let (dist, sign) = if q < -WRIST_LIMIT {
-                    (q + WRIST_LIMIT, 1.0)
-                } else if q > WRIST_LIMIT {
-                    (WRIST_LIMIT - q, -1.0)
-                } else {
-                    return None;
-                };
-                let imp = impedance(dist.abs());
-                let b = 2.0 / (IMP_MAX * TIME_CONST);
-                let k = 1.0 / (IMP_MAX * IMP_MAX * TIME_CONST * TIME_CONST);
-                Some(Limit {
-                    joint,
-                    sign,
-                    a_ref: -b * sign * self.qd[joint] - k * imp * dist,
-                    r: (1.0 - imp) / imp * INV_WEIGHT0[joint - 1],
-                })
-            })
-            .collect();
+        // The violated limits, at most one per limited joint.
+        let (mut limits, mut count) = ([Limit::default(); LIMITED], 0);
+        for joint in 1..N {
+            let q = self.q[joint];
+            let (dist, sign) = if q < -WRIST_LIMIT {
+                (q + WRIST_LIMIT, 1.0)
+            } else if q > WRIST_LIMIT {
+                (WRIST_LIMIT - q, -1.0)
+            } else {
+                continue;
+            };
+            let imp = impedance(dist.abs());
+            let b = 2.0 / (IMP_MAX * TIME_CONST);
+            let k = 1.0 / (IMP_MAX * IMP_MAX * TIME_CONST * TIME_CONST);
+            limits[count] = Limit {
+                joint,
+                sign,
+                a_ref: -b * sign * self.qd[joint] - k * imp * dist,
+                r: (1.0 - imp) / imp * INV_WEIGHT0[joint - 1],
+            };
+            count += 1;
+        }
+        let limits = &limits[..count];
         let mut force = smooth;
-        for (limit, lambda) in limits.iter().zip(limit_forces(&limits, &minv, &a0)) {
+        for (limit, lambda) in limits.iter().zip(limit_forces(limits, &minv, &a0)) {
             force[limit.joint] += limit.sign * lambda;
         }
 
@@ -285,12 +292,7 @@ impl Manipulator for Reacher3 {
         for _ in 0..SUBSTEPS {
             self.physics_step(u);
         }
-        if action[N] > PUSH_THRESHOLD {
-            let [bu, bv] = self.end_effector();
-            if (0.0..=1.0).contains(&bu) && (0.0..=1.0).contains(&bv) {
-                touch(Touch::At { u: bu, v: bv });
-            }
-        }
+        push_at_fingertip(action[N], self.joints()[N - 1], touch);
         self.q.iter().chain(&self.qd).all(|x| x.is_finite())
     }
 
@@ -332,45 +334,20 @@ impl Manipulator for Reacher3 {
 mod tests {
     use super::*;
 
-    /// MuJoCo's single physics steps of this arm (`scripts/reference/reacher3_mujoco.py`).
-    fn mujoco_steps() -> Vec<serde_json::Value> {
-        let text = include_str!("../../../data/reference/reacher3/steps.json");
-        let data: serde_json::Value = serde_json::from_str(text).unwrap();
-        data["three_link"]["steps"].as_array().unwrap().clone()
-    }
-
-    fn three(v: &serde_json::Value) -> [f64; N] {
-        std::array::from_fn(|i| v[i].as_f64().unwrap())
-    }
-
-    /// Every recorded step, free or against one or both limits, lands where MuJoCo's did.
-    /// MuJoCo's Newton solver stops at its tolerance; the exact solution here differs from it
-    /// by far less than the step changes the state.
+    /// Every recorded step, free or against one or both limits, lands where MuJoCo's did
+    /// (MuJoCo's Newton solver stops at its tolerance; the solution here is exact).
     #[test]
     fn steps_match_mujoco() {
-        let steps = mujoco_steps();
-        let mut limited = [0usize; 3];
-        for step in &steps {
-            let mut arm = Reacher3 {
-                q: three(&step["q"]),
-                qd: three(&step["qd"]),
-            };
-            let active = (1..N).filter(|&j| arm.q[j].abs() > WRIST_LIMIT).count();
-            limited[active] += 1;
-            arm.physics_step(three(&step["u"]));
-            let (q, qd) = (three(&step["q_next"]), three(&step["qd_next"]));
-            for i in 0..N {
-                assert!(
-                    (arm.q[i] - q[i]).abs() < 1e-9 && (arm.qd[i] - qd[i]).abs() < 1e-7,
-                    "{step}: joint {i}: q {} against {}, q̇ {} against {}",
-                    arm.q[i],
-                    q[i],
-                    arm.qd[i],
-                    qd[i]
-                );
-            }
-        }
+        let starts = crate::reacher::mujoco::check_steps("three_link", |q, qd, u| {
+            let mut arm = Reacher3 { q, qd };
+            arm.physics_step(u);
+            (arm.q, arm.qd)
+        });
         // Free steps, one limit and both at once are all covered.
+        let mut limited = [0usize; 3];
+        for q in &starts {
+            limited[(1..N).filter(|&j| q[j].abs() > WRIST_LIMIT).count()] += 1;
+        }
         assert!(limited.iter().all(|&n| n >= 20), "{limited:?}");
     }
 

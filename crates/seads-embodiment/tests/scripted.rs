@@ -145,13 +145,8 @@ fn reacher_controller(
         ];
         ((t[0] + 0.15) / 0.3, (t[1] + 0.15) / 0.3)
     };
-    let margin = 0.01;
     let next = [q[0] + 0.04 * qd[0], q[1] + 0.04 * qd[1]];
-    let inside = [tip(q), tip(next)].iter().all(|&(tu, tv)| {
-        [(-1.0, -1.0), (-1.0, 1.0), (1.0, -1.0), (1.0, 1.0)]
-            .iter()
-            .all(|(du, dv)| layout.locate(tu + du * margin, tv + dv * margin) == Some(target_move))
-    });
+    let inside = well_inside(layout, target_move, [tip(q), tip(next)]);
     // Far beyond ±160° the soft wrist limit yanks the arm back within the step: no push then
     // (slightly beyond is the resting pose of a wrist pressed against its limit).
     let still = qd[0].abs() + qd[1].abs() < 0.3 && q[1].abs() < 2.95;
@@ -160,6 +155,17 @@ fn reacher_controller(
         u[1] as f32,
         if inside && still { 1.0 } else { -1.0 },
     ]
+}
+
+/// Whether every point (board coordinates: the fingertip now and after the next step, where
+/// the push is evaluated) lies in the region of `target_move` with a margin of 0.01 all round.
+fn well_inside(layout: Layout, target_move: MoveId, points: [(f64, f64); 2]) -> bool {
+    let margin = 0.01;
+    points.iter().all(|&(u, v)| {
+        [(-1.0, -1.0), (-1.0, 1.0), (1.0, -1.0), (1.0, 1.0)]
+            .iter()
+            .all(|(du, dv)| layout.locate(u + du * margin, v + dv * margin) == Some(target_move))
+    })
 }
 
 #[test]
@@ -219,13 +225,8 @@ fn reacher3_controller(
         }
         ((at[0] + 0.15) / 0.3, (at[1] + 0.15) / 0.3)
     };
-    let margin = 0.01;
     let next: [f64; 3] = std::array::from_fn(|j| q[j] + 0.04 * qd[j]);
-    let inside = [tip(q), tip(next)].iter().all(|&(tu, tv)| {
-        [(-1.0, -1.0), (-1.0, 1.0), (1.0, -1.0), (1.0, 1.0)]
-            .iter()
-            .all(|(du, dv)| layout.locate(tu + du * margin, tv + dv * margin) == Some(target_move))
-    });
+    let inside = well_inside(layout, target_move, [tip(q), tip(next)]);
     let still =
         qd.iter().map(|v| v.abs()).sum::<f64>() < 0.3 && q[1..].iter().all(|a| a.abs() < 2.95);
     let push = if inside && still { 1.0 } else { -1.0 };
