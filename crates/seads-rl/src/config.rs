@@ -201,9 +201,7 @@ impl TrainConfig {
             );
         }
         let algorithm = algorithm_of(&table)?;
-        if !flat_layout::upgrade(&mut table, algorithm)? {
-            check_sections(&table, algorithm)?;
-        }
+        into_sections(&mut table, algorithm)?;
         // The values the file states, before what it leaves out is filled in.
         Self::from_table(table.clone())?;
         let Some(toml::Value::String(env)) = table.get("env").cloned() else {
@@ -233,10 +231,9 @@ impl TrainConfig {
     pub fn from_toml(text: &str) -> Result<Self, RlError> {
         let mut table = parse_table(text)?;
         let algorithm = algorithm_of(&table)?;
-        if flat_layout::upgrade(&mut table, algorithm)? {
+        if into_sections(&mut table, algorithm)? {
             return Self::from_table(table);
         }
-        check_sections(&table, algorithm)?;
         let config: Self =
             toml::from_str(text).map_err(|e| RlError::Config(one_line_toml_error(text, &e)))?;
         config.validate_values()?;
@@ -394,12 +391,7 @@ impl TrainConfig {
         .into_iter()
         .find(|&(a, default)| a != self.algorithm && !default);
         if let Some((other, _)) = changed {
-            return Err(RlError::Config(format!(
-                "[{}] is the section of algorithm {:?}, not of this run's {:?}; remove it",
-                other.section(),
-                other.name(),
-                self.algorithm.name()
-            )));
+            return Err(foreign_section(other, self.algorithm));
         }
         if self.algorithm.is_baseline()
             && self.sac.updates_per_epoch != SacConfig::default().updates_per_epoch
@@ -518,19 +510,31 @@ fn algorithm_of(table: &toml::Table) -> Result<Algorithm, RlError> {
     }
 }
 
-/// A file holds the section of its algorithm only: another algorithm's section is an error.
-fn check_sections(table: &toml::Table, algorithm: Algorithm) -> Result<(), RlError> {
-    for other in Algorithm::ALL.into_iter().filter(|&a| a != algorithm) {
-        if table.contains_key(other.section()) {
-            return Err(RlError::Config(format!(
-                "[{}] is the section of algorithm {:?}, not of this run's {:?}; remove it",
-                other.section(),
-                other.name(),
-                algorithm.name()
-            )));
-        }
+/// Brings `table` (a configuration of `algorithm`) into the sectioned layout: a file of the flat
+/// layout is upgraded (returns `true`; the sections it carried at their defaults are checked
+/// by value, [`TrainConfig::validate_values`]); a sectioned file must hold no other algorithm's
+/// section.
+fn into_sections(table: &mut toml::Table, algorithm: Algorithm) -> Result<bool, RlError> {
+    if flat_layout::upgrade(table, algorithm)? {
+        return Ok(true);
     }
-    Ok(())
+    match Algorithm::ALL
+        .into_iter()
+        .find(|&other| other != algorithm && table.contains_key(other.section()))
+    {
+        Some(other) => Err(foreign_section(other, algorithm)),
+        None => Ok(false),
+    }
+}
+
+/// The error for a section of algorithm `other` in a configuration of `algorithm`.
+fn foreign_section(other: Algorithm, algorithm: Algorithm) -> RlError {
+    RlError::Config(format!(
+        "[{}] is the section of algorithm {:?}, not of this run's {:?}; remove it",
+        other.section(),
+        other.name(),
+        algorithm.name()
+    ))
 }
 
 /// What [`TrainConfig`] writes: its fields, with the section of its algorithm only.

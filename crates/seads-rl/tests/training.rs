@@ -498,10 +498,12 @@ fn presets_parse_and_round_trip() {
 #[test]
 fn every_committed_run_config_loads() {
     let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../..");
-    let mut files = Vec::new();
-    for dir in ["docs/results", "data", "crates/seads-py/tests/data"] {
-        collect_configs(&root.join(dir), &mut files);
-    }
+    let files: Vec<std::path::PathBuf> = ["docs/results", "data", "crates/seads-py/tests/data"]
+        .iter()
+        .flat_map(|dir| walkdir::WalkDir::new(root.join(dir)))
+        .map(|entry| entry.unwrap().into_path())
+        .filter(|path| path.file_name().is_some_and(|n| n == "config.toml"))
+        .collect();
     assert!(
         files.len() > 200,
         "found only {} config.toml files",
@@ -551,20 +553,6 @@ fn every_committed_run_config_loads() {
         assert_eq!(TrainConfig::from_toml(&config.to_toml()).unwrap(), config);
     }
     assert!(flat > 100, "only {flat} files in the flat layout");
-}
-
-fn collect_configs(dir: &std::path::Path, out: &mut Vec<std::path::PathBuf>) {
-    let Ok(entries) = std::fs::read_dir(dir) else {
-        return;
-    };
-    for entry in entries.flatten() {
-        let path = entry.path();
-        if path.is_dir() {
-            collect_configs(&path, out);
-        } else if path.file_name().is_some_and(|n| n == "config.toml") {
-            out.push(path);
-        }
-    }
 }
 
 /// Whether `stated` is part of `found`: tables key by key, numbers by value (an integer may come

@@ -424,27 +424,20 @@ env_overrides = { "lightsout-cursor" = { num_skills = 30 }, "tileswap-cursor" = 
     #[test]
     fn every_shipped_and_committed_manifest_expands() {
         let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../..");
-        let mut files = Vec::new();
-        for entry in std::fs::read_dir(root.join("experiments")).unwrap() {
-            files.push(entry.unwrap().path());
-        }
-        let mut stack = vec![root.join("docs/results")];
-        while let Some(dir) = stack.pop() {
-            for entry in std::fs::read_dir(dir).unwrap() {
-                let path = entry.unwrap().path();
-                if path.is_dir() {
-                    stack.push(path);
-                } else if path.file_name().is_some_and(|n| n == "manifest.toml") {
-                    files.push(path);
-                }
-            }
-        }
-        let manifests: Vec<_> = files
-            .iter()
-            .filter(|p| p.extension().is_some_and(|e| e == "toml"))
+        let experiments = walkdir::WalkDir::new(root.join("experiments")).max_depth(1);
+        let committed = walkdir::WalkDir::new(root.join("docs/results"));
+        let manifests: Vec<std::path::PathBuf> = experiments
+            .into_iter()
+            .chain(committed)
+            .map(|entry| entry.unwrap().into_path())
+            .filter(|p| {
+                p.extension().is_some_and(|e| e == "toml")
+                    && (p.starts_with(root.join("experiments"))
+                        || p.file_name().is_some_and(|n| n == "manifest.toml"))
+            })
             .collect();
         assert!(manifests.len() > 20, "{}", manifests.len());
-        for path in manifests {
+        for path in &manifests {
             let text = std::fs::read_to_string(path).unwrap();
             let runs = Manifest::parse(&text, "m.toml")
                 .and_then(|m| m.expand())
