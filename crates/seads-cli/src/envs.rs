@@ -91,9 +91,11 @@ pub struct BenchArgs {
     /// Threads, each stepping its own environment.
     #[arg(long, default_value_t = 1)]
     threads: usize,
-    /// Jaco only: physics steps per environment step (reference: 50).
-    #[arg(long)]
-    physics_substeps: Option<usize>,
+    /// An option of the manipulator, as KEY=VALUE in TOML (repeatable), e.g.
+    /// `--manipulator physics_substeps=25` for the Jaco (physics steps per environment step;
+    /// reference: 50). The Cursor and the Reachers have none.
+    #[arg(long = "manipulator", value_name = "KEY=VALUE", value_parser = manipulator_option)]
+    manipulator: Vec<(String, serde_json::Value)>,
     /// Print JSON.
     #[arg(long)]
     json: bool,
@@ -105,7 +107,7 @@ pub fn env_bench(args: BenchArgs) -> Result<()> {
         return Err(BadInput(anyhow::anyhow!("--steps and --threads must be at least 1")).into());
     }
     let config = EnvConfig {
-        physics_substeps: args.physics_substeps,
+        manipulator: args.manipulator.into_iter().collect(),
         ..EnvConfig::default()
     };
     let env = build_env(&args.env, &config)?;
@@ -124,4 +126,38 @@ pub fn env_bench(args: BenchArgs) -> Result<()> {
         );
     }
     Ok(())
+}
+
+/// One manipulator option from `KEY=VALUE`, the value read as TOML (`25`, `0.5`, `"text"`).
+fn manipulator_option(text: &str) -> Result<(String, serde_json::Value), String> {
+    let bad =
+        || format!("expected KEY=VALUE with a TOML value, like physics_substeps=25, got {text:?}");
+    let (key, value) = text.split_once('=').ok_or_else(bad)?;
+    let table: toml::Table = format!("v = {}", value.trim()).parse().map_err(|_| bad())?;
+    let value = serde_json::to_value(&table["v"]).map_err(|_| bad())?;
+    let key = key.trim();
+    if key.is_empty() {
+        return Err(bad());
+    }
+    Ok((key.to_owned(), value))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::manipulator_option;
+
+    #[test]
+    fn manipulator_options_are_read_as_toml_values() {
+        assert_eq!(
+            manipulator_option("physics_substeps=25"),
+            Ok(("physics_substeps".into(), 25.into()))
+        );
+        assert_eq!(
+            manipulator_option(" gain = 0.5").unwrap().1,
+            serde_json::json!(0.5)
+        );
+        for bad in ["physics_substeps", "=3", "x=", "x=not toml"] {
+            assert!(manipulator_option(bad).is_err(), "{bad}");
+        }
+    }
 }

@@ -25,10 +25,12 @@ fn env_step(c: &mut Criterion) {
         ("lightsout-jaco", None),
         ("lightsout-jaco-10-substeps", Some(10)),
     ] {
-        let config = EnvConfig {
-            physics_substeps: substeps,
-            ..EnvConfig::default()
-        };
+        let mut config = EnvConfig::default();
+        if let Some(n) = substeps {
+            config
+                .manipulator
+                .insert("physics_substeps".into(), serde_json::Value::from(n));
+        }
         let mut env = make_env("lightsout-jaco", &config).expect("registered");
         group.bench_function(label, |b| {
             b.iter(|| random_rollout(env.as_mut(), JACO_STEPS, 1).expect("finite actions"))

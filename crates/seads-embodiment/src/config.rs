@@ -1,13 +1,20 @@
-//! Configuration of an environment: board variant and reset distribution (SPEC §1.5, §1.6).
+//! Configuration of an environment: board variant and reset distribution (SPEC §1.5, §1.6), and
+//! the manipulator's own options.
 
 use seads_games::Split;
+use serde::de::DeserializeOwned;
 use serde::{Deserialize, Serialize};
 
 use crate::EnvError;
 
-/// Options shared by every environment. `Default` gives the paper's training environment.
+/// Options of an environment. `Default` gives the paper's training environment.
+///
+/// The board and reset options are shared by every environment; `manipulator` holds the
+/// manipulator's own options (`[env_config.manipulator]` in a run's `config.toml`), which the
+/// manipulator's options type reads when the environment is built
+/// ([`EnvConfig::manipulator_options`]).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields, default)]
+#[serde(try_from = "Stated")]
 pub struct EnvConfig {
     /// Board side length; only `lightsout-cursor` accepts sizes other than the game's default
     /// (odd, 5 to 13, as spaced boards).
@@ -23,9 +30,11 @@ pub struct EnvConfig {
     pub random_solution_depth: bool,
     /// Steps per skill, overriding the environment's default T_max.
     pub step_limit: Option<usize>,
-    /// Jaco only: physics steps per 0.1 s environment step (reference: 50 steps of 2 ms). Fewer
-    /// steps run proportionally faster with coarser contact and servo dynamics.
-    pub physics_substeps: Option<usize>,
+    /// The manipulator's own options, by name (empty: its defaults). Which keys exist is the
+    /// manipulator's business: the Cursor and the Reachers have none, the Jaco has
+    /// `physics_substeps` ([`crate::JacoOptions`]).
+    #[serde(skip_serializing_if = "serde_json::Map::is_empty")]
+    pub manipulator: serde_json::Map<String, serde_json::Value>,
 }
 
 impl Default for EnvConfig {
@@ -37,7 +46,7 @@ impl Default for EnvConfig {
             max_solution_depth: 5,
             random_solution_depth: true,
             step_limit: None,
-            physics_substeps: None,
+            manipulator: serde_json::Map::new(),
         }
     }
 }
@@ -54,12 +63,167 @@ impl EnvConfig {
         {
             return bad(format!("spacing must lie in [0, 1], got {s}"));
         }
-        if self.physics_substeps == Some(0) {
-            return bad("physics_substeps must be at least 1".into());
-        }
         if self.step_limit == Some(0) {
             return bad("step_limit must be at least 1".into());
         }
         Ok(())
+    }
+
+    /// The manipulator's options as its options type `T` (unset keys take `T`'s defaults); a
+    /// key `T` does not have, or a value of the wrong type, is an error naming `env`.
+    ///
+    /// ```
+    /// use seads_embodiment::{EnvConfig, EnvError, NoOptions};
+    /// // A manipulator's options type: its keys, their defaults, unknown keys refused.
+    /// #[derive(serde::Deserialize)]
+    /// #[serde(deny_unknown_fields, default)]
+    /// struct ArmOptions {
+    ///     substeps: std::num::NonZeroUsize,
+    /// }
+    /// impl Default for ArmOptions {
+    ///     fn default() -> Self {
+    ///         Self { substeps: std::num::NonZeroUsize::MIN }
+    ///     }
+    /// }
+    /// let mut config = EnvConfig::default();
+    /// assert_eq!(config.manipulator_options::<ArmOptions>("my-arm")?.substeps.get(), 1);
+    /// config.manipulator.insert("substeps".into(), 25.into());
+    /// assert_eq!(config.manipulator_options::<ArmOptions>("my-arm")?.substeps.get(), 25);
+    /// // A manipulator without options refuses the key; so does a zero here.
+    /// assert!(config.manipulator_options::<NoOptions>("lightsout-cursor").is_err());
+    /// config.manipulator.insert("substeps".into(), 0.into());
+    /// assert!(config.manipulator_options::<ArmOptions>("my-arm").is_err());
+    /// # Ok::<(), EnvError>(())
+    /// ```
+    pub fn manipulator_options<T: DeserializeOwned>(&self, env: &str) -> Result<T, EnvError> {
+        serde_json::from_value(serde_json::Value::Object(self.manipulator.clone())).map_err(
+            |source| EnvError::ManipulatorOptions {
+                env: env.to_owned(),
+                source,
+            },
+        )
+    }
+}
+
+/// The options of a manipulator that has none: any key is refused.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct NoOptions {}
+
+/// What a configuration states, in the current layout or in the older one that kept the Jaco's
+/// `physics_substeps` beside the board options (committed Jaco runs' files); read into
+/// [`EnvConfig`], which writes the current layout only.
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields, default)]
+struct Stated {
+    board_size: Option<usize>,
+    spacing: Option<f64>,
+    reset_split: Split,
+    max_solution_depth: usize,
+    random_solution_depth: bool,
+    step_limit: Option<usize>,
+    manipulator: serde_json::Map<String, serde_json::Value>,
+    /// The older layout's place of the Jaco's option.
+    physics_substeps: Option<serde_json::Value>,
+}
+
+impl Default for Stated {
+    fn default() -> Self {
+        let EnvConfig {
+            board_size,
+            spacing,
+            reset_split,
+            max_solution_depth,
+            random_solution_depth,
+            step_limit,
+            manipulator,
+        } = EnvConfig::default();
+        Self {
+            board_size,
+            spacing,
+            reset_split,
+            max_solution_depth,
+            random_solution_depth,
+            step_limit,
+            manipulator,
+            physics_substeps: None,
+        }
+    }
+}
+
+impl TryFrom<Stated> for EnvConfig {
+    type Error = String;
+
+    fn try_from(stated: Stated) -> Result<Self, String> {
+        let mut manipulator = stated.manipulator;
+        if let Some(value) = stated.physics_substeps {
+            const KEY: &str = "physics_substeps";
+            if manipulator.contains_key(KEY) {
+                return Err(format!(
+                    "{KEY} is given twice: beside the board options (the older layout) and in \
+                     `manipulator`; keep the one in `manipulator`"
+                ));
+            }
+            manipulator.insert(KEY.into(), value);
+        }
+        Ok(Self {
+            board_size: stated.board_size,
+            spacing: stated.spacing,
+            reset_split: stated.reset_split,
+            max_solution_depth: stated.max_solution_depth,
+            random_solution_depth: stated.random_solution_depth,
+            step_limit: stated.step_limit,
+            manipulator,
+        })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn parse(text: &str) -> Result<EnvConfig, toml::de::Error> {
+        toml::from_str(text)
+    }
+
+    #[test]
+    fn manipulator_options_round_trip_and_write_nothing_when_empty() {
+        let config = parse("max_solution_depth = 3\n[manipulator]\nphysics_substeps = 25").unwrap();
+        assert_eq!(config.manipulator["physics_substeps"], 25);
+        let written = toml::to_string(&config).unwrap();
+        assert!(
+            written.contains("[manipulator]\nphysics_substeps = 25"),
+            "{written}"
+        );
+        assert_eq!(parse(&written).unwrap(), config);
+        let plain = toml::to_string(&EnvConfig::default()).unwrap();
+        assert!(!plain.contains("manipulator"), "{plain}");
+        assert_eq!(parse(&plain).unwrap(), EnvConfig::default());
+    }
+
+    #[test]
+    fn the_older_layouts_key_moves_into_the_manipulators_options() {
+        let old = parse("physics_substeps = 25").unwrap();
+        let new = parse("[manipulator]\nphysics_substeps = 25").unwrap();
+        assert_eq!(old, new);
+        let twice = parse("physics_substeps = 25\n[manipulator]\nphysics_substeps = 10");
+        let err = twice.unwrap_err().to_string();
+        assert!(err.contains("given twice"), "{err}");
+        let unknown = parse("substeps = 25").unwrap_err().to_string();
+        assert!(unknown.contains("unknown field `substeps`"), "{unknown}");
+    }
+
+    #[test]
+    fn no_options_refuses_every_key() {
+        let mut config = EnvConfig::default();
+        assert!(config.manipulator_options::<NoOptions>("x").is_ok());
+        config.manipulator.insert("speed".into(), 1.into());
+        let err = config.manipulator_options::<NoOptions>("x").unwrap_err();
+        assert!(
+            err.to_string()
+                .starts_with("x: invalid manipulator options"),
+            "{err}"
+        );
+        assert!(std::error::Error::source(&err).is_some());
     }
 }

@@ -60,6 +60,14 @@ pub enum EnvError {
     /// A configuration value that cannot be used.
     #[error("invalid environment configuration: {0}")]
     InvalidConfig(String),
+    /// The manipulator's options (`EnvConfig::manipulator`) do not fit its options type.
+    #[error("{env}: invalid manipulator options: {source}")]
+    ManipulatorOptions {
+        /// Environment name.
+        env: String,
+        /// What the options type said.
+        source: serde_json::Error,
+    },
     /// A manipulator state of the wrong length or out of range.
     #[error("{env}: invalid manipulator state: {reason}")]
     InvalidState {

@@ -27,16 +27,35 @@
 #![allow(clippy::approx_constant)]
 
 use std::f32::consts::{PI, TAU};
+use std::num::NonZeroUsize;
 
 use rand::RngExt;
 use rand_chacha::ChaCha8Rng;
 use rapier3d::math::{Pose, Rotation, Vector};
 use rapier3d::prelude::*;
+use serde::{Deserialize, Serialize};
 
 use crate::{Manipulator, Push, Shape, Touch};
 
 /// Physics steps per environment step in the reference (0.1 s control period / 2 ms).
 pub const DEFAULT_SUBSTEPS: usize = 50;
+
+/// The Jaco's own options (`[env_config.manipulator]`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct JacoOptions {
+    /// Physics steps per 0.1 s environment step (reference: [`DEFAULT_SUBSTEPS`] steps of 2 ms).
+    /// Fewer steps run proportionally faster with coarser contact and servo dynamics.
+    pub physics_substeps: NonZeroUsize,
+}
+
+impl Default for JacoOptions {
+    fn default() -> Self {
+        Self {
+            physics_substeps: NonZeroUsize::new(DEFAULT_SUBSTEPS).expect("50 is not zero"),
+        }
+    }
+}
 /// Control period, s.
 const CONTROL_DT: f32 = 0.1;
 /// Velocity-solver iterations of rapier per physics step (the multibody mass matrix dominates

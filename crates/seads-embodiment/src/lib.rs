@@ -65,13 +65,13 @@ mod spec;
 mod task;
 
 pub use board::BoardState;
-pub use config::EnvConfig;
+pub use config::{EnvConfig, NoOptions};
 pub use cursor::Cursor;
 pub use embodied::{Embodied, Environment, Manipulator, Touch};
 pub use error::EnvError;
 pub use filmed::Filmed;
 #[cfg(feature = "jaco")]
-pub use jaco::{DEFAULT_SUBSTEPS as JACO_DEFAULT_SUBSTEPS, Jaco, JacoBoard};
+pub use jaco::{DEFAULT_SUBSTEPS as JACO_DEFAULT_SUBSTEPS, Jaco, JacoBoard, JacoOptions};
 pub use layout::Layout;
 pub use noise::{ACTION_NOISE_STREAM, ActionNoise};
 pub use policy::{SkillPolicy, SkillRun, execute_skill};

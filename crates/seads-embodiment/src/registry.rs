@@ -12,7 +12,8 @@ use serde::Serialize;
 
 use crate::board::BoardState;
 use crate::{
-    Cursor, Embodied, EnvConfig, EnvError, Environment, Layout, Manipulator, Reacher, Reacher3,
+    Cursor, Embodied, EnvConfig, EnvError, Environment, Layout, Manipulator, NoOptions, Reacher,
+    Reacher3,
 };
 #[cfg(feature = "jaco")]
 use crate::{Jaco, JacoBoard};
@@ -152,27 +153,25 @@ pub fn make_env(name: &str, config: &EnvConfig) -> Result<Box<dyn Environment>, 
         .build(config.board_size.unwrap_or(entry.game.default_size()))
         .map_err(|e| EnvError::InvalidConfig(format!("{}: {e}", entry.name)))?;
     let layout = layout(entry, game.as_ref(), config)?;
-    #[cfg(feature = "jaco")]
-    let jaco = matches!(entry.embodiment, Embodiment::Jaco(_));
-    #[cfg(not(feature = "jaco"))]
-    let jaco = false;
-    if config.physics_substeps.is_some() && !jaco {
-        return Err(EnvError::InvalidConfig(format!(
-            "physics_substeps applies to the Jaco environments, not {}",
-            entry.name
-        )));
-    }
     let board = BoardState::new(entry.game, game.size(), config)?;
     let name = entry.name.as_str();
     Ok(match entry.embodiment {
-        Embodiment::Cursor => build(name, Cursor::default(), board, layout, config),
-        Embodiment::Reacher => build(name, Reacher::default(), board, layout, config),
-        Embodiment::Reacher3 => build(name, Reacher3::default(), board, layout, config),
+        Embodiment::Cursor => {
+            let NoOptions {} = config.manipulator_options(name)?;
+            build(name, Cursor::default(), board, layout, config)
+        }
+        Embodiment::Reacher => {
+            let NoOptions {} = config.manipulator_options(name)?;
+            build(name, Reacher::default(), board, layout, config)
+        }
+        Embodiment::Reacher3 => {
+            let NoOptions {} = config.manipulator_options(name)?;
+            build(name, Reacher3::default(), board, layout, config)
+        }
         #[cfg(feature = "jaco")]
         Embodiment::Jaco(jaco) => {
-            let substeps = config
-                .physics_substeps
-                .unwrap_or(crate::jaco::DEFAULT_SUBSTEPS);
+            let options: crate::JacoOptions = config.manipulator_options(name)?;
+            let substeps = options.physics_substeps.get();
             build(name, Jaco::new(jaco, substeps), board, layout, config)
         }
     })

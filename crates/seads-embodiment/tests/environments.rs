@@ -263,16 +263,32 @@ fn jaco_clones_continue_identically_and_cannot_be_restored() {
         env.restore_manipulator(&vec![0.0; m]),
         Err(EnvError::Unsupported { .. })
     ));
-    assert!(matches!(
-        make_env(
-            "lightsout-cursor",
-            &EnvConfig {
-                physics_substeps: Some(10),
-                ..EnvConfig::default()
-            }
-        ),
-        Err(EnvError::InvalidConfig(_))
-    ));
+}
+
+#[test]
+fn each_manipulator_reads_its_own_options_and_refuses_others() {
+    let with = |key: &str, value: i64| {
+        let mut config = EnvConfig::default();
+        config.manipulator.insert(key.into(), value.into());
+        config
+    };
+    for name in env_names() {
+        let unknown = make_env(name, &with("no_such_option", 1)).err();
+        assert!(
+            matches!(unknown, Some(EnvError::ManipulatorOptions { .. })),
+            "{name}: {unknown:?}"
+        );
+        // The Jaco's one option: only the Jaco environments take it, and never zero.
+        let jaco = name.ends_with("-jaco");
+        let substeps = make_env(name, &with("physics_substeps", 10));
+        assert_eq!(substeps.is_ok(), jaco, "{name}");
+        if jaco {
+            assert!(
+                make_env(name, &with("physics_substeps", 0)).is_err(),
+                "{name}"
+            );
+        }
+    }
 }
 
 #[test]

@@ -483,10 +483,10 @@ fn forward_kinematics_matches_the_observed_pinch_site() {
 
 /// Presses every move in `moves` from every seed; returns the failures.
 fn sweep(name: &str, substeps: usize, seeds: &[u64], moves: &[MoveId]) -> Vec<String> {
-    let config = EnvConfig {
-        physics_substeps: Some(substeps),
-        ..EnvConfig::default()
-    };
+    let mut config = EnvConfig::default();
+    config
+        .manipulator
+        .insert("physics_substeps".into(), substeps.into());
     let mut env = make_env(name, &config).unwrap();
     let n = env.spec().board_size;
     let mut failures = Vec::new();

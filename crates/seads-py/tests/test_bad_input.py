@@ -47,6 +47,16 @@ def test_unknown_environments_and_options_are_named():
         seads.SeadsVectorEnv("lightsout-cursor", 0)
 
 
+def test_a_manipulator_takes_its_own_options_only():
+    jaco = seads.SeadsEnv("lightsout-jaco", manipulator={"physics_substeps": 5})
+    jaco.reset(seed=0)
+    jaco.step(np.zeros(jaco.action_space.shape, dtype=np.float32))
+    with pytest.raises(ValueError, match="invalid manipulator options.*physics_substeps"):
+        seads.SeadsEnv("lightsout-cursor", manipulator={"physics_substeps": 5})
+    with pytest.raises(ValueError, match="invalid manipulator options"):
+        seads.SeadsEnv("lightsout-jaco", manipulator={"physics_substeps": 0})
+
+
 def test_wrong_boards_and_moves_are_value_errors():
     game = seads.Game("lightsout")
     with pytest.raises(ValueError):

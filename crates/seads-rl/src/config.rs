@@ -630,6 +630,24 @@ mod tests {
     }
 
     #[test]
+    fn the_jaco_presets_take_25_physics_steps_as_the_manipulators_option() {
+        let mut jaco = 0;
+        for algorithm in Algorithm::ALL {
+            for env in env_names().into_iter().filter(|e| e.ends_with("-jaco")) {
+                let config = TrainConfig::preset_for(env, algorithm).unwrap();
+                assert_eq!(
+                    config.env_config.manipulator.get("physics_substeps"),
+                    Some(&serde_json::Value::from(25)),
+                    "{env} {algorithm:?}"
+                );
+                config.validate().unwrap();
+                jaco += 1;
+            }
+        }
+        assert_eq!(jaco, 9);
+    }
+
+    #[test]
     fn a_user_config_must_name_its_env_and_fills_from_its_preset() {
         let err = TrainConfig::from_user_toml("", None, None).unwrap_err();
         assert!(err.to_string().contains("names no `env`"), "{err}");

@@ -529,6 +529,18 @@ fn every_committed_run_config_loads() {
         ];
         flat += usize::from(stated.contains_key("baseline") || stated.contains_key("relabel"));
         for (key, value) in &stated {
+            // The Jaco's `physics_substeps` stood beside the board options before manipulators
+            // had options of their own.
+            let value = &match (key.as_str(), value) {
+                ("env_config", toml::Value::Table(env)) if env.contains_key("physics_substeps") => {
+                    let mut env = env.clone();
+                    let substeps = env.remove("physics_substeps").unwrap();
+                    let options = toml::Table::from_iter([("physics_substeps".into(), substeps)]);
+                    env.insert("manipulator".into(), options.into());
+                    toml::Value::Table(env)
+                }
+                _ => value.clone(),
+            };
             let section = if seads_keys.contains(&key.as_str()) {
                 Some("seads")
             } else if key == "baseline" {

@@ -254,6 +254,48 @@ fn env_bench_reports_steps_per_second() {
         &["env-bench", "--env", "lightsout-cursor", "--threads", "0"],
         "at least 1",
     );
+    // A manipulator's options are its own: the Cursor has none, the Jaco's must fit its type.
+    check_bad_input(
+        &[
+            "env-bench",
+            "--env",
+            "lightsout-cursor",
+            "--manipulator",
+            "physics_substeps=25",
+        ],
+        "unknown field `physics_substeps`",
+    );
+    for bad in [
+        "physics_substeps=-1",
+        "physics_substeps=0",
+        "physics_substeps=nan",
+    ] {
+        check_bad_input(
+            &["env-bench", "--env", "lightsout-jaco", "--manipulator", bad],
+            "invalid manipulator options",
+        );
+    }
+    check_bad_input(
+        &[
+            "env-bench",
+            "--env",
+            "lightsout-jaco",
+            "--manipulator",
+            "physics_substeps",
+        ],
+        "KEY=VALUE",
+    );
+    let v = json(&[
+        "env-bench",
+        "--env",
+        "lightsout-jaco",
+        "--manipulator",
+        "physics_substeps=5",
+        "--steps",
+        "20",
+        "--json",
+    ]);
+    assert_eq!(v["steps"], 20);
 }
 
 /// A tiny training configuration (small networks, small budget) written into `dir`.
@@ -1332,7 +1374,6 @@ fn numeric_options_reject_negative_nan_and_infinite_values() {
         (&["render"], "--spacing"),
         (&["env-bench"], "--steps"),
         (&["env-bench"], "--threads"),
-        (&["env-bench"], "--physics-substeps"),
         (&["record"], "--episodes"),
         (&["record"], "--steps"),
         (&["record"], "--seed"),

@@ -9,7 +9,8 @@ terminates, and the episode is truncated after T_max·S steps.
 
 Environment options are keyword arguments: ``max_solution_depth``, ``random_solution_depth``,
 ``reset_split`` ("train" or "test"), ``board_size`` and ``spacing`` (LightsOutCursor),
-``step_limit``, ``physics_substeps`` (Jaco).
+``step_limit``, and ``manipulator``: a dict of the manipulator's own options (the Jaco's
+``physics_substeps``; the Cursor and the Reachers have none).
 """
 
 from __future__ import annotations
