@@ -63,14 +63,52 @@ impl DepthResult {
 
     /// Counts one more task of this depth, which ended in `outcome`.
     pub fn record(&mut self, outcome: &SolveOutcome) {
+        self.count(&TaskSummary::of(outcome));
+    }
+
+    /// Counts one more task of this depth, of which `task` is what counts.
+    pub fn count(&mut self, task: &TaskSummary) {
         self.tasks += 1;
-        self.plan_found += outcome.plan_found as usize;
-        self.planning_s.push(outcome.planning_s);
-        self.timeouts += outcome.timed_out as usize;
-        if outcome.solved {
+        self.plan_found += task.plan_found as usize;
+        self.planning_s.push(task.planning_s);
+        self.timeouts += task.timed_out as usize;
+        if task.solved {
             self.solved += 1;
-            self.solution_steps.push(outcome.manipulator_steps);
-            self.skill_steps.extend(&outcome.skill_steps);
+            self.solution_steps.push(task.manipulator_steps);
+            self.skill_steps.extend(&task.skill_steps);
+        }
+    }
+}
+
+/// What a finished task adds to its depth's [`DepthResult`]: enough to count it again when an
+/// evaluation resumes, without solving it again. Its fields are [`SolveOutcome`]'s of the same
+/// names, so that it reads from a line of a tasks file (other keys are ignored).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct TaskSummary {
+    /// The board reached the goal.
+    pub solved: bool,
+    /// The first search found a plan.
+    pub plan_found: bool,
+    /// Seconds spent searching.
+    pub planning_s: f64,
+    /// A search stopped at the time limit.
+    pub timed_out: bool,
+    /// Total manipulator steps.
+    pub manipulator_steps: usize,
+    /// Manipulator steps of every executed skill.
+    pub skill_steps: Vec<usize>,
+}
+
+impl TaskSummary {
+    /// What `outcome` adds to its depth's result.
+    pub fn of(outcome: &SolveOutcome) -> Self {
+        Self {
+            solved: outcome.solved,
+            plan_found: outcome.plan_found,
+            planning_s: outcome.planning_s,
+            timed_out: outcome.timed_out,
+            manipulator_steps: outcome.manipulator_steps,
+            skill_steps: outcome.skill_steps.clone(),
         }
     }
 }
@@ -97,6 +135,20 @@ pub fn evaluate(
     evaluation: &Evaluation,
     policy: &dyn SkillPolicy,
     successor: &mut dyn Successor,
+    each: impl FnMut(&TaskRecord<'_>),
+) -> Result<Vec<DepthResult>, EnvError> {
+    evaluate_resuming(evaluation, policy, successor, |_, _| None, each)
+}
+
+/// [`evaluate`], taking the tasks that `finished` knows (by depth and seed) as they ended
+/// before instead of solving them again: an evaluation that was stopped resumes where it
+/// stopped, with the same results (each task depends on nothing but its seed). `each` is called
+/// with the tasks solved now.
+pub fn evaluate_resuming(
+    evaluation: &Evaluation,
+    policy: &dyn SkillPolicy,
+    successor: &mut dyn Successor,
+    mut finished: impl FnMut(usize, u64) -> Option<TaskSummary>,
     mut each: impl FnMut(&TaskRecord<'_>),
 ) -> Result<Vec<DepthResult>, EnvError> {
     let mut results = Vec::new();
@@ -116,6 +168,10 @@ pub fn evaluate(
         let goal = game.goal();
         let mut result = DepthResult::new(depth);
         for &seed in &seeds {
+            if let Some(task) = finished(depth, seed) {
+                result.count(&task);
+                continue;
+            }
             env.seed(seed);
             env.reset()?;
             let board = env.board();

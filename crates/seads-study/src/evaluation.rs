@@ -3,12 +3,13 @@
 //! evaluations over training (the paper's Fig. 3), one line per checkpoint and mode in
 //! [`OVER_TRAINING`]; and running an evaluation of a trained agent or a baseline's policy.
 
+use std::collections::BTreeMap;
 use std::path::Path;
 
 use seads_games::BoardGame;
 use seads_planner::{
     CheckpointId, DepthResult, Evaluation, EvaluationKind, EvaluationRecord, PlanChoice, Protocol,
-    SearchLimits, SolveConfig, TaskRecord, TaskSet, evaluate,
+    SearchLimits, SolveConfig, TaskRecord, TaskSet, TaskSummary, evaluate_resuming,
 };
 use seads_rl::{Agent, TrainConfig};
 use serde::{Deserialize, Serialize};
@@ -175,6 +176,17 @@ pub fn over_training_protocol(tasks: &TaskSet, limits: SearchLimits, replan: boo
 pub fn evaluate_agent(
     agent: &mut Agent,
     protocol: &Protocol,
+    each: impl FnMut(&TaskRecord<'_>),
+) -> Result<Vec<DepthResult>> {
+    evaluate_agent_resuming(agent, protocol, |_, _| None, each)
+}
+
+/// [`evaluate_agent`], counting the tasks `finished` knows (by depth and seed) as they ended
+/// before instead of solving them again.
+fn evaluate_agent_resuming(
+    agent: &mut Agent,
+    protocol: &Protocol,
+    finished: impl FnMut(usize, u64) -> Option<TaskSummary>,
     mut each: impl FnMut(&TaskRecord<'_>),
 ) -> Result<Vec<DepthResult>> {
     let limits = protocol
@@ -192,12 +204,19 @@ pub fn evaluate_agent(
         action_noise: protocol.action_noise,
     };
     let (policy, model) = agent.parts()?;
-    evaluate(&evaluation, policy, model, |task| each(task)).map_err(StudyError::Environment)
+    evaluate_resuming(&evaluation, policy, model, finished, |task| each(task))
+        .map_err(StudyError::Environment)
 }
 
 /// Evaluates the agent with `protocol` and saves the record and one line per task into the run
 /// directory (`evaluation-replan.json` and `evaluation-replan-tasks.jsonl` for the standard
-/// depths of the latest checkpoint), calling `each` with every task as it ends.
+/// depths of the latest checkpoint), calling `each` with every task solved now.
+///
+/// It resumes: each task's line is appended, as the task ends, to the tasks file's `.partial`
+/// beside it, headed by the protocol and the checkpoint. An evaluation of the same protocol and
+/// checkpoint that finds it counts the tasks written there as they ended and solves only the
+/// others (a task depends on nothing but its seed, so the results are those of one whole run);
+/// the `.partial` file is removed once the record is saved.
 pub fn run_evaluation(
     agent: &mut Agent,
     run: &Path,
@@ -205,20 +224,94 @@ pub fn run_evaluation(
     mut each: impl FnMut(&TaskRecord<'_>),
 ) -> Result<EvaluationRecord> {
     let game = crate::run_game(&agent.config)?;
-    let mut lines = String::new();
-    let results = evaluate_agent(agent, protocol, |task| {
-        lines += &task_line(game.as_ref(), task).to_string();
-        lines.push('\n');
-        each(task);
-    })?;
     let (checkpoint, named) = checkpoint_of(run, &agent.checkpoint)?;
+    let partial = run.join(format!("{}.partial", protocol.tasks_file(named)));
+    let header =
+        serde_json::json!({ "evaluation": { "protocol": protocol, "checkpoint": &checkpoint } });
+    let earlier = finished_tasks(&partial, &header)?;
+    if earlier.is_empty() {
+        let mut text = header.to_string();
+        text.push('\n');
+        seads_rl::store::write_atomic(&partial, text.as_bytes())?;
+    }
+    let mut now = BTreeMap::new();
+    let mut append_error = None;
+    let results = evaluate_agent_resuming(
+        agent,
+        protocol,
+        |depth, seed| {
+            earlier
+                .get(&(depth, seed))
+                .map(|(summary, _)| summary.clone())
+        },
+        |task| {
+            let line = task_line(game.as_ref(), task);
+            if append_error.is_none()
+                && let Err(e) = seads_rl::store::append_json_line(&partial, &line)
+            {
+                append_error = Some(e);
+            }
+            now.insert((task.depth, task.seed), line);
+            each(task);
+        },
+    )?;
+    if let Some(e) = append_error {
+        return Err(e.into());
+    }
+    let mut lines = String::new();
+    for &depth in &protocol.tasks.depths {
+        for seed in protocol.tasks.seeds() {
+            let line = now
+                .get(&(depth, seed))
+                .or_else(|| earlier.get(&(depth, seed)).map(|(_, line)| line))
+                .ok_or_else(|| StudyError::failed(format!("task {depth}/{seed} has no line")))?;
+            lines += &line.to_string();
+            lines.push('\n');
+        }
+    }
     let record = EvaluationRecord {
         checkpoint: Some(checkpoint),
         protocol: Some(protocol.clone()),
         results,
     };
     save_evaluation(run, &record, named, Some(&lines))?;
-    Ok(record)
+    match std::fs::remove_file(&partial) {
+        Err(e) if e.kind() != std::io::ErrorKind::NotFound => {
+            Err(e).doing(|| format!("removing {}", partial.display()))
+        }
+        _ => Ok(record),
+    }
+}
+
+/// The tasks an earlier, stopped evaluation wrote into `partial` under `header`, by depth and
+/// seed, with their lines. None where there is no such file, or it was written under another
+/// header (another protocol or checkpoint) or cannot be read back whole: the evaluation then
+/// starts afresh and rewrites it.
+fn finished_tasks(
+    partial: &Path,
+    header: &serde_json::Value,
+) -> Result<BTreeMap<(usize, u64), (TaskSummary, serde_json::Value)>> {
+    if !partial.exists() {
+        return Ok(BTreeMap::new());
+    }
+    let Ok((lines, _torn)) = seads_rl::store::read_json_lines::<serde_json::Value>(partial) else {
+        return Ok(BTreeMap::new());
+    };
+    if lines.first() != Some(header) {
+        return Ok(BTreeMap::new());
+    }
+    let mut tasks = BTreeMap::new();
+    for line in lines.into_iter().skip(1) {
+        let key = (line["depth"].as_u64(), line["seed"].as_u64());
+        let (Some(depth), Some(seed)) = key else {
+            return Ok(BTreeMap::new());
+        };
+        let Ok(summary) = serde_json::from_value::<TaskSummary>(line.clone()) else {
+            return Ok(BTreeMap::new());
+        };
+        tasks.insert((depth as usize, seed), (summary, line));
+    }
+    Ok(tasks)
 }
 
 /// Evaluates a baseline's policy saved in `checkpoint` alone on `tasks` and saves the record
@@ -291,6 +384,8 @@ fn task_line(game: &dyn BoardGame, task: &TaskRecord<'_>) -> serde_json::Value {
         "first_plan": o.first_plan,
         "executed": o.executed,
         "skill_steps": o.skill_steps,
+        "manipulator_steps": o.manipulator_steps,
+        "planning_s": o.planning_s,
         "timed_out": o.timed_out,
         "failure": o.failure,
         "deviations": deviations,

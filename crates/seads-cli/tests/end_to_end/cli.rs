@@ -2320,3 +2320,98 @@ fn the_golden_runs_first_100_epochs_repeat_line_for_line() {
     }
     assert_eq!(expected.len(), ours.len(), "every epoch of first-100.jsonl");
 }
+
+/// A stopped evaluation resumes: the tasks its `.partial` file holds under the same protocol and
+/// checkpoint are counted as written there (a planted outcome shows it), a torn last line is
+/// dropped, the other tasks are solved, and the file is gone at the end. A `.partial` of another
+/// protocol is ignored.
+#[test]
+fn a_stopped_evaluation_resumes_from_its_finished_tasks() {
+    let dir = tempfile::tempdir().unwrap();
+    let evaluate = |run: &std::path::Path| {
+        json(&[
+            "evaluate",
+            "--run",
+            s(run),
+            "--depths",
+            "1-2",
+            "--boards",
+            "2",
+            "--max-expanded",
+            "2000",
+            "--replan",
+            "--json",
+        ])
+    };
+    const TASKS: &str = "evaluation-replan-depths-1-2-tasks.jsonl";
+    let lines = |run: &std::path::Path| -> Vec<serde_json::Value> {
+        std::fs::read_to_string(run.join(TASKS))
+            .unwrap()
+            .lines()
+            .map(|l| {
+                let mut v: serde_json::Value = serde_json::from_str(l).unwrap();
+                v.as_object_mut().unwrap().remove("planning_s");
+                v
+            })
+            .collect()
+    };
+    let whole = dir.path().join("whole");
+    copy_tiny_run(&whole);
+    let reference = evaluate(&whole);
+    let whole_lines = lines(&whole);
+    assert_eq!(whole_lines.len(), 4);
+    assert!(!whole.join(format!("{TASKS}.partial")).exists());
+    let record: serde_json::Value = serde_json::from_str(
+        &std::fs::read_to_string(whole.join("evaluation-replan-depths-1-2.json")).unwrap(),
+    )
+    .unwrap();
+    let header = |protocol: &serde_json::Value| serde_json::json!({"evaluation": {"protocol": protocol, "checkpoint": record["checkpoint"]}});
+    let first_two: Vec<String> = std::fs::read_to_string(whole.join(TASKS))
+        .unwrap()
+        .lines()
+        .take(2)
+        .map(str::to_owned)
+        .collect();
+    // The first task planted as solved in 7 steps: a resumed evaluation counts it so.
+    let mut planted: serde_json::Value = serde_json::from_str(&first_two[0]).unwrap();
+    for (key, value) in [
+        ("solved", serde_json::json!(true)),
+        ("plan_found", serde_json::json!(true)),
+        ("manipulator_steps", serde_json::json!(7)),
+        ("skill_steps", serde_json::json!([7])),
+        ("failure", serde_json::Value::Null),
+    ] {
+        planted[key] = value;
+    }
+    let resumed = dir.path().join("resumed");
+    copy_tiny_run(&resumed);
+    let partial = format!(
+        "{}\n{planted}\n{}\n{{\"depth\": 2, \"se",
+        header(&record["protocol"]),
+        first_two[1]
+    );
+    std::fs::write(resumed.join(format!("{TASKS}.partial")), partial).unwrap();
+    let v = evaluate(&resumed);
+    let mut expected = whole_lines.clone();
+    expected[0] = planted.clone();
+    expected[0].as_object_mut().unwrap().remove("planning_s");
+    assert_eq!(lines(&resumed), expected);
+    let second = f64::from(u8::from(whole_lines[1]["solved"] == true));
+    assert_eq!(
+        v["success_rate"]["1"].as_f64().unwrap(),
+        (1.0 + second) / 2.0,
+        "{v}"
+    );
+    assert_eq!(v["success_rate"]["2"], reference["success_rate"]["2"]);
+    assert!(!resumed.join(format!("{TASKS}.partial")).exists());
+    // Another protocol's file is not this evaluation's: everything is solved anew.
+    let other = dir.path().join("other");
+    copy_tiny_run(&other);
+    let mut protocol = record["protocol"].clone();
+    protocol["tasks"]["boards"] = 3.into();
+    let partial = format!("{}\n{planted}\n", header(&protocol));
+    std::fs::write(other.join(format!("{TASKS}.partial")), partial).unwrap();
+    let v = evaluate(&other);
+    assert_eq!(lines(&other), whole_lines);
+    assert_eq!(v["success_rate"], reference["success_rate"]);
+}
