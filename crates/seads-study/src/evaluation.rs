@@ -246,8 +246,12 @@ pub fn run_evaluation(
         },
         |task| {
             let line = task_line(game.as_ref(), task);
+            // The search time is kept for the resumed record only: the tasks file holds what
+            // repeats on any machine.
+            let mut resumable = line.clone();
+            resumable["planning_s"] = task.outcome.planning_s.into();
             if append_error.is_none()
-                && let Err(e) = seads_rl::store::append_json_line(&partial, &line)
+                && let Err(e) = seads_rl::store::append_json_line(&partial, &resumable)
             {
                 append_error = Some(e);
             }
@@ -309,6 +313,10 @@ fn finished_tasks(
         let Ok(summary) = serde_json::from_value::<TaskSummary>(line.clone()) else {
             return Ok(BTreeMap::new());
         };
+        let mut line = line;
+        if let Some(fields) = line.as_object_mut() {
+            fields.remove("planning_s");
+        }
         tasks.insert((depth as usize, seed), (summary, line));
     }
     Ok(tasks)
@@ -385,7 +393,6 @@ fn task_line(game: &dyn BoardGame, task: &TaskRecord<'_>) -> serde_json::Value {
         "executed": o.executed,
         "skill_steps": o.skill_steps,
         "manipulator_steps": o.manipulator_steps,
-        "planning_s": o.planning_s,
         "timed_out": o.timed_out,
         "failure": o.failure,
         "deviations": deviations,

@@ -2380,15 +2380,18 @@ fn a_stopped_evaluation_resumes_from_its_finished_tasks() {
         ("manipulator_steps", serde_json::json!(7)),
         ("skill_steps", serde_json::json!([7])),
         ("failure", serde_json::Value::Null),
+        ("planning_s", serde_json::json!(0.5)),
     ] {
         planted[key] = value;
     }
     let resumed = dir.path().join("resumed");
     copy_tiny_run(&resumed);
+    // A `.partial` line also holds the task's search time (the tasks file does not).
+    let mut second: serde_json::Value = serde_json::from_str(&first_two[1]).unwrap();
+    second["planning_s"] = serde_json::json!(0.25);
     let partial = format!(
-        "{}\n{planted}\n{}\n{{\"depth\": 2, \"se",
-        header(&record["protocol"]),
-        first_two[1]
+        "{}\n{planted}\n{second}\n{{\"depth\": 2, \"se",
+        header(&record["protocol"])
     );
     std::fs::write(resumed.join(format!("{TASKS}.partial")), partial).unwrap();
     let v = evaluate(&resumed);
