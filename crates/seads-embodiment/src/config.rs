@@ -112,43 +112,40 @@ pub struct NoOptions {}
 
 /// What a configuration states, in the current layout or in the older one that kept the Jaco's
 /// `physics_substeps` beside the board options (committed Jaco runs' files); read into
-/// [`EnvConfig`], which writes the current layout only.
+/// [`EnvConfig`], which writes the current layout only. A key left out takes
+/// [`EnvConfig::default`]'s value.
 #[derive(Deserialize)]
-#[serde(deny_unknown_fields, default)]
+#[serde(deny_unknown_fields)]
 struct Stated {
+    #[serde(default)]
     board_size: Option<usize>,
+    #[serde(default)]
     spacing: Option<f64>,
+    #[serde(default = "train")]
     reset_split: Split,
+    #[serde(default = "max_solution_depth")]
     max_solution_depth: usize,
+    #[serde(default = "random_solution_depth")]
     random_solution_depth: bool,
+    #[serde(default)]
     step_limit: Option<usize>,
+    #[serde(default)]
     manipulator: serde_json::Map<String, serde_json::Value>,
     /// The older layout's place of the Jaco's option.
+    #[serde(default)]
     physics_substeps: Option<serde_json::Value>,
 }
 
-impl Default for Stated {
-    fn default() -> Self {
-        let EnvConfig {
-            board_size,
-            spacing,
-            reset_split,
-            max_solution_depth,
-            random_solution_depth,
-            step_limit,
-            manipulator,
-        } = EnvConfig::default();
-        Self {
-            board_size,
-            spacing,
-            reset_split,
-            max_solution_depth,
-            random_solution_depth,
-            step_limit,
-            manipulator,
-            physics_substeps: None,
-        }
-    }
+fn train() -> Split {
+    EnvConfig::default().reset_split
+}
+
+fn max_solution_depth() -> usize {
+    EnvConfig::default().max_solution_depth
+}
+
+fn random_solution_depth() -> bool {
+    EnvConfig::default().random_solution_depth
 }
 
 impl TryFrom<Stated> for EnvConfig {

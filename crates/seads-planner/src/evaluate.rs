@@ -82,7 +82,8 @@ impl DepthResult {
 
 /// What a finished task adds to its depth's [`DepthResult`]: enough to count it again when an
 /// evaluation resumes, without solving it again. Its fields are [`SolveOutcome`]'s of the same
-/// names, so that it reads from a line of a tasks file (other keys are ignored).
+/// names, so that it reads from a task's line with its search time added (other keys are
+/// ignored), as a stopped evaluation's `.partial` file holds it.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct TaskSummary {
     /// The board reached the goal.

@@ -263,8 +263,9 @@ pub fn run_evaluation(
         return Err(e.into());
     }
     let mut lines = String::new();
+    let seeds = protocol.tasks.seeds();
     for &depth in &protocol.tasks.depths {
-        for seed in protocol.tasks.seeds() {
+        for &seed in &seeds {
             let line = now
                 .get(&(depth, seed))
                 .or_else(|| earlier.get(&(depth, seed)).map(|(_, line)| line))

@@ -457,6 +457,24 @@ fn copy_tiny_run(to: &std::path::Path) {
     copy_dir(&tiny_run().join("run"), to);
 }
 
+/// `seads evaluate --json` of `run` with re-planning on 2 boards of depths 1 and 2 (searches
+/// bounded by 2,000 states); it writes `evaluation-replan-depths-1-2*` into the run.
+fn evaluate_two_boards_of_depths_1_2(run: &str) -> serde_json::Value {
+    json(&[
+        "evaluate",
+        "--run",
+        run,
+        "--depths",
+        "1-2",
+        "--boards",
+        "2",
+        "--max-expanded",
+        "2000",
+        "--replan",
+        "--json",
+    ])
+}
+
 /// One tiny trained run shared by the planning tests.
 fn tiny_run() -> &'static std::path::Path {
     static RUN: std::sync::OnceLock<tempfile::TempDir> = std::sync::OnceLock::new();
@@ -557,19 +575,7 @@ fn solve_evaluate_and_plot_a_trained_run() {
     ] {
         assert!(v.get(key).is_some(), "solve reports {key}");
     }
-    let v = json(&[
-        "evaluate",
-        "--run",
-        run,
-        "--depths",
-        "1-2",
-        "--boards",
-        "2",
-        "--max-expanded",
-        "2000",
-        "--replan",
-        "--json",
-    ]);
+    let v = evaluate_two_boards_of_depths_1_2(run);
     for key in [
         "success_rate",
         "plan_found",
@@ -2328,21 +2334,7 @@ fn the_golden_runs_first_100_epochs_repeat_line_for_line() {
 #[test]
 fn a_stopped_evaluation_resumes_from_its_finished_tasks() {
     let dir = tempfile::tempdir().unwrap();
-    let evaluate = |run: &std::path::Path| {
-        json(&[
-            "evaluate",
-            "--run",
-            s(run),
-            "--depths",
-            "1-2",
-            "--boards",
-            "2",
-            "--max-expanded",
-            "2000",
-            "--replan",
-            "--json",
-        ])
-    };
+    let evaluate = |run: &std::path::Path| evaluate_two_boards_of_depths_1_2(s(run));
     const TASKS: &str = "evaluation-replan-depths-1-2-tasks.jsonl";
     let lines = |run: &std::path::Path| -> Vec<serde_json::Value> {
         std::fs::read_to_string(run.join(TASKS))
