@@ -125,8 +125,9 @@ pub struct Plan {
     /// Distinct states discovered.
     pub discovered: usize,
     /// The model's log-probability of the plan's predicted states (the sum of its steps'
-    /// log q(z_{t+1} | z_t, k_t)), where the plan was chosen by it ([`PlanChoice::MostLikely`]
-    /// and a model with probabilities).
+    /// log q(z_{t+1} | z_t, k_t)), where the plan was chosen by it: [`PlanChoice::MostLikely`],
+    /// a model with probabilities, and a choice to make (more than one way to the goal in the
+    /// batch that found it, or more than one skill predicted to make a step).
     pub log_likelihood: Option<f32>,
 }
 
@@ -337,6 +338,8 @@ fn search<K: Key>(
     let mut new: Vec<bool> = Vec::new();
     let mut chunks = Vec::new();
     let mut expanded = 0;
+    // The start's successors, kept from the first layer for the plan choice.
+    let mut start_row: Vec<SymbolicState> = Vec::new();
     for _layer in 0..config.max_layers {
         let next_start = nodes.len();
         let mut chunk_start = fringe.start;
@@ -368,6 +371,9 @@ fn search<K: Key>(
             states.extend(nodes[group.clone()].iter().map(|n| n.state));
             out.clear();
             successor.successors(&states, &mut out);
+            if group.start == 0 {
+                start_row.extend_from_slice(&out[..k]);
+            }
             // Only the successors before the first goal count; the rest are never looked at.
             let found = out.par_iter().position_first(|&next| next == goal);
             let seen = found.unwrap_or(out.len());
@@ -387,14 +393,27 @@ fn search<K: Key>(
                                 return Ok(first);
                             }
                             // Every way to the goal from this chunk, in search order.
-                            let hits = chunk.clone().flat_map(|p| (0..k).map(move |s| (p, s)));
-                            let candidates: Vec<Plan> = hits
+                            let hits: Vec<(usize, usize)> = chunk
+                                .clone()
+                                .flat_map(|p| (0..k).map(move |s| (p, s)))
                                 .filter(|&(p, s)| out[(p - group.start) * k + s] == goal)
                                 .take(MAX_CANDIDATES)
-                                .map(|(p, s)| trace(&nodes, p, s, goal, expanded, nodes.len()))
                                 .collect();
-                            let start = nodes[0].state;
-                            return Ok(most_likely(successor, start, candidates).unwrap_or(first));
+                            let candidates: Vec<Plan> = hits
+                                .iter()
+                                .map(|&(p, s)| trace(&nodes, p, s, goal, expanded, nodes.len()))
+                                .collect();
+                            // The successors the search has computed of the start and of the
+                            // states the candidates' last steps leave.
+                            let rows = hits.iter().map(|&(p, _)| {
+                                let row = (p - group.start) * k;
+                                (nodes[p].state, &out[row..row + k])
+                            });
+                            let known: Vec<_> = std::iter::once((start, &start_row[..]))
+                                .chain(rows)
+                                .collect();
+                            let chosen = most_likely(successor, start, candidates, &known);
+                            return Ok(chosen.unwrap_or(first));
                         }
                         if new[row + skill] {
                             nodes.push(Node {
@@ -473,11 +492,16 @@ const MAX_CANDIDATES: usize = 64;
 
 /// Of `candidates` (plans from `start`, in search order), the one the model is surest of, each
 /// step's skill the likeliest of the skills whose predicted successor is that step's state; the
-/// earliest of equals. `None` where the model has no probabilities or there is no candidate.
+/// earliest of equals. `known` holds successor rows the caller has computed (a state and its K
+/// successors); only the other steps' states are computed again. Where there is nothing to
+/// choose (one candidate, and one skill predicted to make each of its steps), that candidate
+/// comes back as it is, without asking the model for probabilities (its `log_likelihood` stays
+/// `None`). `None` where the model has no probabilities or there is no candidate.
 pub(crate) fn most_likely(
     successor: &mut dyn Successor,
     start: SymbolicState,
-    candidates: Vec<Plan>,
+    mut candidates: Vec<Plan>,
+    known: &[(SymbolicState, &[SymbolicState])],
 ) -> Option<Plan> {
     let k = successor.num_skills();
     // Each step as (from, to), every candidate's in turn.
@@ -489,21 +513,41 @@ pub(crate) fn most_likely(
                 .zip(plan.predicted.iter().copied())
         })
         .collect();
+    // Each step's successor row: a known one, else computed here.
+    let lookup = |z: SymbolicState| known.iter().find(|&&(y, _)| y == z).map(|&(_, row)| row);
+    let missing: Vec<SymbolicState> = steps
+        .iter()
+        .map(|&(z, _)| z)
+        .filter(|&z| lookup(z).is_none())
+        .collect();
+    let mut computed = Vec::with_capacity(missing.len() * k);
+    successor.successors(&missing, &mut computed);
+    let mut fresh = computed.chunks(k.max(1));
+    let rows: Vec<&[SymbolicState]> = steps
+        .iter()
+        .map(|&(z, _)| lookup(z).or_else(|| fresh.next()).unwrap_or(&[]))
+        .collect();
+    // The skills predicted to make each step (the planned one does, so there is one).
+    let makers: Vec<Vec<usize>> = steps
+        .iter()
+        .zip(&rows)
+        .map(|(&(_, to), row)| (0..row.len()).filter(|&s| row[s] == to).collect())
+        .collect();
+    if candidates.len() == 1 && makers.iter().all(|m| m.len() == 1) {
+        return candidates.pop();
+    }
     let log_q = successor.log_likelihoods(&steps)?;
-    let from: Vec<SymbolicState> = steps.iter().map(|&(z, _)| z).collect();
-    let mut next = Vec::with_capacity(from.len() * k);
-    successor.successors(&from, &mut next);
     let mut best: Option<Plan> = None;
     let mut offset = 0;
     for mut plan in candidates {
         let mut total = 0.0f32;
         for (t, skill) in plan.skills.iter_mut().enumerate() {
-            let (i, to) = (offset + t, steps[offset + t].1);
-            // The likeliest skill that the model predicts to make this step (the planned one
-            // does, so there is one); the lowest of equals.
-            let (chosen, ll) = (0..k)
-                .filter(|&s| next[i * k + s] == to)
-                .map(|s| (s, log_q[i * k + s]))
+            let i = offset + t;
+            // The likeliest skill that the model predicts to make this step; the lowest of
+            // equals.
+            let (chosen, ll) = makers[i]
+                .iter()
+                .map(|&s| (s, log_q[i * k + s]))
                 // A NaN (a broken model) never wins.
                 .map(|(s, ll)| (s, if ll.is_nan() { f32::NEG_INFINITY } else { ll }))
                 .fold(None, |acc: Option<(usize, f32)>, (s, ll)| match acc {

@@ -385,7 +385,7 @@ fn choose(
         PlanChoice::FirstFound => Some(first),
         PlanChoice::MostLikely => {
             plans.truncate(MAX_CANDIDATES);
-            Some(most_likely(successor, start, plans).unwrap_or(first))
+            Some(most_likely(successor, start, plans, &[]).unwrap_or(first))
         }
     }
 }

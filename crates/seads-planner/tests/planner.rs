@@ -537,6 +537,78 @@ fn the_most_likely_plan_takes_the_sure_skill_of_two_for_one_move() {
     assert_eq!((plan.skills, plan.log_likelihood), (vec![4, 9], None));
 }
 
+/// A successor function that counts what the planner asks of the model it wraps.
+struct Counting<'a> {
+    inner: &'a mut dyn Successor,
+    /// States whose successors were computed.
+    states: usize,
+    /// Calls for probabilities.
+    weighings: usize,
+}
+
+impl Successor for Counting<'_> {
+    fn num_skills(&self) -> usize {
+        self.inner.num_skills()
+    }
+    fn symbolic_len(&self) -> usize {
+        self.inner.symbolic_len()
+    }
+    fn successors(&mut self, states: &[SymbolicState], out: &mut Vec<SymbolicState>) {
+        self.states += states.len();
+        self.inner.successors(states, out);
+    }
+    fn log_likelihoods(&mut self, pairs: &[(SymbolicState, SymbolicState)]) -> Option<Vec<f32>> {
+        self.weighings += 1;
+        self.inner.log_likelihoods(pairs)
+    }
+}
+
+/// The most likely plan costs the model no successors beyond the search's own (the start's and
+/// the last steps' are kept from it), and no probabilities where there is nothing to choose: at
+/// depth 1 with one skill for the move it is the first plan found at the first-found cost; with
+/// two skills for the move, or two orders of two moves, the model weighs the choice once.
+#[test]
+fn the_most_likely_plan_asks_the_model_only_for_what_the_search_did_not_compute() {
+    let mut model = TwoForMoveSeven {
+        game: LightsOut::new(5).unwrap(),
+        seven_unsure: true,
+    };
+    let goal = model.game.goal();
+    // (moves, calls for probabilities by the most likely choice)
+    for (moves, weighings) in [(vec![3], 0), (vec![7], 1), (vec![3, 12], 1)] {
+        let board = model.game.apply_all(goal, &moves);
+        let mut plan = |choice| {
+            let mut counting = Counting {
+                inner: &mut model,
+                states: 0,
+                weighings: 0,
+            };
+            let config = PlannerConfig {
+                plan: choice,
+                ..PlannerConfig::default()
+            };
+            let plan = bfs_plan(&mut counting, board, goal, &config).unwrap();
+            (plan, counting.states, counting.weighings)
+        };
+        let (first, first_states, _) = plan(PlanChoice::FirstFound);
+        let (likely, likely_states, likely_weighings) = plan(PlanChoice::MostLikely);
+        assert_eq!(likely_states, first_states, "{moves:?}");
+        assert_eq!(likely_weighings, weighings, "{moves:?}");
+        assert_eq!(likely.expanded, first.expanded, "{moves:?}");
+        if weighings == 0 {
+            assert_eq!(likely, first, "{moves:?}: nothing to choose");
+        } else {
+            assert_eq!(likely.skills.len(), moves.len(), "{moves:?}");
+            assert!(
+                !likely.skills.contains(&7),
+                "{moves:?}: {:?}",
+                likely.skills
+            );
+            assert!(likely.log_likelihood.is_some(), "{moves:?}");
+        }
+    }
+}
+
 /// A skill the model is sure of always presses the wrong field (skill 7 presses field 8); skill
 /// 25, which the model doubts, makes move 7. With re-planning, the most likely choice stops taking
 /// skill 7 from a board it failed from and solves every board with skill 25; the paper's choice
