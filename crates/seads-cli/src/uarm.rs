@@ -192,9 +192,12 @@ pub struct UarmTrainArgs {
     #[arg(long)]
     reset_board: bool,
     /// What the skills see: board-and-pen, board, pen or nothing (what is not seen reads 0; the
-    /// forward model always sees the board). A resumed run keeps its own.
-    #[arg(long, default_value = "board-and-pen")]
-    observe: Observation,
+    /// forward model always sees the board). Default: pen with absolute pushes (a press is the
+    /// same whatever the board shows; on the twin it solves every board where seeing the board
+    /// too does not, docs/results/uarm-ablations), board-and-pen with displacements (the
+    /// Cursor's). A resumed run keeps its own.
+    #[arg(long)]
+    observe: Option<Observation>,
     /// The twin only: standard deviation, mm, of where a tap lands around the commanded point
     /// (pen offset, the arm's repeatability). A resumed run keeps its own.
     #[arg(long, default_value_t = 0.0, value_name = "MM")]
@@ -242,7 +245,9 @@ impl UarmTrainArgs {
         RobotSettings {
             action_space: self.action_space,
             reset_board: self.reset_board,
-            observe: self.observe,
+            observe: self
+                .observe
+                .unwrap_or_else(|| self.action_space.observation()),
             twin_noise: self.noise(),
         }
     }
@@ -418,17 +423,23 @@ pub fn train(mut args: UarmTrainArgs) -> Result<()> {
 }
 
 /// A resumed run acts and sees as it was trained, on a twin with its noise, whatever the options
-/// say. A run from before `robot.toml` keeps the flags given.
+/// say. A run from before `robot.toml` keeps the flags given; its skills saw everything unless
+/// `--observe` says otherwise.
 fn adopt_run_settings(args: &mut UarmTrainArgs) -> Result<()> {
-    if let Some(settings) = RobotSettings::read(&args.out).map_err(|e| match e {
+    match RobotSettings::read(&args.out).map_err(|e| match e {
         UarmError::Config(_) => BadInput(e.into()).into(),
         other => anyhow::Error::from(other),
     })? {
-        args.action_space = settings.action_space;
-        args.reset_board = settings.reset_board;
-        args.observe = settings.observe;
-        args.tap_sd_mm = settings.twin_noise.tap_sd_mm;
-        args.late_reports = settings.twin_noise.late_report_p;
+        Some(settings) => {
+            args.action_space = settings.action_space;
+            args.reset_board = settings.reset_board;
+            args.observe = Some(settings.observe);
+            args.tap_sd_mm = settings.twin_noise.tap_sd_mm;
+            args.late_reports = settings.twin_noise.late_report_p;
+        }
+        None => {
+            args.observe.get_or_insert_default();
+        }
     }
     Ok(())
 }

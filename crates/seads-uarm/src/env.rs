@@ -53,6 +53,19 @@ impl ActionSpace {
             .find(|space| space.env_name() == name)
     }
 
+    /// What a new run's skills see unless told otherwise. With absolute pushes, the pen's
+    /// position only: a skill is one press, the same wherever the lights are, and on the twin
+    /// (`docs/results/uarm-ablations/`) skills that saw the board as well scattered their
+    /// presses with it (87 and 100 of 100 boards over two seeds), where skills that saw the pen
+    /// only solved 100 of 100 on both. The paper states no observation for the robot. With
+    /// displacements, the board and the pen, as the Cursor sees its world.
+    pub fn observation(self) -> Observation {
+        match self {
+            Self::Absolute => Observation::Pen,
+            Self::Displacement => Observation::BoardAndPen,
+        }
+    }
+
     /// Steps per skill: one press, or as many displacements as the Cursor's skills take.
     pub fn step_limit(self) -> usize {
         match self {

@@ -1260,6 +1260,38 @@ fn uarm_rejects_bad_input() {
     assert!(!run.exists(), "a refused command writes nothing");
 }
 
+/// What a new robot run's skills see unless told: the pen only with absolute pushes (the preset
+/// that the twin's ablations chose), the board and the pen with displacements (the Cursor's).
+#[test]
+fn a_new_robot_run_sees_what_its_action_space_needs() {
+    for (space, observe) in [("absolute", "pen"), ("displacement", "board-and-pen")] {
+        let dir = tempfile::tempdir().unwrap();
+        let run = dir.path().join("run");
+        seads_ok(&[
+            "uarm",
+            "train",
+            "--port",
+            "sim:2",
+            "--action-space",
+            space,
+            "--env-steps",
+            "8",
+            "--boards",
+            "1",
+            "--max-expanded",
+            "1000",
+            "--quiet",
+            "--out",
+            s(&run),
+        ]);
+        let robot = std::fs::read_to_string(run.join("robot.toml")).unwrap();
+        assert!(
+            robot.contains(&format!("observe = \"{observe}\"\n")),
+            "{space}: {robot}"
+        );
+    }
+}
+
 /// The settings an ablation of the robot changes are recorded with the run, and a resume keeps
 /// them whatever its options say.
 #[test]
