@@ -17,12 +17,14 @@ pub trait Successor {
     fn preferred_batch(&self) -> usize {
         0
     }
-    /// The model's log-probability log q(z_T | z_0, k) of each pair `(z_0, z_T)` under every
-    /// skill, pair-major (entry `i · K + k`), for choosing among plans the one the model is
-    /// surest of; `None` for a model without probabilities (the true rules: every successor is
-    /// certain).
-    fn log_likelihoods(&mut self, pairs: &[(SymbolicState, SymbolicState)]) -> Option<Vec<f32>> {
-        let _ = pairs;
+    /// The model's log-probability log q(z_T | z_0, k) of each step `(z_0, k, z_T)`, for
+    /// choosing among plans the one the model is surest of; `None` for a model without
+    /// probabilities (the true rules: every successor is certain).
+    fn log_likelihoods(
+        &mut self,
+        steps: &[(SymbolicState, usize, SymbolicState)],
+    ) -> Option<Vec<f32>> {
+        let _ = steps;
         None
     }
 }

@@ -103,17 +103,24 @@ impl Successor for ForwardModel {
         }
     }
 
-    fn log_likelihoods(&mut self, pairs: &[(SymbolicState, SymbolicState)]) -> Option<Vec<f32>> {
-        let from: Vec<SymbolicState> = pairs.iter().map(|&(z, _)| z).collect();
+    fn log_likelihoods(
+        &mut self,
+        steps: &[(SymbolicState, usize, SymbolicState)],
+    ) -> Option<Vec<f32>> {
+        if steps.iter().any(|&(_, k, _)| k >= self.skills) {
+            return None;
+        }
+        // Each step's row of its start's logits under every skill.
+        let from: Vec<SymbolicState> = steps.iter().map(|&(z, _, _)| z).collect();
         let logits = self.flip_logits(&from);
         Some(
-            logits
-                .axis_iter(Axis(0))
+            steps
+                .iter()
                 .enumerate()
-                .map(|(row, logits)| {
-                    let (z0, zt) = pairs[row / self.skills];
+                .map(|(i, &(z0, k, zt))| {
                     let flipped = z0 ^ zt;
                     logits
+                        .row(i * self.skills + k)
                         .iter()
                         .enumerate()
                         .map(|(bit, &l)| log_sigmoid(if flipped.get(bit) { l } else { -l }))

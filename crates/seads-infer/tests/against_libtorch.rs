@@ -127,13 +127,13 @@ fn successors_and_their_probabilities_match_libtorchs() {
     torch_model.successors(&states, &mut b);
     assert_eq!(a, b);
     let k = light.model.num_skills();
-    let pairs: Vec<(SymbolicState, SymbolicState)> = states
+    let steps: Vec<(SymbolicState, usize, SymbolicState)> = states
         .iter()
         .enumerate()
-        .flat_map(|(i, &z)| [(z, a[i * k + i % k]), (z, z)])
+        .flat_map(|(i, &z)| [(z, i % k, a[i * k + i % k]), (z, (i + 1) % k, z)])
         .collect();
-    let la = light.model.log_likelihoods(&pairs).unwrap();
-    let lb = torch_model.log_likelihoods(&pairs).unwrap();
+    let la = light.model.log_likelihoods(&steps).unwrap();
+    let lb = torch_model.log_likelihoods(&steps).unwrap();
     assert_eq!(la.len(), lb.len());
     for (x, y) in la.iter().zip(&lb) {
         assert!((x - y).abs() <= 1e-5 * y.abs().max(1.0), "{x} against {y}");

@@ -536,7 +536,13 @@ pub(crate) fn most_likely(
     if candidates.len() == 1 && makers.iter().all(|m| m.len() == 1) {
         return candidates.pop();
     }
-    let log_q = successor.log_likelihoods(&steps)?;
+    // The probability of each step under each skill predicted to make it, step by step.
+    let weighed: Vec<(SymbolicState, usize, SymbolicState)> = steps
+        .iter()
+        .zip(&makers)
+        .flat_map(|(&(from, to), makers)| makers.iter().map(move |&s| (from, s, to)))
+        .collect();
+    let mut log_q = successor.log_likelihoods(&weighed)?.into_iter();
     let mut best: Option<Plan> = None;
     let mut offset = 0;
     for mut plan in candidates {
@@ -547,7 +553,7 @@ pub(crate) fn most_likely(
             // equals.
             let (chosen, ll) = makers[i]
                 .iter()
-                .map(|&s| (s, log_q[i * k + s]))
+                .map(|&s| (s, log_q.next().unwrap_or(f32::NAN)))
                 // A NaN (a broken model) never wins.
                 .map(|(s, ll)| (s, if ll.is_nan() { f32::NEG_INFINITY } else { ll }))
                 .fold(None, |acc: Option<(usize, f32)>, (s, ll)| match acc {

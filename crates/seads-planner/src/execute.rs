@@ -230,8 +230,11 @@ impl Successor for Avoiding<'_> {
         self.inner.preferred_batch()
     }
 
-    fn log_likelihoods(&mut self, pairs: &[(SymbolicState, SymbolicState)]) -> Option<Vec<f32>> {
-        self.inner.log_likelihoods(pairs)
+    fn log_likelihoods(
+        &mut self,
+        steps: &[(SymbolicState, usize, SymbolicState)],
+    ) -> Option<Vec<f32>> {
+        self.inner.log_likelihoods(steps)
     }
 }
 

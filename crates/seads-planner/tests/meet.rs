@@ -238,18 +238,20 @@ impl Successor for TwoForSeven<'_> {
             out.extend((0..26).map(|k| self.0.apply(z, Self::moves(k))));
         }
     }
-    fn log_likelihoods(&mut self, pairs: &[(SymbolicState, SymbolicState)]) -> Option<Vec<f32>> {
-        let game = self.0;
+    fn log_likelihoods(
+        &mut self,
+        steps: &[(SymbolicState, usize, SymbolicState)],
+    ) -> Option<Vec<f32>> {
         Some(
-            pairs
+            steps
                 .iter()
-                .flat_map(|&(z0, zt)| {
-                    (0..26).map(move |k| match game.apply(z0, Self::moves(k)) == zt {
+                .map(
+                    |&(z0, k, zt)| match self.0.apply(z0, Self::moves(k)) == zt {
                         true if k == 7 => -3.0,
                         true => -0.01,
                         false => -50.0,
-                    })
-                })
+                    },
+                )
                 .collect(),
         )
     }

@@ -465,19 +465,19 @@ impl Successor for TwoForMoveSeven {
             out.extend((0..26).map(|k| self.game.apply(z, Self::moves(k))));
         }
     }
-    fn log_likelihoods(&mut self, pairs: &[(SymbolicState, SymbolicState)]) -> Option<Vec<f32>> {
-        let this = &*self;
+    fn log_likelihoods(
+        &mut self,
+        steps: &[(SymbolicState, usize, SymbolicState)],
+    ) -> Option<Vec<f32>> {
         Some(
-            pairs
+            steps
                 .iter()
-                .flat_map(|&(z0, zt)| {
-                    (0..26).map(move |k| {
-                        if this.game.apply(z0, Self::moves(k)) == zt {
-                            this.confidence(k)
-                        } else {
-                            -50.0
-                        }
-                    })
+                .map(|&(z0, k, zt)| {
+                    if self.game.apply(z0, Self::moves(k)) == zt {
+                        self.confidence(k)
+                    } else {
+                        -50.0
+                    }
                 })
                 .collect(),
         )
@@ -557,9 +557,12 @@ impl Successor for Counting<'_> {
         self.states += states.len();
         self.inner.successors(states, out);
     }
-    fn log_likelihoods(&mut self, pairs: &[(SymbolicState, SymbolicState)]) -> Option<Vec<f32>> {
+    fn log_likelihoods(
+        &mut self,
+        steps: &[(SymbolicState, usize, SymbolicState)],
+    ) -> Option<Vec<f32>> {
         self.weighings += 1;
-        self.inner.log_likelihoods(pairs)
+        self.inner.log_likelihoods(steps)
     }
 }
 

@@ -693,9 +693,28 @@ impl seads_games::Successor for ForwardModel {
         }
     }
 
-    /// log q(z_T | z_0, k) for every pair and skill: the scores the forward model trains on.
-    fn log_likelihoods(&mut self, pairs: &[(SymbolicState, SymbolicState)]) -> Option<Vec<f32>> {
-        Some(SkillModel::scores(self, pairs))
+    /// log q(z_T | z_0, k) of each step, as the forward model trains on it (only the steps' own
+    /// skills are computed); `None` for a skill the model does not have.
+    fn log_likelihoods(
+        &mut self,
+        steps: &[(SymbolicState, usize, SymbolicState)],
+    ) -> Option<Vec<f32>> {
+        if steps.iter().any(|&(_, k, _)| k >= self.k) {
+            return None;
+        }
+        if steps.is_empty() {
+            return Some(Vec::new());
+        }
+        let z0: Vec<SymbolicState> = steps.iter().map(|&(z, _, _)| z).collect();
+        let skills: Vec<usize> = steps.iter().map(|&(_, k, _)| k).collect();
+        tch::no_grad(|| {
+            let logits = self.flip_logits(&z0, &skills); // n × D
+            let flipped =
+                states_tensor(steps.iter().map(|&(z, _, zt)| z ^ zt), self.d, self.device);
+            let ll =
+                Self::bit_log_likelihood(&logits, &flipped).sum_dim_intlist(1, false, Kind::Float);
+            Vec::<f32>::try_from(ll.to_device(Device::Cpu)).ok()
+        })
     }
 
     fn preferred_batch(&self) -> usize {
@@ -729,6 +748,35 @@ mod tests {
                 }
             })
             .sum()
+    }
+
+    /// A step's log-probability for the planner is the score of its skill for its pair.
+    #[test]
+    fn step_log_likelihoods_are_the_scores_of_their_skills() {
+        use seads_games::Successor as _;
+        let mut model = ForwardModel::new(25, 25, &SkillModelConfig::default(), Device::Cpu, 4);
+        let (a, b) = (
+            SymbolicState::from_u64(0b1011),
+            SymbolicState::from_u64(1 << 24 | 7),
+        );
+        let pairs = [(a, b), (b, b), (b, a)];
+        let scores = model.scores(&pairs);
+        let steps: Vec<_> = pairs
+            .iter()
+            .enumerate()
+            .flat_map(|(i, &(z0, zt))| [(i, 0), (i, 9), (i, 24)].map(|(i, k)| (i, (z0, k, zt))))
+            .collect();
+        let ll = model
+            .log_likelihoods(&steps.iter().map(|&(_, s)| s).collect::<Vec<_>>())
+            .unwrap();
+        for (&(i, (_, k, _)), got) in steps.iter().zip(ll) {
+            let want = scores[i * 25 + k];
+            assert!(
+                (got - want).abs() <= 1e-5 * want.abs().max(1.0),
+                "{i}, {k}: {got} vs {want}"
+            );
+        }
+        assert_eq!(model.log_likelihoods(&[(a, 25, b)]), None, "no skill 25");
     }
 
     #[test]
