@@ -1,10 +1,12 @@
 """The planner's plan choice: its cost (docs/results/plan-choice/plan-bench.json) and what it
 changes for trained agents (docs/results/plan-choice/agents/<choice>/seed-N/).
 
-`seads plan-bench` was run with `--plan first-found` and `--plan most-likely`, alternately, twice
-each, with one binary. Writes docs/results/plan-choice/summary.md: per depth, the expanded states
-(the same search both ways), each choice's mean milliseconds per plan (the two runs in brackets)
-and their ratio; then, for each agent evaluated with both choices (the same tasks), the boards
+`docs/results/plan-choice/bench.sh` ran `seads plan-bench` with `--plan first-found` and
+`--plan most-likely` by one binary, and `--plan most-likely` by the binary before the change, in
+turn, twice each. Writes docs/results/plan-choice/summary.md: per depth, the expanded states (the
+same search every way), each run's mean milliseconds per plan (the two runs in brackets), the
+most likely plan's cost against the first found's (one binary) and against the previous binary's
+most likely plan; then, for each agent evaluated with both choices (the same tasks), the boards
 solved per depth and the tasks that one choice solved and the other did not. Standard library
 only:
     python3 scripts/analysis/plan_choice.py
@@ -17,25 +19,36 @@ ROOT = pathlib.Path(__file__).resolve().parents[2]
 FOLDER = ROOT / "docs/results/plan-choice"
 data = json.loads((FOLDER / "plan-bench.json").read_text())
 runs = data["runs"]
+COLUMNS = [
+    ("new", "first-found", "first found, ms per plan"),
+    ("new", "most-likely", "most likely, ms per plan"),
+    ("old", "most-likely", "most likely before, ms per plan"),
+]
 lines = [
-    f"Written by `scripts/analysis/plan_choice.py` from `plan-bench.json`: `{data['command']}`, "
-    f"{data['binary']}; {data['machine']}; runs in the order {data['order']}.",
+    f"Written by `scripts/analysis/plan_choice.py` from `plan-bench.json`: `{data['command']}`; "
+    f"{data['binary']}, and before it {data['previous']}; release builds; {data['machine']}; "
+    f"runs in the order {data['order']}.",
     "",
-    "| depth | expanded states (all boards, both choices) | first found, ms per plan | "
-    "most likely, ms per plan | ratio |",
-    "|---|---|---|---|---|",
+    "| depth | expanded states (all boards, every run) | "
+    + " | ".join(title for _, _, title in COLUMNS)
+    + " | most likely / first found | most likely / before |",
+    "|---|---|---|---|---|---|---|",
 ]
 for i, row in enumerate(runs[0]["result"]["depths"]):
-    ms = {
-        choice: [r["result"]["depths"][i]["mean_s"] * 1000 for r in runs if r["plan"] == choice]
-        for choice in ("first-found", "most-likely")
-    }
+    mean, cells = {}, []
+    for which, plan, _ in COLUMNS:
+        ms = [
+            r["result"]["depths"][i]["mean_s"] * 1000
+            for r in runs
+            if r["which"] == which and r["plan"] == plan
+        ]
+        mean[which, plan] = sum(ms) / len(ms)
+        cells.append(f"{mean[which, plan]:.2f} ({', '.join(f'{x:.2f}' for x in ms)})")
     expanded = sorted({sum(r["result"]["depths"][i]["expanded"]) for r in runs})
-    mean = {c: sum(v) / len(v) for c, v in ms.items()}
-    cells = {c: f"{mean[c]:.2f} ({', '.join(f'{x:.2f}' for x in v)})" for c, v in ms.items()}
+    likely = mean["new", "most-likely"]
     lines.append(
-        f"| {row['depth']} | {', '.join(map(str, expanded))} | {cells['first-found']} | "
-        f"{cells['most-likely']} | {mean['most-likely'] / mean['first-found']:.2f} |"
+        f"| {row['depth']} | {', '.join(map(str, expanded))} | {' | '.join(cells)} | "
+        f"{likely / mean['new', 'first-found']:.2f} | {likely / mean['old', 'most-likely']:.2f} |"
     )
 
 GROUPS = [
