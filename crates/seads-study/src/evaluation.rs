@@ -4,7 +4,7 @@
 //! [`OVER_TRAINING`]; and running an evaluation of a trained agent or a baseline's policy.
 
 use std::collections::BTreeMap;
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
 use seads_games::BoardGame;
 use seads_planner::{
@@ -225,9 +225,7 @@ pub fn run_evaluation(
 ) -> Result<EvaluationRecord> {
     let game = crate::run_game(&agent.config)?;
     let (checkpoint, named) = checkpoint_of(run, &agent.checkpoint)?;
-    let partial = run.join(format!("{}.partial", protocol.tasks_file(named)));
-    let header =
-        serde_json::json!({ "evaluation": { "protocol": protocol, "checkpoint": &checkpoint } });
+    let (partial, header) = journal(run, protocol, &checkpoint, named);
     let earlier = finished_tasks(&partial, &header)?;
     if earlier.is_empty() {
         let mut text = header.to_string();
@@ -286,6 +284,27 @@ pub fn run_evaluation(
         }
         _ => Ok(record),
     }
+}
+
+/// How many tasks of `protocol` a stopped evaluation of the agent's checkpoint in `run` has
+/// finished: [`run_evaluation`] counts them instead of solving them again.
+pub fn finished_before(agent: &Agent, run: &Path, protocol: &Protocol) -> Result<usize> {
+    let (checkpoint, named) = checkpoint_of(run, &agent.checkpoint)?;
+    let (partial, header) = journal(run, protocol, &checkpoint, named);
+    Ok(finished_tasks(&partial, &header)?.len())
+}
+
+/// The `.partial` file of an evaluation in progress and the header its tasks are written under.
+fn journal(
+    run: &Path,
+    protocol: &Protocol,
+    checkpoint: &CheckpointId,
+    named: Option<u64>,
+) -> (PathBuf, serde_json::Value) {
+    let partial = run.join(format!("{}.partial", protocol.tasks_file(named)));
+    let header =
+        serde_json::json!({ "evaluation": { "protocol": protocol, "checkpoint": checkpoint } });
+    (partial, header)
 }
 
 /// The tasks an earlier, stopped evaluation wrote into `partial` under `header`, by depth and

@@ -21,6 +21,17 @@ pub fn run_evaluation(
         quiet,
         "{wide_bar} {pos}/{len} {msg}",
     );
+    // A resumed evaluation starts from the tasks its stopped run finished.
+    let before = seads_study::evaluation::finished_before(agent, run, protocol)
+        .map_err(crate::study_error)?;
+    if before > 0 {
+        eprintln!(
+            "seads: {}: resuming an evaluation: {before} of {} tasks finished before",
+            run.display(),
+            protocol.tasks.len()
+        );
+    }
+    bar.set_position(before as u64);
     let record = seads_study::evaluation::run_evaluation(agent, run, protocol, |task| {
         bar.set_message(format!("depth {}", task.depth));
         bar.inc(1);

@@ -460,7 +460,12 @@ fn copy_tiny_run(to: &std::path::Path) {
 /// `seads evaluate --json` of `run` with re-planning on 2 boards of depths 1 and 2 (searches
 /// bounded by 2,000 states); it writes `evaluation-replan-depths-1-2*` into the run.
 fn evaluate_two_boards_of_depths_1_2(run: &str) -> serde_json::Value {
-    json(&[
+    serde_json::from_slice(&evaluate_two_boards_of_depths_1_2_output(run).stdout).unwrap()
+}
+
+/// What [`evaluate_two_boards_of_depths_1_2`] prints, standard error included.
+fn evaluate_two_boards_of_depths_1_2_output(run: &str) -> std::process::Output {
+    seads_ok(&[
         "evaluate",
         "--run",
         run,
@@ -2418,7 +2423,13 @@ fn a_stopped_evaluation_resumes_from_its_finished_tasks() {
         header(&record["protocol"])
     );
     std::fs::write(resumed.join(format!("{TASKS}.partial")), partial).unwrap();
-    let v = evaluate(&resumed);
+    let out = evaluate_two_boards_of_depths_1_2_output(s(&resumed));
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let note = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        note.contains("resuming an evaluation: 2 of 4 tasks finished before"),
+        "{note}"
+    );
     let mut expected = whole_lines.clone();
     expected[0] = planted.clone();
     expected[0].as_object_mut().unwrap().remove("planning_s");
