@@ -457,7 +457,7 @@ env_overrides = { "lightsout-cursor" = { num_skills = 30 }, "tileswap-cursor" = 
                 include_str!("../../../../experiments/table1-arms.toml"),
                 4 * 7 * 5,
             ),
-            (include_str!("../../../../experiments/vic.toml"), 4 * 3),
+            (include_str!("../../../../experiments/vic.toml"), 2 * 4 * 3),
             (include_str!("../../../../experiments/arms.toml"), 5 * 2),
             (
                 include_str!("../../../../experiments/board-size.toml"),
