@@ -952,10 +952,11 @@ fn uarm_twin_calibrates_and_trains() {
             .unwrap()
             .contains("uarm-lightsout-absolute")
     );
-    // The paper's protocol unless asked otherwise, recorded for a resume.
+    // The preset unless asked otherwise (the pen seen only:
+    // `a_new_robot_run_sees_what_its_action_space_needs`), recorded for a resume.
     assert_eq!(
         std::fs::read_to_string(run.join("robot.toml")).unwrap(),
-        "action_space = \"absolute\"\nreset_board = false\nobserve = \"board-and-pen\"\n"
+        "action_space = \"absolute\"\nreset_board = false\nobserve = \"pen\"\n"
     );
     // A robot run has figures and a report too: what its directory holds.
     let figures = dir.path().join("figures");
