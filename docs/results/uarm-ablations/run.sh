@@ -8,8 +8,10 @@
 set -u
 B=${SEADS:-/root/seads-frozen/13631e6/bin/seads}
 here=$(cd "$(dirname "$0")" && pwd)
+# "paper" names its observation: a new run's default is the pen only since 3ab6aec (13631e6's
+# default was the board and the pen, so the runs here are the same with either line).
 settings=(
-  "paper|"
+  "paper|--observe board-and-pen"
   "observe-board|--observe board"
   "observe-pen|--observe pen"
   "observe-nothing|--observe nothing"
