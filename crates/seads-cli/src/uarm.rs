@@ -46,18 +46,10 @@ impl Connection {
     /// The twin that `--port sim` or `sim:SEED` asks for, with `noise`; any other port is a
     /// serial port, which takes no noise.
     fn twin(&self, noise: TwinNoise) -> Result<Option<Twin>> {
-        let seed = if self.port == "sim" {
-            0
-        } else if let Some(seed) = self.port.strip_prefix("sim:") {
-            seed.parse().map_err(|_| {
-                BadInput(anyhow::anyhow!(
-                    "--port {}: the twin's seed must be a whole number (sim:SEED)",
-                    self.port
-                ))
-            })?
-        } else if noise.is_none() {
-            return Ok(None);
-        } else {
+        let Some(seed) = self.twin_seed()? else {
+            if noise.is_none() {
+                return Ok(None);
+            }
             bail!(BadInput(anyhow::anyhow!(
                 "--tap-sd-mm and --late-reports need the twin (--port sim): a real arm has its own noise"
             )));
@@ -65,6 +57,23 @@ impl Connection {
         Ok(Some(
             Twin::with_noise(seed, noise).map_err(|e| BadInput(e.into()))?,
         ))
+    }
+
+    /// The seed of the twin that `--port sim` (0) or `sim:SEED` names; `None` for a serial port.
+    fn twin_seed(&self) -> Result<Option<u64>> {
+        if self.port == "sim" {
+            return Ok(Some(0));
+        }
+        let Some(seed) = self.port.strip_prefix("sim:") else {
+            return Ok(None);
+        };
+        let seed = seed.parse().map_err(|_| {
+            BadInput(anyhow::anyhow!(
+                "--port {}: the twin's seed must be a whole number (sim:SEED)",
+                self.port
+            ))
+        })?;
+        Ok(Some(seed))
     }
 
     fn arm(&self, twin: Option<&Twin>) -> Result<Swift> {
@@ -411,11 +420,21 @@ pub fn train(mut args: UarmTrainArgs) -> Result<()> {
     };
     crate::train::drive(&mut run, args.quiet)?;
     drop(run);
+    // On the twin, the evaluation plays a fresh one, as `seads uarm evaluate` does: its outcome
+    // does not depend on where training left the pen and the noise, nor on whether the run was
+    // resumed. The real arm stays connected.
+    let (env, twin_seed) = match args.connection.twin_seed()? {
+        Some(_) => {
+            drop((env, twin));
+            evaluation_env(&args.connection, args.calibration.as_deref(), &args.out)?
+        }
+        None => (env, None),
+    };
     evaluate(
         &args.out,
         None,
         env,
-        twin.is_some(),
+        twin_seed,
         args.boards,
         args.search.limits(),
         args.quiet,
@@ -476,61 +495,87 @@ pub fn evaluate_run(args: UarmEvaluateArgs) -> Result<()> {
     let config = crate::run_config(&args.run)?;
     let _lock = crate::lock_run(&args.run)?;
     crate::kernels::use_kernels(config.portable_numerics)?;
-    let action_space = ActionSpace::of_env(&config.env).ok_or_else(|| {
-        BadInput(anyhow::anyhow!(
-            "{} is a {} run, not a robot run (see `seads evaluate`)",
-            args.run.display(),
-            config.env
-        ))
-    })?;
-    // The run's observation and, on the twin, its noise; boards are set, not reset.
-    let settings = RobotSettings {
-        reset_board: false,
-        ..run_settings(&args.run, action_space)?
-    };
-    let noise = if args.connection.is_twin() {
-        settings.twin_noise
-    } else {
-        TwinNoise::default()
-    };
-    let twin = args.connection.twin(noise)?;
-    let env = build_env(
-        &args.connection,
-        args.calibration.as_deref(),
-        &settings,
-        twin.as_ref(),
-    )?;
+    let (env, twin_seed) =
+        evaluation_env(&args.connection, args.calibration.as_deref(), &args.run)?;
     evaluate(
         &args.run,
         args.checkpoint,
         env,
-        twin.is_some(),
+        twin_seed,
         args.boards,
         args.search.limits(),
         args.quiet,
     )
 }
 
+/// The arm, or a fresh twin with the run's noise, that the robot run in `run` is evaluated on:
+/// its skills see what they saw in training, and boards are set, not reset. With the twin's seed
+/// (`None` for the real arm).
+fn evaluation_env(
+    connection: &Connection,
+    calibration: Option<&Path>,
+    run: &Path,
+) -> Result<(UarmEnv, Option<u64>)> {
+    let config = crate::run_config(run)?;
+    let action_space = ActionSpace::of_env(&config.env).ok_or_else(|| {
+        BadInput(anyhow::anyhow!(
+            "{} is a {} run, not a robot run (see `seads evaluate`)",
+            run.display(),
+            config.env
+        ))
+    })?;
+    let settings = RobotSettings {
+        reset_board: false,
+        ..run_settings(run, action_space)?
+    };
+    let noise = if connection.is_twin() {
+        settings.twin_noise
+    } else {
+        TwinNoise::default()
+    };
+    let twin = connection.twin(noise)?;
+    let env = build_env(connection, calibration, &settings, twin.as_ref())?;
+    Ok((env, connection.twin_seed()?))
+}
+
 /// Success with re-planning on the protocol's tasks of depth 1–5 (the twin's boards are set to
 /// them: the boards a Cursor evaluation plays), or on the boards the app shows (the real
 /// tablet's cannot be set), of the checkpoint of `epoch` or the latest. Saved per depth as
 /// `evaluation-replan.json` (the file `seads plot` and `seads report` read), or
-/// `evaluation-replan-epoch-<EPOCH>.json` for an earlier checkpoint.
+/// `evaluation-replan-epoch-<EPOCH>.json` for an earlier checkpoint, with one line per task. A
+/// stopped evaluation resumes from its finished tasks (on the twin, exactly: they are replayed).
 fn evaluate(
     run: &Path,
     epoch: Option<u64>,
     env: UarmEnv,
-    settable: bool,
+    twin_seed: Option<u64>,
     boards: usize,
     limits: seads_planner::SearchLimits,
     quiet: bool,
 ) -> Result<()> {
     let checkpoint = find_checkpoint(run, epoch).map_err(|e| BadInput(e.into()))?;
-    let bar = crate::progress_bar(5 * boards as u64, quiet, "{wide_bar} {pos}/{len}");
-    let record =
-        seads_study::robot::evaluate_robot(run, &checkpoint, env, settable, boards, limits, || {
-            bar.inc(1)
-        })
+    let evaluation = seads_study::robot::RobotEvaluation {
+        twin_seed,
+        boards,
+        limits,
+    };
+    let before = evaluation
+        .finished_before(run, &checkpoint)
+        .map_err(crate::study_error)?;
+    let tasks = 5 * boards as u64;
+    if before > 0 {
+        eprintln!(
+            "resuming a robot evaluation: {before} of {tasks} tasks finished before{}",
+            if twin_seed.is_some() {
+                " (the twin replays them)"
+            } else {
+                ""
+            }
+        );
+    }
+    let bar = crate::progress_bar(tasks, quiet, "{wide_bar} {pos}/{len}");
+    let record = evaluation
+        .run(run, &checkpoint, env, || bar.inc(1))
         .map_err(crate::study_error)?;
     bar.finish_and_clear();
     let results = record.results;

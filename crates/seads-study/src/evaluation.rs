@@ -4,7 +4,7 @@
 //! [`OVER_TRAINING`]; and running an evaluation of a trained agent or a baseline's policy.
 
 use std::collections::BTreeMap;
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
 use seads_games::BoardGame;
 use seads_planner::{
@@ -14,6 +14,7 @@ use seads_planner::{
 use seads_rl::{Agent, TrainConfig};
 use serde::{Deserialize, Serialize};
 
+use crate::journal::Journal;
 use crate::{Context as _, Result, StudyError};
 
 /// Which checkpoint `agent` is, and `None` where it is the run's latest (whose evaluation takes
@@ -213,10 +214,10 @@ fn evaluate_agent_resuming(
 /// depths of the latest checkpoint), calling `each` with every task solved now.
 ///
 /// It resumes: each task's line is appended, as the task ends, to the tasks file's `.partial`
-/// beside it, headed by the protocol and the checkpoint. An evaluation of the same protocol and
-/// checkpoint that finds it counts the tasks written there as they ended and solves only the
-/// others (a task depends on nothing but its seed, so the results are those of one whole run);
-/// the `.partial` file is removed once the record is saved.
+/// beside it, headed by the protocol and the checkpoint (`journal.rs`). An evaluation of the
+/// same protocol and checkpoint that finds it counts the tasks written there as they ended and
+/// solves only the others (a task depends on nothing but its seed, so the results are those of
+/// one whole run); the `.partial` file is removed once the record is saved.
 pub fn run_evaluation(
     agent: &mut Agent,
     run: &Path,
@@ -225,48 +226,29 @@ pub fn run_evaluation(
 ) -> Result<EvaluationRecord> {
     let game = crate::run_game(&agent.config)?;
     let (checkpoint, named) = checkpoint_of(run, &agent.checkpoint)?;
-    let (partial, header) = journal(run, protocol, &checkpoint, named);
-    let earlier = finished_tasks(&partial, &header)?;
-    if earlier.is_empty() {
-        let mut text = header.to_string();
-        text.push('\n');
-        seads_rl::store::write_atomic(&partial, text.as_bytes())?;
-    }
+    let mut journal = Journal::open(run, protocol, &checkpoint, named, &[])?;
     let mut now = BTreeMap::new();
-    let mut append_error = None;
+    let finished = journal.summaries();
     let results = evaluate_agent_resuming(
         agent,
         protocol,
-        |depth, seed| {
-            earlier
-                .get(&(depth, seed))
-                .map(|(summary, _)| summary.clone())
-        },
+        |depth, seed| finished.get(&(depth, seed)).cloned(),
         |task| {
             let line = task_line(game.as_ref(), task);
             // The search time is kept for the resumed record only: the tasks file holds what
             // repeats on any machine.
-            let mut resumable = line.clone();
-            resumable["planning_s"] = task.outcome.planning_s.into();
-            if append_error.is_none()
-                && let Err(e) = seads_rl::store::append_json_line(&partial, &resumable)
-            {
-                append_error = Some(e);
-            }
+            journal.append(&line, task.outcome.planning_s);
             now.insert((task.depth, task.seed), line);
             each(task);
         },
     )?;
-    if let Some(e) = append_error {
-        return Err(e.into());
-    }
     let mut lines = String::new();
     let seeds = protocol.tasks.seeds();
     for &depth in &protocol.tasks.depths {
         for &seed in &seeds {
             let line = now
                 .get(&(depth, seed))
-                .or_else(|| earlier.get(&(depth, seed)).map(|(_, line)| line))
+                .or_else(|| journal.earlier(depth, seed).map(|(_, line)| line))
                 .ok_or_else(|| StudyError::failed(format!("task {depth}/{seed} has no line")))?;
             lines += &line.to_string();
             lines.push('\n');
@@ -277,69 +259,15 @@ pub fn run_evaluation(
         protocol: Some(protocol.clone()),
         results,
     };
-    save_evaluation(run, &record, named, Some(&lines))?;
-    match std::fs::remove_file(&partial) {
-        Err(e) if e.kind() != std::io::ErrorKind::NotFound => {
-            Err(e).doing(|| format!("removing {}", partial.display()))
-        }
-        _ => Ok(record),
-    }
+    journal.finish(|| save_evaluation(run, &record, named, Some(&lines)))?;
+    Ok(record)
 }
 
 /// How many tasks of `protocol` a stopped evaluation of the agent's checkpoint in `run` has
 /// finished: [`run_evaluation`] counts them instead of solving them again.
 pub fn finished_before(agent: &Agent, run: &Path, protocol: &Protocol) -> Result<usize> {
     let (checkpoint, named) = checkpoint_of(run, &agent.checkpoint)?;
-    let (partial, header) = journal(run, protocol, &checkpoint, named);
-    Ok(finished_tasks(&partial, &header)?.len())
-}
-
-/// The `.partial` file of an evaluation in progress and the header its tasks are written under.
-fn journal(
-    run: &Path,
-    protocol: &Protocol,
-    checkpoint: &CheckpointId,
-    named: Option<u64>,
-) -> (PathBuf, serde_json::Value) {
-    let partial = run.join(format!("{}.partial", protocol.tasks_file(named)));
-    let header =
-        serde_json::json!({ "evaluation": { "protocol": protocol, "checkpoint": checkpoint } });
-    (partial, header)
-}
-
-/// The tasks an earlier, stopped evaluation wrote into `partial` under `header`, by depth and
-/// seed, with their lines. None where there is no such file, or it was written under another
-/// header (another protocol or checkpoint) or cannot be read back whole: the evaluation then
-/// starts afresh and rewrites it.
-fn finished_tasks(
-    partial: &Path,
-    header: &serde_json::Value,
-) -> Result<BTreeMap<(usize, u64), (TaskSummary, serde_json::Value)>> {
-    if !partial.exists() {
-        return Ok(BTreeMap::new());
-    }
-    let Ok((lines, _torn)) = seads_rl::store::read_json_lines::<serde_json::Value>(partial) else {
-        return Ok(BTreeMap::new());
-    };
-    if lines.first() != Some(header) {
-        return Ok(BTreeMap::new());
-    }
-    let mut tasks = BTreeMap::new();
-    for line in lines.into_iter().skip(1) {
-        let key = (line["depth"].as_u64(), line["seed"].as_u64());
-        let (Some(depth), Some(seed)) = key else {
-            return Ok(BTreeMap::new());
-        };
-        let Ok(summary) = serde_json::from_value::<TaskSummary>(line.clone()) else {
-            return Ok(BTreeMap::new());
-        };
-        let mut line = line;
-        if let Some(fields) = line.as_object_mut() {
-            fields.remove("planning_s");
-        }
-        tasks.insert((depth as usize, seed), (summary, line));
-    }
-    Ok(tasks)
+    Journal::finished_before(run, protocol, &checkpoint, named, &[])
 }
 
 /// Evaluates a baseline's policy saved in `checkpoint` alone on `tasks` and saves the record
@@ -387,7 +315,7 @@ pub fn run_policy_evaluation(
 
 /// One line of `evaluation-*-tasks.jsonl`: a task, how it ended, and every skill that left
 /// another board than the forward model predicted (boards as `seads solve --board` takes them).
-fn task_line(game: &dyn BoardGame, task: &TaskRecord<'_>) -> serde_json::Value {
+pub(crate) fn task_line(game: &dyn BoardGame, task: &TaskRecord<'_>) -> serde_json::Value {
     let o = task.outcome;
     let deviations: Vec<serde_json::Value> = o
         .deviations

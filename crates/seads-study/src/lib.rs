@@ -44,6 +44,7 @@ pub mod draw;
 mod error;
 pub mod evaluation;
 pub mod figures;
+mod journal;
 pub mod over_training;
 pub mod provenance;
 pub mod recording;

@@ -1,28 +1,34 @@
 #!/usr/bin/env bash
 # The robot's absolute pushes on the twin (issue 44 item 3): one setting changed at a time from
 # the paper's robot protocol (4 one-press episodes per epoch, 16 SAC updates, alpha 0.1, board and
-# pen seen, a perfect twin), 2 seeds each, 5000 interactions, on the frozen binary of one clean
-# commit. Resumable: a run with its evaluation is skipped, a started one resumed. Each final
-# evaluation (20 boards per depth 1-5, re-planning) bounds its searches by 2^20 expanded states:
-# an agent that lacks a move fails many searches, and each failed one costs the whole bound.
+# pen seen, a perfect twin), 2 seeds each, 5000 interactions. Training on the frozen binary of one
+# clean commit (13631e6); its own evaluation at the end of training is bounded to one state and
+# replaced. Each run is then evaluated by the frozen binary $EVAL (`seads uarm evaluate`: a fresh
+# twin of the run's seed, as `uarm train` has done since 2026-11-29; evaluations resume, the
+# twin replaying finished tasks): 20 boards per depth 1-5, re-planning, searches bounded by 2^20
+# expanded states (an agent that lacks a move fails many searches, each costing the whole
+# bound). A run with `evaluation-replan-tasks.jsonl` (written only by such an evaluation) is done.
+# Resumable: rerun the script.
 set -u
 B=${SEADS:-/root/seads-frozen/13631e6/bin/seads}
+E=${EVAL:?the frozen binary that evaluates, e.g. /root/seads-frozen/<commit>/bin/seads}
 here=$(cd "$(dirname "$0")" && pwd)
 # "paper" names its observation: a new run's default is the pen only since 3ab6aec (13631e6's
-# default was the board and the pen, so the runs here are the same with either line).
+# default was the board and the pen, so the runs here are the same with either line). The settings
+# not yet trained come first; the runs trained before are evaluated again after them.
 settings=(
-  "paper|--observe board-and-pen"
-  "observe-board|--observe board"
-  "observe-pen|--observe pen"
-  "observe-nothing|--observe nothing"
-  "alpha-0.01|--alpha 0.01"
-  "tap-sd-5mm|--tap-sd-mm 5"
   "late-reports-0.1|--late-reports 0.1"
   "updates-4|--updates-per-epoch 4"
   "episodes-16|--episodes-per-epoch 16"
   "alpha-0.3|--alpha 0.3"
   "updates-64|--updates-per-epoch 64"
   "episodes-1|--episodes-per-epoch 1"
+  "paper|--observe board-and-pen"
+  "observe-board|--observe board"
+  "observe-pen|--observe pen"
+  "observe-nothing|--observe nothing"
+  "alpha-0.01|--alpha 0.01"
+  "tap-sd-5mm|--tap-sd-mm 5"
 )
 jobs=()
 for setting in "${settings[@]}"; do
@@ -35,12 +41,16 @@ printf '%s\n' "${jobs[@]}" | xargs -P "${JOBS:-2}" -I{} bash -c '
   IFS="|" read -r name opts seed <<< "{}"
   run='"$here"'/runs/$name-$seed
   log='"$here"'/logs/$name-$seed.log
-  [[ -f $run/evaluation-replan.json ]] && exit 0
-  if [[ -f $run/config.toml ]]; then
-    '"$B"' uarm train --port sim:$seed --resume --out $run --cores 1 --quiet --max-expanded 1048576 >> $log 2>&1
-  else
-    rm -rf $run
-    '"$B"' uarm train --port sim:$seed --seed $seed $opts --out $run --cores 1 --quiet --max-expanded 1048576 >> $log 2>&1
+  [[ -f $run/evaluation-replan-tasks.jsonl ]] && exit 0
+  if [[ ! -f $run/evaluation-replan.json ]]; then
+    if [[ -f $run/config.toml ]]; then
+      '"$B"' uarm train --port sim:$seed --resume --out $run --cores 1 --quiet --max-expanded 1 >> $log 2>&1
+    else
+      rm -rf $run
+      '"$B"' uarm train --port sim:$seed --seed $seed $opts --out $run --cores 1 --quiet --max-expanded 1 >> $log 2>&1
+    fi
+    echo "$(date +%H:%M) $name-$seed trained, exit $?" >> '"$here"'/done.log
   fi
-  echo "$(date +%H:%M) $name-$seed exit $?" >> '"$here"'/done.log
+  '"$E"' uarm evaluate --port sim:$seed --run $run --quiet --max-expanded 1048576 >> $log 2>&1
+  echo "$(date +%H:%M) $name-$seed evaluated, exit $?" >> '"$here"'/done.log
 '

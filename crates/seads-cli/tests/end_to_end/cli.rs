@@ -1362,6 +1362,110 @@ fn a_robot_run_records_its_ablation_settings() {
     );
 }
 
+/// A robot evaluation on the noisy twin from the command line: `uarm evaluate` plays the tasks
+/// that the evaluation at the end of `uarm train` played (both on a fresh twin of the port's
+/// seed), a stopped one resumes from its journal (saying so) to the same tasks and results, and a
+/// journal the twin does not repeat is one line of bad input. (This tiny agent finds no plan, so
+/// no skill runs: that a replay puts the twin where the whole evaluation left it is
+/// `a_stopped_twin_evaluation_resumes_to_the_whole_one` in `seads-study`.)
+#[test]
+fn a_robot_evaluation_is_the_same_whole_resumed_or_after_training() {
+    let dir = tempfile::tempdir().unwrap();
+    let run = dir.path().join("run");
+    let limits = ["--port", "sim:3", "--boards", "2", "--max-expanded", "2000"];
+    let mut args = vec!["uarm", "train", "--env-steps", "16", "--tap-sd-mm", "8"];
+    args.extend(limits);
+    args.extend(["--out", s(&run), "--quiet"]);
+    seads_ok(&args);
+    const TASKS: &str = "evaluation-replan-tasks.jsonl";
+    let tasks = |run: &std::path::Path| std::fs::read_to_string(run.join(TASKS)).unwrap();
+    // The results without the search times, which differ between machines.
+    let results = |run: &std::path::Path| {
+        let text = std::fs::read_to_string(run.join("evaluation-replan.json")).unwrap();
+        let mut v: serde_json::Value = serde_json::from_str(&text).unwrap();
+        for r in v["results"].as_array_mut().unwrap() {
+            r.as_object_mut().unwrap().remove("planning_s");
+        }
+        v
+    };
+    let whole = tasks(&run);
+    let lines: Vec<serde_json::Value> = whole
+        .lines()
+        .map(|l| serde_json::from_str(l).unwrap())
+        .collect();
+    assert_eq!(lines.len(), 10, "{whole}");
+    assert!(
+        lines
+            .iter()
+            .all(|l| l["reached"].is_string() && l["solution_depth"].is_u64())
+    );
+    let evaluate = |run: &std::path::Path| {
+        let mut args = vec!["uarm", "evaluate", "--run", s(run)];
+        args.extend(limits);
+        seads(&args)
+    };
+    let copy = |name: &str| {
+        let to = dir.path().join(name);
+        copy_dir(&run, &to);
+        std::fs::remove_file(to.join(TASKS)).unwrap();
+        std::fs::remove_file(to.join("evaluation-replan.json")).unwrap();
+        to
+    };
+    let again = copy("again");
+    assert!(evaluate(&again).status.success());
+    assert_eq!(
+        tasks(&again),
+        whole,
+        "uarm evaluate plays what uarm train's evaluation played"
+    );
+    assert_eq!(results(&again), results(&run));
+    // Stopped after five tasks: the journal holds them under the evaluation's header.
+    let record = results(&run);
+    let header = serde_json::json!({"evaluation": {
+        "protocol": record["protocol"], "checkpoint": record["checkpoint"], "twin": 3}});
+    let journal = |lines: &[serde_json::Value]| {
+        let mut text = format!("{header}\n");
+        for l in lines {
+            let mut l = l.clone();
+            l["planning_s"] = 0.0.into();
+            text += &format!("{l}\n");
+        }
+        text
+    };
+    let resumed = copy("resumed");
+    std::fs::write(
+        resumed.join(format!("{TASKS}.partial")),
+        journal(&lines[..5]),
+    )
+    .unwrap();
+    let out = evaluate(&resumed);
+    assert!(out.status.success());
+    let note = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        note.contains("resuming a robot evaluation: 5 of 10 tasks finished before"),
+        "{note}"
+    );
+    assert_eq!(tasks(&resumed), whole);
+    assert_eq!(results(&resumed), record);
+    assert!(!resumed.join(format!("{TASKS}.partial")).exists());
+    // A journal whose boards the twin does not reach: nothing is evaluated over it.
+    let mut wrong = lines[..5].to_vec();
+    let reached = wrong[4]["reached"].as_str().unwrap().to_owned();
+    let flipped = if reached.starts_with('0') { "1" } else { "0" };
+    wrong[4]["reached"] = format!("{flipped}{}", &reached[1..]).into();
+    let wrong_run = copy("wrong");
+    std::fs::write(wrong_run.join(format!("{TASKS}.partial")), journal(&wrong)).unwrap();
+    let out = evaluate(&wrong_run);
+    assert_eq!(out.status.code(), Some(2));
+    let err = String::from_utf8_lossy(&out.stderr);
+    let errors: Vec<&str> = err.lines().filter(|l| l.starts_with("error")).collect();
+    assert!(
+        errors.len() == 1 && errors[0].contains("does not repeat"),
+        "{err}"
+    );
+    assert!(!wrong_run.join(TASKS).exists());
+}
+
 /// The run's `portable_numerics` decides libtorch's kernels, not the environment the binary
 /// inherits: a portable run gives the same numbers whatever MKL_CBWR says, and a fast run is
 /// another run.
