@@ -21,17 +21,25 @@ pub enum PlanChoice {
     MostLikely,
     /// The first plan found, in fringe-then-skill order (the reference's search).
     FirstFound,
+    /// [`MostLikely`](Self::MostLikely), and wary of a skill that keeps failing: once a skill has
+    /// left another board than predicted twice in a task, re-planning does not choose it again
+    /// from any board while a plan without it is left (then as `MostLikely`). A learned skill
+    /// that misses its move from one board mostly misses it from the next, whose board is new.
+    MostLikelyWary,
 }
 
 impl std::str::FromStr for PlanChoice {
     type Err = String;
 
-    /// `most-likely` or `first-found`, the names records use.
+    /// `most-likely`, `first-found` or `most-likely-wary`, the names records use.
     fn from_str(text: &str) -> Result<Self, String> {
         match text {
             "most-likely" => Ok(Self::MostLikely),
             "first-found" => Ok(Self::FirstFound),
-            other => Err(format!("{other:?} is not one of most-likely, first-found")),
+            "most-likely-wary" => Ok(Self::MostLikelyWary),
+            other => Err(format!(
+                "{other:?} is not one of most-likely, first-found, most-likely-wary"
+            )),
         }
     }
 }

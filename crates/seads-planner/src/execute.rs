@@ -161,7 +161,8 @@ pub fn solve(
 
 /// Plans from `start`. With [`PlanChoice::MostLikely`], the skills that deviated in this task
 /// (`outcome.deviations`) are not taken again from the board they deviated from, unless no plan
-/// is left without them.
+/// is left without them; with [`PlanChoice::MostLikelyWary`], before that, the skills that
+/// deviated twice are not taken from any board, unless no plan is left without them.
 fn search(
     start: SymbolicState,
     successor: &mut dyn Successor,
@@ -171,37 +172,61 @@ fn search(
 ) -> Result<crate::Plan, PlanError> {
     let began = Instant::now();
     outcome.plans += 1;
-    let failed: Vec<(SymbolicState, usize)> = match config.planner.plan {
-        PlanChoice::MostLikely => outcome
+    let plan = config.planner.plan;
+    let pairs: Vec<(SymbolicState, usize)> = match plan {
+        PlanChoice::MostLikely | PlanChoice::MostLikelyWary => outcome
             .deviations
             .iter()
             .map(|d| (d.before, d.skill))
             .collect(),
         PlanChoice::FirstFound => Vec::new(),
     };
-    let mut plan = if failed.is_empty() {
-        find_plan(successor, start, goal, &config.planner)
-    } else {
-        let mut avoiding = Avoiding {
-            inner: successor,
-            failed: &failed,
-        };
-        find_plan(&mut avoiding, start, goal, &config.planner)
-    };
-    if plan.is_err() && !failed.is_empty() {
-        outcome.timed_out |= matches!(plan, Err(PlanError::Timeout { .. }));
-        plan = find_plan(successor, start, goal, &config.planner);
+    let mut skills: Vec<usize> = Vec::new();
+    if plan == PlanChoice::MostLikelyWary {
+        let mut failures = std::collections::BTreeMap::new();
+        for d in &outcome.deviations {
+            *failures.entry(d.skill).or_insert(0) += 1;
+        }
+        skills.extend(
+            failures
+                .into_iter()
+                .filter(|&(_, n)| n >= 2)
+                .map(|(k, _)| k),
+        );
     }
+    // Each try lifts one restriction: the skills failed twice, then each failed skill from its
+    // board, then (below) nothing.
+    let everywhere = (!skills.is_empty()).then_some((&skills[..], &pairs[..]));
+    let from_boards = (!pairs.is_empty()).then_some((&[][..], &pairs[..]));
+    let mut result = None;
+    for (skills, failed) in everywhere.into_iter().chain(from_boards) {
+        let mut avoiding = Avoiding {
+            inner: &mut *successor,
+            skills,
+            failed,
+        };
+        let plan = find_plan(&mut avoiding, start, goal, &config.planner);
+        outcome.timed_out |= matches!(plan, Err(PlanError::Timeout { .. }));
+        if plan.is_ok() {
+            result = Some(plan);
+            break;
+        }
+    }
+    let result = result.unwrap_or_else(|| {
+        let plan = find_plan(successor, start, goal, &config.planner);
+        outcome.timed_out |= matches!(plan, Err(PlanError::Timeout { .. }));
+        plan
+    });
     outcome.planning_s += began.elapsed().as_secs_f64();
-    outcome.timed_out |= matches!(plan, Err(PlanError::Timeout { .. }));
-    plan
+    result
 }
 
-/// A successor function in which the skills that failed from a board lead nowhere from it (back
-/// to the board itself, which the search has seen), so that a search takes them only from other
-/// boards.
+/// A successor function in which the skills that failed (`skills` from every board, `failed`
+/// from one board each) lead nowhere (back to the board itself, which the search has seen), so
+/// that a search takes them only where they are not avoided.
 struct Avoiding<'a> {
     inner: &'a mut dyn Successor,
+    skills: &'a [usize],
     failed: &'a [(SymbolicState, usize)],
 }
 
@@ -218,9 +243,15 @@ impl Successor for Avoiding<'_> {
         let (base, k) = (out.len(), self.inner.num_skills());
         self.inner.successors(states, out);
         for (i, &z) in states.iter().enumerate() {
+            let row = base + i * k;
+            for &skill in self.skills {
+                if skill < k {
+                    out[row + skill] = z;
+                }
+            }
             for &(board, skill) in self.failed {
                 if board == z && skill < k {
-                    out[base + i * k + skill] = z;
+                    out[row + skill] = z;
                 }
             }
         }

@@ -383,7 +383,7 @@ fn choose(
     let first = plans.first()?.clone();
     match choice {
         PlanChoice::FirstFound => Some(first),
-        PlanChoice::MostLikely => {
+        PlanChoice::MostLikely | PlanChoice::MostLikelyWary => {
             plans.truncate(MAX_CANDIDATES);
             Some(most_likely(successor, start, plans, &[]).unwrap_or(first))
         }

@@ -751,3 +751,75 @@ fn the_default_limits_give_the_same_evaluation_on_a_slow_machine() {
     assert_eq!(idle, slow, "task for task");
     assert_eq!(idle_solved, slow_solved);
 }
+
+/// Skill 7 of a scripted Cursor policy presses another field than 7, which one depending on the
+/// board (its lit fields counted): a skill that misses its move from board after board, as a
+/// learned skill whose outcome depends on where the cursor starts does. The model (the true
+/// rules) is sure that skill 7 makes move 7.
+struct Wandering(CursorPolicy);
+
+impl SkillPolicy for Wandering {
+    fn num_skills(&self) -> usize {
+        25
+    }
+
+    fn act(&self, observations: &[f32], skills: &[usize], actions: &mut [f32]) {
+        const WRONG: [usize; 10] = [8, 12, 2, 6, 16, 18, 22, 11, 13, 17];
+        let width = observations.len() / skills.len();
+        for ((obs, &k), act) in observations
+            .chunks(width)
+            .zip(skills)
+            .zip(actions.chunks_mut(3))
+        {
+            let lit = obs[2..].iter().filter(|&&v| v > 0.5).count();
+            let k = if k == 7 { WRONG[lit % WRONG.len()] } else { k };
+            self.0.act(obs, &[k], act);
+        }
+    }
+}
+
+/// With a skill that fails from board after board, the most likely plan takes it again from
+/// each new board until the task runs out of plans; the wary choice stops taking it after its
+/// second failure and solves the board without move 7 (a 5×5 LightsOut board has four
+/// solutions, and field 7 lies on a quiet pattern, so some of them leave it out).
+#[test]
+fn the_wary_choice_stops_taking_a_skill_that_keeps_failing() {
+    let policy = Wandering(CursorPolicy::lightsout(None));
+    let lo = &*LIGHTSOUT;
+    let (mut likely_failed, mut wary_solved) = (0, 0);
+    // Boards whose plans without move 7 are short enough for a quick test (9 and 8 moves).
+    let boards: Vec<SymbolicState> = [[7, 0, 24], [7, 3, 20]]
+        .iter()
+        .map(|moves| lo.apply_all(lo.goal(), moves))
+        .collect();
+    for (i, &board) in boards.iter().enumerate() {
+        let mut outcomes = Vec::new();
+        for plan in [PlanChoice::MostLikely, PlanChoice::MostLikelyWary] {
+            let mut env = test_env(3, i as u64);
+            env.set_board(board).unwrap();
+            let config = SolveConfig {
+                replan: true,
+                planner: PlannerConfig {
+                    plan,
+                    ..PlannerConfig::default()
+                },
+                ..SolveConfig::default()
+            };
+            let mut model = GameSuccessor::new(lo);
+            outcomes.push(solve(env.as_mut(), &policy, &mut model, lo.goal(), &config).unwrap());
+        }
+        let (likely, wary) = (&outcomes[0], &outcomes[1]);
+        assert!(likely.first_plan.contains(&7), "{:?}", likely.first_plan);
+        assert_eq!(wary.first_plan, likely.first_plan, "one search: one plan");
+        let sevens =
+            |o: &seads_planner::SolveOutcome| o.executed.iter().filter(|&&k| k == 7).count();
+        assert!(sevens(wary) <= 2, "{:?}", wary.executed);
+        if !likely.solved {
+            likely_failed += 1;
+            assert!(sevens(likely) > 2, "{:?}", likely.executed);
+        }
+        wary_solved += usize::from(wary.solved);
+    }
+    assert_eq!(wary_solved, boards.len());
+    assert_eq!(likely_failed, boards.len());
+}

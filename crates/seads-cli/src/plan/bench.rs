@@ -34,8 +34,8 @@ pub struct PlanBenchArgs {
     /// arithmetic; for comparison).
     #[arg(long)]
     float32: bool,
-    /// Which plan each search returns: most-likely (default) or first-found (the paper's), to
-    /// compare the two choices' cost with one binary.
+    /// Which plan each search returns: most-likely (default), most-likely-wary (the same for a
+    /// single search) or first-found (the paper's), to compare the choices' cost with one binary.
     #[arg(long, value_name = "CHOICE", default_value = "most-likely")]
     plan: seads_planner::PlanChoice,
     /// How each search goes: breadth (default, the paper's) or both-ends, to compare the two

@@ -40,7 +40,9 @@ pub struct SearchArgs {
     timeout: Option<f64>,
     /// Which of the shortest plans to take: `most-likely` (the plan the forward model gives the
     /// highest probability, each step by the skill likeliest to make it; re-planning avoids a
-    /// skill that just failed from the same board) or `first-found` (the paper's search).
+    /// skill that just failed from the same board), `most-likely-wary` (also avoids, from every
+    /// board, a skill that failed twice in the task, while a plan without it is left) or
+    /// `first-found` (the paper's search).
     #[arg(long, value_name = "CHOICE", default_value = "most-likely")]
     plan: PlanChoice,
     /// How each search goes: `breadth` (breadth-first from the board, the paper's) or
