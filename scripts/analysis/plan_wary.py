@@ -4,7 +4,8 @@
 Usage: python3 scripts/analysis/plan_wary.py docs/results/plan-wary
 
 Reads each agent's wary evaluations (`seed-N/evaluation-replan-depths-D-D*`) and the same agent's
-most-likely evaluations in `docs/results/deep-search/agents-a58a2c4/seed-N/`, and writes
+most-likely evaluations in
+`docs/results/deep-search/agents-a58a2c4/sweep/runs/lightsout-cursor/seads/seed-N/`, and writes
 `summary.md` beside them: boards solved per agent and depth by each choice, the tasks only one of
 them solved, and the mean search time per task. A task whose most-likely run saw no skill deviate
 twice must be the same under both choices (the wary choice differs only after a second failure of
@@ -17,7 +18,7 @@ import sys
 from collections import Counter
 
 root = pathlib.Path(sys.argv[1])
-base = root.parent / "deep-search" / "agents-a58a2c4"
+base = root.parent / "deep-search" / "agents-a58a2c4" / "sweep" / "runs" / "lightsout-cursor" / "seads"
 
 
 def tasks(path):
@@ -56,7 +57,7 @@ for wary_dir in sorted(root.glob("seed-*")):
         totals["tasks"] += len(wary)
 
 out = ["Written by `scripts/analysis/plan_wary.py` from `seed-N/` (the wary choice, `run.sh`) and "
-       "`../deep-search/agents-a58a2c4/seed-N/` (the most likely plan), the same agents, boards "
+       "`../deep-search/agents-a58a2c4/sweep/runs/lightsout-cursor/seads/seed-N/` (the most likely plan), the same agents, boards "
        "and protocol (re-planning, from both ends, 16 GiB, 2^22 expanded states).",
        "",
        "| agent | depth | most likely: solved | wary: solved | only wary solved | only most likely solved "
