@@ -7,7 +7,8 @@ Reads each agent's wary evaluations (`seed-N/evaluation-replan-depths-D-D*`) and
 most-likely evaluations in
 `docs/results/deep-search/agents-a58a2c4/sweep/runs/lightsout-cursor/seads/seed-N/`, and writes
 `summary.md` beside them: boards solved per agent and depth by each choice, the tasks only one of
-them solved, and the mean search time per task. A task whose most-likely run saw no skill deviate
+them solved, and the mean search time per task; and, where `shallow/` holds both choices
+evaluations of depths 1-5 (`run.sh`), the same for those. A task whose most-likely run saw no skill deviate
 twice must be the same under both choices (the wary choice differs only after a second failure of
 one skill); the script checks that and fails otherwise.
 """
@@ -67,5 +68,35 @@ for a, d, sl, sw, n, ow, ol, tl, tw in sorted(rows, key=lambda r: (r[0], r[1])):
     out.append(f"| {a} | {d} | {sl} / {n} | {sw} / {n} | {ow} | {ol} | {tl:.1f} s / {tw:.1f} s |")
 out += ["", f"In all: most likely {totals['likely']} of {totals['tasks']} tasks, "
             f"wary {totals['wary']} of {totals['tasks']}."]
+# Depths 1-5: both choices evaluated here (`shallow/<choice>/seed-N/`), the standard test boards.
+shallow = root / "shallow"
+if shallow.exists():
+    out += ["", "Depths 1-5 (`shallow/`, the standard 20 test boards per depth, both choices by the same "
+            "binary and protocol):", "",
+            "| agent | most likely: solved per depth | wary: solved per depth | only wary solved "
+            "| only most likely solved | search per task, most likely / wary |",
+            "|---|---|---|---|---|---|"]
+    t = Counter()
+    for likely_dir in sorted((shallow / "most-likely").glob("seed-*")):
+        wary_dir = shallow / "most-likely-wary" / likely_dir.name
+        fl, fw = likely_dir / "evaluation-replan-tasks.jsonl", wary_dir / "evaluation-replan-tasks.jsonl"
+        if not (fl.exists() and fw.exists()):
+            continue
+        likely, wary = tasks(fl), tasks(fw)
+        for key, task in likely.items():
+            if not any(n >= 2 for n in Counter(d["skill"] for d in task["deviations"]).values()):
+                assert task == wary[key], f"{fw}: task {key} differs without a repeated failure"
+        rl = json.loads((likely_dir / "evaluation-replan.json").read_text())["results"]
+        rw = json.loads((wary_dir / "evaluation-replan.json").read_text())["results"]
+        ow = sum(wary[k]["solved"] and not likely[k]["solved"] for k in wary)
+        ol = sum(likely[k]["solved"] and not wary[k]["solved"] for k in wary)
+        mean = lambda rs: statistics.mean(x for r in rs for x in r["planning_s"])
+        out.append(f"| {likely_dir.name} | {' / '.join(str(r['solved']) for r in rl)} "
+                   f"| {' / '.join(str(r['solved']) for r in rw)} | {ow} | {ol} "
+                   f"| {mean(rl):.2f} s / {mean(rw):.2f} s |")
+        t["likely"] += sum(r["solved"] for r in rl)
+        t["wary"] += sum(r["solved"] for r in rw)
+        t["tasks"] += len(wary)
+    out += ["", f"In all: most likely {t['likely']} of {t['tasks']} tasks, wary {t['wary']} of {t['tasks']}."]
 (root / "summary.md").write_text("\n".join(out) + "\n")
 print("\n".join(out))
