@@ -635,14 +635,7 @@ fn replanning_avoids_a_skill_that_failed_from_the_same_board() {
                 game: LightsOut::new(5).unwrap(),
                 seven_unsure: false,
             };
-            let config = SolveConfig {
-                replan: true,
-                planner: PlannerConfig {
-                    plan,
-                    ..PlannerConfig::default()
-                },
-                ..SolveConfig::default()
-            };
+            let config = replanning(plan);
             let out = solve(env_copy.as_mut(), &policy, &mut model, lo.goal(), &config).unwrap();
             outcomes.push(out);
         }
@@ -661,6 +654,18 @@ fn replanning_avoids_a_skill_that_failed_from_the_same_board() {
         solved += usize::from(likely.solved);
     }
     assert_eq!(solved, 6);
+}
+
+/// Solving with re-planning and the planner's defaults but for `plan`.
+fn replanning(plan: PlanChoice) -> SolveConfig {
+    SolveConfig {
+        replan: true,
+        planner: PlannerConfig {
+            plan,
+            ..PlannerConfig::default()
+        },
+        ..SolveConfig::default()
+    }
 }
 
 /// A successor function that takes `delay` longer per call: a machine that is slower or busy.
@@ -797,14 +802,7 @@ fn the_wary_choice_stops_taking_a_skill_that_keeps_failing() {
         for plan in [PlanChoice::MostLikely, PlanChoice::MostLikelyWary] {
             let mut env = test_env(3, i as u64);
             env.set_board(board).unwrap();
-            let config = SolveConfig {
-                replan: true,
-                planner: PlannerConfig {
-                    plan,
-                    ..PlannerConfig::default()
-                },
-                ..SolveConfig::default()
-            };
+            let config = replanning(plan);
             let mut model = GameSuccessor::new(lo);
             outcomes.push(solve(env.as_mut(), &policy, &mut model, lo.goal(), &config).unwrap());
         }

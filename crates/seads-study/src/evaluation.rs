@@ -14,7 +14,7 @@ use seads_planner::{
 use seads_rl::{Agent, TrainConfig};
 use serde::{Deserialize, Serialize};
 
-use crate::journal::Journal;
+use crate::journal::Place;
 use crate::{Context as _, Result, StudyError};
 
 /// Which checkpoint `agent` is, and `None` where it is the run's latest (whose evaluation takes
@@ -226,7 +226,7 @@ pub fn run_evaluation(
 ) -> Result<EvaluationRecord> {
     let game = crate::run_game(&agent.config)?;
     let (checkpoint, named) = checkpoint_of(run, &agent.checkpoint)?;
-    let mut journal = Journal::open(run, protocol, &checkpoint, named, &[])?;
+    let mut journal = Place::new(run, protocol, &checkpoint, named, &[]).open()?;
     let mut now = BTreeMap::new();
     let finished = journal.summaries();
     let results = evaluate_agent_resuming(
@@ -267,7 +267,7 @@ pub fn run_evaluation(
 /// finished: [`run_evaluation`] counts them instead of solving them again.
 pub fn finished_before(agent: &Agent, run: &Path, protocol: &Protocol) -> Result<usize> {
     let (checkpoint, named) = checkpoint_of(run, &agent.checkpoint)?;
-    Journal::finished_before(run, protocol, &checkpoint, named, &[])
+    Place::new(run, protocol, &checkpoint, named, &[]).finished_before()
 }
 
 /// Evaluates a baseline's policy saved in `checkpoint` alone on `tasks` and saves the record

@@ -24,59 +24,55 @@ pub(crate) struct Journal {
     append_error: Option<StudyError>,
 }
 
-impl Journal {
-    /// The `.partial` file of the evaluation of `checkpoint` with `protocol` in `run` and the
-    /// header its tasks are written under (`extra` keys added to the header's `evaluation`).
-    fn place(
+/// Where the journal of one evaluation lies, and the header its tasks are written under.
+pub(crate) struct Place {
+    partial: PathBuf,
+    header: serde_json::Value,
+}
+
+impl Place {
+    /// The `.partial` file of the evaluation of `checkpoint` (`named` by its epoch unless it is
+    /// the run's latest) with `protocol` in `run`, its header holding `extra` keys beside the
+    /// protocol and the checkpoint.
+    pub(crate) fn new(
         run: &Path,
         protocol: &Protocol,
         checkpoint: &CheckpointId,
         named: Option<u64>,
         extra: &[(&str, serde_json::Value)],
-    ) -> (PathBuf, serde_json::Value) {
+    ) -> Self {
         let partial = run.join(format!("{}.partial", protocol.tasks_file(named)));
         let mut evaluation = serde_json::json!({ "protocol": protocol, "checkpoint": checkpoint });
         for (key, value) in extra {
             evaluation[*key] = value.clone();
         }
-        (partial, serde_json::json!({ "evaluation": evaluation }))
+        let header = serde_json::json!({ "evaluation": evaluation });
+        Self { partial, header }
     }
 
     /// How many tasks a stopped evaluation wrote under this header.
-    pub(crate) fn finished_before(
-        run: &Path,
-        protocol: &Protocol,
-        checkpoint: &CheckpointId,
-        named: Option<u64>,
-        extra: &[(&str, serde_json::Value)],
-    ) -> Result<usize> {
-        let (partial, header) = Self::place(run, protocol, checkpoint, named, extra);
-        Ok(finished_tasks(&partial, &header)?.len())
+    pub(crate) fn finished_before(&self) -> Result<usize> {
+        Ok(finished_tasks(&self.partial, &self.header)?.len())
     }
 
     /// Opens the journal: reads the tasks a stopped evaluation under the same header wrote, or
     /// starts a new journal with the header.
-    pub(crate) fn open(
-        run: &Path,
-        protocol: &Protocol,
-        checkpoint: &CheckpointId,
-        named: Option<u64>,
-        extra: &[(&str, serde_json::Value)],
-    ) -> Result<Self> {
-        let (partial, header) = Self::place(run, protocol, checkpoint, named, extra);
-        let earlier = finished_tasks(&partial, &header)?;
+    pub(crate) fn open(self) -> Result<Journal> {
+        let earlier = finished_tasks(&self.partial, &self.header)?;
         if earlier.is_empty() {
-            let mut text = header.to_string();
+            let mut text = self.header.to_string();
             text.push('\n');
-            seads_rl::store::write_atomic(&partial, text.as_bytes())?;
+            seads_rl::store::write_atomic(&self.partial, text.as_bytes())?;
         }
-        Ok(Self {
-            partial,
+        Ok(Journal {
+            partial: self.partial,
             earlier,
             append_error: None,
         })
     }
+}
 
+impl Journal {
     /// The task of `depth` and `seed`, if it finished before.
     pub(crate) fn earlier(&self, depth: usize, seed: u64) -> Option<&Finished> {
         self.earlier.get(&(depth, seed))

@@ -15,7 +15,7 @@ use seads_rl::Agent;
 use seads_uarm::UarmEnv;
 
 use crate::evaluation::{checkpoint_of, save_evaluation, task_line};
-use crate::journal::Journal;
+use crate::journal::Place;
 use crate::{Result, StudyError};
 
 /// A robot evaluation: re-planning on the tasks of depth 1–5 with `boards` boards per depth,
@@ -54,7 +54,7 @@ impl RobotEvaluation {
     /// How many tasks a stopped evaluation of `checkpoint` in `run` finished.
     pub fn finished_before(&self, run: &Path, checkpoint: &Path) -> Result<usize> {
         let (id, named) = checkpoint_of(run, checkpoint)?;
-        Journal::finished_before(run, &self.protocol(), &id, named, &self.header())
+        Place::new(run, &self.protocol(), &id, named, &self.header()).finished_before()
     }
 
     /// Evaluates the robot run in `run` at `checkpoint` in `env`, calling `each` after every
@@ -95,7 +95,7 @@ impl RobotEvaluation {
             planner: self.limits.planner(),
             ..SolveConfig::default()
         };
-        let mut journal = Journal::open(run, &protocol, &id, named, &self.header())?;
+        let mut journal = Place::new(run, &protocol, &id, named, &self.header()).open()?;
         let mut results: BTreeMap<usize, DepthResult> = BTreeMap::new();
         let mut lines = String::new();
         let seeds = protocol.tasks.seeds();
