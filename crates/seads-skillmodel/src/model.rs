@@ -12,7 +12,7 @@ use tch::nn::{self, Module};
 use tch::{Device, Kind, Tensor};
 
 use crate::SkillModelError;
-use crate::screen::{Int8Screen, MAX_WIDTH, MIN_ROWS};
+use crate::screen::{Activations, Int8Screen, MAX_WIDTH, MIN_ROWS};
 use seads_nn::{Adam, Init, Mlp, mean_f32};
 
 /// States per successor call on a GPU (25 skills: 8·10⁵ network rows, about 2 GiB of
@@ -330,6 +330,27 @@ fn mode_flips(logits: &Tensor, z0: &Tensor) -> Tensor {
 /// always cut the same way, so that the successors do not depend on the number of threads.
 const CPU_PART: usize = 512;
 
+/// The first layer's rectified activations, factorised: row s·K + k is
+/// relu(z₀ part of state s + column of skill k), both H₁ wide (as `flip_logits_all_skills`
+/// computes them), built per row when the screen reads it.
+struct FirstLayer {
+    per_state: Vec<f32>,
+    skill_cols: Vec<f32>,
+    k: usize,
+}
+
+impl Activations for FirstLayer {
+    fn write_row(&self, r: usize, out: &mut [f32]) {
+        let h1 = out.len();
+        let (state, skill) = (r / self.k, r % self.k);
+        let a = &self.per_state[state * h1..(state + 1) * h1];
+        let b = &self.skill_cols[skill * h1..(skill + 1) * h1];
+        for ((x, &a), &b) in out.iter_mut().zip(a).zip(b) {
+            *x = (a + b).max(0.0);
+        }
+    }
+}
+
 /// A forward model's layers for inference on one thread: shallow handles on its weights (a
 /// tensor may be used from one thread at a time; the handles share the storage).
 struct Inference {
@@ -390,28 +411,26 @@ impl Inference {
     /// The same flips through the 8-bit screen (`screen.rs`), and the number of (state, skill)
     /// rows it left to float32.
     fn screened_flips(&self, z0: &Tensor, screen: &Int8Screen) -> (Vec<u8>, usize) {
-        // The first layer exactly as `flip_logits_all_skills` computes it.
+        // The first layer exactly as `flip_logits_all_skills` computes it, each row built when
+        // the screen reads it.
         let (d, k) = (self.d, self.k);
         let (per_state, skill_cols) = self.first_layer_parts(z0);
         let h1 = per_state.size()[1] as usize;
         let floats = |t: Tensor| Vec::<f32>::try_from(t.contiguous().view([-1])).expect("floats");
-        let per_state = floats(per_state);
-        let skill_cols = floats(skill_cols);
-        let n = per_state.len() / h1;
-        let mut hidden = Vec::with_capacity(n * k * h1);
-        for state in per_state.chunks(h1) {
-            for col in skill_cols.chunks(h1) {
-                hidden.extend(state.iter().zip(col).map(|(&a, &b)| (a + b).max(0.0)));
-            }
-        }
+        let hidden = FirstLayer {
+            per_state: floats(per_state),
+            skill_cols: floats(skill_cols),
+            k,
+        };
+        let n = hidden.per_state.len() / h1;
         let mut flips = vec![0u8; n * k * d];
         let redo = screen.decide(&hidden, n * k, &mut flips);
         if !redo.is_empty() {
             // Those rows in float32, through the same layers as `flip_logits_all_skills`.
-            let rows: Vec<f32> = redo
-                .iter()
-                .flat_map(|&row| hidden[row * h1..(row + 1) * h1].iter().copied())
-                .collect();
+            let mut rows = vec![0.0f32; redo.len() * h1];
+            for (out, &row) in rows.chunks_mut(h1).zip(&redo) {
+                hidden.write_row(row, out);
+            }
             let h = Tensor::from_slice(&rows).view([redo.len() as i64, h1 as i64]);
             let logits = floats(self.after_first_layer(h));
             let bits = floats(z0.shallow_clone());
@@ -809,6 +828,32 @@ mod tests {
 
     /// The GPU's path (run here on the CPU) packs the float32 mode's states into words: the
     /// same successors as the CPU's path, for states of one, two and three words.
+    /// The screen's first-layer rows, built per row, are the float path's activations.
+    #[test]
+    fn first_layer_rows_are_the_float_paths_activations() {
+        let model = ForwardModel::new(25, 7, &SkillModelConfig::default(), Device::Cpu, 5);
+        let states: Vec<SymbolicState> = (0..40u64)
+            .map(|i| SymbolicState::from_u64(i.wrapping_mul(0x9e37_79b9) & ((1 << 25) - 1)))
+            .collect();
+        let z0 = states_tensor(states.iter().copied(), 25, Device::Cpu);
+        let inference = model.inference();
+        let (per_state, skill_cols) = inference.first_layer_parts(&z0);
+        let expected = (per_state.unsqueeze(1) + skill_cols.unsqueeze(0)).relu(); // n × K × H₁
+        let h1 = per_state.size()[1] as usize;
+        let expected = Vec::<f32>::try_from(expected.contiguous().view([-1])).unwrap();
+        let floats = |t: Tensor| Vec::<f32>::try_from(t.contiguous().view([-1])).unwrap();
+        let rows = FirstLayer {
+            per_state: floats(per_state),
+            skill_cols: floats(skill_cols),
+            k: 7,
+        };
+        let mut row = vec![0.0f32; h1];
+        for r in 0..states.len() * 7 {
+            rows.write_row(r, &mut row);
+            assert_eq!(row[..], expected[r * h1..(r + 1) * h1], "row {r}");
+        }
+    }
+
     #[test]
     fn the_device_path_gives_the_float32_successors() {
         use rand::RngExt;

@@ -10,6 +10,11 @@
 //!   (libtorch's `_int_mm`, AVX-512 VNNI where the CPU has it);
 //! - the output layer runs in float32 on the dequantised, rectified h₂.
 //!
+//! A batch goes through in blocks of 1,024 (state, skill) rows with reused buffers, and each
+//! row's h₁ is built when it is read ([`Activations`]): a batch's activations are never held at
+//! once, and a block's stay in cache (the successor function's cost halves against holding them;
+//! `docs/results/screen-blocks/`).
+//!
 //! How far the float path's logit can lie from the screened one, two bounds:
 //! - quick, per row from constants: with every error at half a step,
 //!   s/2 · (Σ_j |V_lj| A_j + Q · Σ_j |V_lj| t_j), where A_j = Σ_i |W_ji| and Q = Σ_i q_i;
@@ -32,7 +37,7 @@ use tch::{Kind, Tensor};
 const GAMMA: f32 = 1e-4;
 /// The widest layer the margin covers.
 pub(crate) const MAX_WIDTH: i64 = 1024;
-/// Integer products take a multiple of this many rows.
+/// Integer products take this many rows at a time.
 const ROW_STEP: usize = 1024;
 /// Fewer (state, skill) rows than this go straight to float32: the integer product's fixed cost
 /// per call outweighs its savings on small batches.
@@ -63,6 +68,21 @@ pub(crate) struct Int8Screen {
     /// Per logit l, for the rounding margin: Σ_j |V_lj| and Σ_j |V_lj| |b2_j|.
     v_abs: Vec<f32>,
     v_b2: Vec<f32>,
+}
+
+/// First-layer activations (≥ 0), one row of H₁ per (state, skill) pair, written on demand: a
+/// batch's rows need not be held at once (the successor function builds each from its state's
+/// part and its skill's column, `model.rs`). A slice is its own rows, H₁ = the row's length.
+pub(crate) trait Activations {
+    /// Writes row `r`'s activations into `out` (H₁ values).
+    fn write_row(&self, r: usize, out: &mut [f32]);
+}
+
+impl Activations for [f32] {
+    fn write_row(&self, r: usize, out: &mut [f32]) {
+        let h1 = out.len();
+        out.copy_from_slice(&self[r * h1..(r + 1) * h1]);
+    }
 }
 
 /// One batch through the screen: the screened logits and what their bounds need.
@@ -202,11 +222,16 @@ impl Int8Screen {
         }
     }
 
-    /// Flip decisions for `rows` first-layer activations (`hidden`, rows × H₁, ≥ 0), written to
-    /// `flips` (rows × D, 1: the bit flips) for every row whose logits are all clear of their
-    /// bounds. Returns the other rows, which the caller computes in float32. The quick bound is
-    /// tried first, the tight one only for rows it does not settle.
-    pub(crate) fn decide(&self, hidden: &[f32], rows: usize, flips: &mut [u8]) -> Vec<usize> {
+    /// Flip decisions for `rows` rows of first-layer activations (`hidden`), written to `flips`
+    /// (rows × D, 1: the bit flips) for every row whose logits are all clear of their bounds.
+    /// Returns the other rows, which the caller computes in float32. The quick bound is tried
+    /// first, the tight one only for rows it does not settle.
+    pub(crate) fn decide(
+        &self,
+        hidden: &(impl Activations + ?Sized),
+        rows: usize,
+        flips: &mut [u8],
+    ) -> Vec<usize> {
         let screened = self.screen(hidden, rows);
         let d = self.d;
         let open: Vec<usize> = (0..rows)
@@ -233,7 +258,7 @@ impl Int8Screen {
     }
 
     /// Quantises, multiplies in integers and finishes in float32.
-    fn screen(&self, hidden: &[f32], rows: usize) -> Screened {
+    fn screen(&self, hidden: &(impl Activations + ?Sized), rows: usize) -> Screened {
         let (h1, h2, d) = (self.h1, self.h2, self.d);
         let mut out = Screened {
             logits: Vec::new(),
@@ -243,53 +268,63 @@ impl Int8Screen {
             hmax: vec![0.0; rows],
             h2max: vec![0.0; rows],
         };
+        let mut x = vec![0.0f32; h1];
         for r in 0..rows {
-            let x = &hidden[r * h1..(r + 1) * h1];
-            let max = max_non_negative(x);
+            hidden.write_row(r, &mut x);
+            let max = max_non_negative(&x);
             out.hmax[r] = max;
             if max > 0.0 && max.is_finite() {
                 let s = max / 127.0;
                 out.scale[r] = s;
                 let inverse = 127.0 / max;
                 let mut sum = 0i32;
-                for (level, &v) in out.q[r * h1..(r + 1) * h1].iter_mut().zip(x) {
+                for (level, &v) in out.q[r * h1..(r + 1) * h1].iter_mut().zip(&x) {
                     *level = nearest_level(v * inverse);
                     sum += i32::from(*level);
                 }
                 out.qsum[r] = sum as f32;
             }
         }
-        // oneDNN compiles a kernel per shape: rows are padded with zeros to a multiple of
-        // `ROW_STEP`, so that a search's batches reuse a few kernels.
-        let padded = rows.div_ceil(ROW_STEP) * ROW_STEP;
-        out.q.resize(padded * h1, 0);
-        let products = Tensor::from_slice(&out.q)
-            .view([padded as i64, h1 as i64])
-            .internal_int_mm(&self.w2)
-            .narrow(0, 0, rows as i64);
-        out.q.truncate(rows * h1);
-        let products =
-            Vec::<i32>::try_from(products.contiguous().view([-1])).expect("int32 products");
-        let mut h2v = vec![0.0f32; rows * h2];
-        for r in 0..rows {
-            let s = out.scale[r];
-            let row = &mut h2v[r * h2..(r + 1) * h2];
-            for ((h, &p), (&t, &b)) in row
-                .iter_mut()
-                .zip(&products[r * h2..(r + 1) * h2])
-                .zip(self.t.iter().zip(&self.b2))
-            {
-                *h = (s * t * p as f32 + b).max(0.0);
+        // Blocks of `ROW_STEP` rows, their buffers reused: a block's integers and activations
+        // stay in cache, and every integer product has one shape (oneDNN compiles a kernel per
+        // shape; the last block is padded with rows of zeros).
+        let mut padded = vec![0i8; ROW_STEP * h1];
+        let mut products = vec![0i32; ROW_STEP * h2];
+        let mut h2v = vec![0.0f32; ROW_STEP * h2];
+        let mut logits = vec![0.0f32; ROW_STEP * d];
+        out.logits.reserve(rows * d);
+        for start in (0..rows).step_by(ROW_STEP) {
+            let n = ROW_STEP.min(rows - start);
+            let q = &out.q[start * h1..(start + n) * h1];
+            let q = if n == ROW_STEP {
+                q
+            } else {
+                padded[..n * h1].copy_from_slice(q);
+                &padded[..]
+            };
+            Tensor::from_slice(q)
+                .view([ROW_STEP as i64, h1 as i64])
+                .internal_int_mm(&self.w2)
+                .copy_data(&mut products, ROW_STEP * h2);
+            for r in 0..n {
+                let s = out.scale[start + r];
+                let row = &mut h2v[r * h2..(r + 1) * h2];
+                for ((h, &p), (&t, &b)) in row
+                    .iter_mut()
+                    .zip(&products[r * h2..(r + 1) * h2])
+                    .zip(self.t.iter().zip(&self.b2))
+                {
+                    *h = (s * t * p as f32 + b).max(0.0);
+                }
+                out.h2max[start + r] = max_non_negative(row);
             }
-            out.h2max[r] = max_non_negative(row);
-        }
-        let logits = Tensor::from_slice(&h2v)
-            .view([rows as i64, h2 as i64])
-            .matmul(&self.w3_t);
-        out.logits = Vec::<f32>::try_from(logits.view([-1])).expect("float logits");
-        for row in out.logits.chunks_mut(d) {
-            for (x, &b) in row.iter_mut().zip(&self.b3) {
-                *x += b;
+            Tensor::from_slice(&h2v[..n * h2])
+                .view([n as i64, h2 as i64])
+                .matmul(&self.w3_t)
+                .copy_data(&mut logits, n * d);
+            for row in logits[..n * d].chunks(d) {
+                out.logits
+                    .extend(row.iter().zip(&self.b3).map(|(&x, &b)| x + b));
             }
         }
         out
@@ -315,39 +350,49 @@ impl Int8Screen {
 
     /// Bounds from the actual errors of each of `rows` (rows.len() × D):
     /// Σ_i |h_i − s·q_i| C_li + s·q_i Σ_j |V_lj| |δW_ji|.
-    fn tight_bounds(&self, screened: &Screened, hidden: &[f32], rows: &[usize]) -> Vec<f32> {
+    fn tight_bounds(
+        &self,
+        screened: &Screened,
+        hidden: &(impl Activations + ?Sized),
+        rows: &[usize],
+    ) -> Vec<f32> {
         if rows.is_empty() {
             return Vec::new();
         }
         let (h1, d) = (self.h1, self.d);
-        // Per row: |h − s·q| then s·q, both rounded up so that they bound the exact values.
-        let mut errors = vec![0.0f32; rows.len() * 2 * h1];
-        for (out, &r) in errors.chunks_mut(2 * h1).zip(rows) {
-            let s = screened.scale[r];
-            let (e, a) = out.split_at_mut(h1);
-            let x = &hidden[r * h1..(r + 1) * h1];
-            let q = &screened.q[r * h1..(r + 1) * h1];
-            for i in 0..h1 {
-                let level = f32::from(q[i]);
-                e[i] = (x[i] - s * level).abs() * (1.0 + GAMMA);
-                a[i] = s * level * (1.0 + GAMMA);
+        // In blocks of `ROW_STEP` rows, their buffers reused (as in `screen`).
+        let block = ROW_STEP.min(rows.len());
+        let mut errors = vec![0.0f32; block * 2 * h1];
+        let mut moved = vec![0.0f32; block * d];
+        let mut x = vec![0.0f32; h1];
+        let mut bounds = Vec::with_capacity(rows.len() * d);
+        for rows in rows.chunks(ROW_STEP) {
+            // Per row: |h − s·q| then s·q, both rounded up so that they bound the exact values.
+            for (out, &r) in errors.chunks_mut(2 * h1).zip(rows) {
+                let s = screened.scale[r];
+                let (e, a) = out.split_at_mut(h1);
+                hidden.write_row(r, &mut x);
+                let q = &screened.q[r * h1..(r + 1) * h1];
+                for i in 0..h1 {
+                    let level = f32::from(q[i]);
+                    e[i] = (x[i] - s * level).abs() * (1.0 + GAMMA);
+                    a[i] = s * level * (1.0 + GAMMA);
+                }
+            }
+            let n = rows.len();
+            Tensor::from_slice(&errors[..n * 2 * h1])
+                .view([n as i64, 2 * h1 as i64])
+                .matmul(&self.sensitivity)
+                .copy_data(&mut moved, n * d);
+            for (moved, &r) in moved.chunks(d).zip(rows) {
+                bounds.extend(moved.iter().enumerate().map(|(l, &m)| {
+                    // A sum of non-negative terms: reordered, it moves by far less than γ.
+                    let quantised = m * (1.0 + GAMMA);
+                    quantised + self.rounding(screened, r, l, quantised)
+                }));
             }
         }
-        let moved = Tensor::from_slice(&errors)
-            .view([rows.len() as i64, 2 * h1 as i64])
-            .matmul(&self.sensitivity);
-        let moved = Vec::<f32>::try_from(moved.view([-1])).expect("float bounds");
-        rows.iter()
-            .enumerate()
-            .flat_map(|(j, &r)| {
-                let moved = &moved[j * d..(j + 1) * d];
-                (0..d).map(move |l| {
-                    // A sum of non-negative terms: reordered, it moves by far less than γ.
-                    let quantised = moved[l] * (1.0 + GAMMA);
-                    quantised + self.rounding(screened, r, l, quantised)
-                })
-            })
-            .collect()
+        bounds
     }
 }
 
@@ -391,7 +436,8 @@ mod tests {
         #![proptest_config(ProptestConfig::with_cases(24))]
 
         /// Every screened logit lies within its bound of the exact logit, for weights and
-        /// activations over several orders of magnitude, sparse activations (after ReLU) included.
+        /// activations over several orders of magnitude, sparse activations (after ReLU) included,
+        /// in a batch of two blocks (the second padded).
         #[test]
         fn the_bound_holds_against_exact_arithmetic(
             seed in 0u64..1000,
@@ -399,7 +445,7 @@ mod tests {
             activation_scale in 0.001f32..100.0,
             zeros in 0.0f64..0.9,
         ) {
-            let (h1, h2, d, rows) = (48usize, 40usize, 7usize, 30usize);
+            let (h1, h2, d, rows) = (48usize, 40usize, 7usize, ROW_STEP + 30);
             let mut rng = ChaCha8Rng::seed_from_u64(seed);
             let mut draw = |n: usize, scale: f32| -> Vec<f32> {
                 (0..n).map(|_| rng.random_range(-1.0f32..1.0) * scale).collect()
@@ -418,11 +464,11 @@ mod tests {
                 &tensor(&w3, d, h2),
                 &Tensor::from_slice(&b3),
             );
-            let screened = screen.screen(&hidden, rows);
+            let screened = screen.screen(&hidden[..], rows);
             let mut tightest = 0.0f64;
             for r in 0..rows {
                 let exact = logits_f64(&w2, &b2, &w3, &b3, &hidden[r * h1..(r + 1) * h1], (h1, h2, d));
-                let tight = screen.tight_bounds(&screened, &hidden, &[r]);
+                let tight = screen.tight_bounds(&screened, &hidden[..], &[r]);
 
                 for l in 0..d {
                     let error = (f64::from(screened.logits[r * d + l]) - exact[l]).abs();
@@ -475,10 +521,10 @@ mod tests {
             &tensor(&w3, 1, h2),
             &Tensor::from_slice(&b3),
         );
-        let screened = screen.screen(&hidden, 1);
+        let screened = screen.screen(&hidden[..], 1);
         let exact = logits_f64(&w2, &b2, &w3, &b3, &hidden, (h1, h2, 1));
         let error = exact[0] - f64::from(screened.logits[0]);
-        let bound = f64::from(screen.tight_bounds(&screened, &hidden, &[0])[0]);
+        let bound = f64::from(screen.tight_bounds(&screened, &hidden[..], &[0])[0]);
         assert!(
             error > 0.0 && error <= bound && error > 0.95 * bound,
             "error {error}, bound {bound}"
@@ -496,7 +542,7 @@ mod tests {
             &w3,
             &Tensor::from_slice(&[0.1f32]),
         );
-        let screened = screen.screen(&[0.0, 0.0], 1);
+        let screened = screen.screen(&[0.0, 0.0][..], 1);
         let bound = screen.quick_bound(&screened, 0, 0);
         // relu(0.5) − relu(0.25) + 0.1 = 0.35
         assert!(
@@ -506,7 +552,7 @@ mod tests {
         );
         let mut flips = [0u8; 2];
         assert_eq!(
-            screen.decide(&[0.0, 0.0, f32::NAN, 1.0], 2, &mut flips),
+            screen.decide(&[0.0, 0.0, f32::NAN, 1.0][..], 2, &mut flips),
             vec![1]
         );
         assert_eq!(flips[0], 1);
