@@ -8,7 +8,7 @@
 # twin replaying finished tasks): 20 boards per depth 1-5, re-planning, searches bounded by 2^20
 # expanded states (an agent that lacks a move fails many searches, each costing the whole
 # bound). A run with `evaluation-replan-tasks.jsonl` (written only by such an evaluation) is done.
-# EVAL: the frozen 83717a6, from 2026-11-29 07:15 on the frozen a634bb8 (the same evaluations,
+# EVAL: the frozen 83717a6, from 2026-11-29 07:12 on the frozen a634bb8 (the same evaluations,
 # faster: docs/results/screen-blocks/).
 # Resumable: rerun the script.
 set -u
