@@ -372,6 +372,20 @@ impl Inference {
         Self { layers, d, k }
     }
 
+    /// The first layer's rectified activations of every state under every skill, factorised
+    /// as the screen reads them, and their width H₁.
+    fn first_layer(&self, z0: &Tensor) -> (FirstLayer, usize) {
+        let (per_state, skill_cols) = self.first_layer_parts(z0);
+        let h1 = per_state.size()[1] as usize;
+        let floats = |t: Tensor| Vec::<f32>::try_from(t.contiguous().view([-1])).expect("floats");
+        let layer = FirstLayer {
+            per_state: floats(per_state),
+            skill_cols: floats(skill_cols),
+            k: self.k,
+        };
+        (layer, h1)
+    }
+
     /// The first layer split into its z_0 part, computed once per state with the bias (n × H),
     /// and each skill's column (K × H), added per skill.
     fn first_layer_parts(&self, z0: &Tensor) -> (Tensor, Tensor) {
@@ -414,15 +428,9 @@ impl Inference {
         // The first layer exactly as `flip_logits_all_skills` computes it, each row built when
         // the screen reads it.
         let (d, k) = (self.d, self.k);
-        let (per_state, skill_cols) = self.first_layer_parts(z0);
-        let h1 = per_state.size()[1] as usize;
-        let floats = |t: Tensor| Vec::<f32>::try_from(t.contiguous().view([-1])).expect("floats");
-        let hidden = FirstLayer {
-            per_state: floats(per_state),
-            skill_cols: floats(skill_cols),
-            k,
-        };
+        let (hidden, h1) = self.first_layer(z0);
         let n = hidden.per_state.len() / h1;
+        let floats = |t: Tensor| Vec::<f32>::try_from(t.contiguous().view([-1])).expect("floats");
         let mut flips = vec![0u8; n * k * d];
         let redo = screen.decide(&hidden, n * k, &mut flips);
         if !redo.is_empty() {
@@ -826,8 +834,6 @@ mod tests {
         }
     }
 
-    /// The GPU's path (run here on the CPU) packs the float32 mode's states into words: the
-    /// same successors as the CPU's path, for states of one, two and three words.
     /// The screen's first-layer rows, built per row, are the float path's activations.
     #[test]
     fn first_layer_rows_are_the_float_paths_activations() {
@@ -839,14 +845,8 @@ mod tests {
         let inference = model.inference();
         let (per_state, skill_cols) = inference.first_layer_parts(&z0);
         let expected = (per_state.unsqueeze(1) + skill_cols.unsqueeze(0)).relu(); // n × K × H₁
-        let h1 = per_state.size()[1] as usize;
         let expected = Vec::<f32>::try_from(expected.contiguous().view([-1])).unwrap();
-        let floats = |t: Tensor| Vec::<f32>::try_from(t.contiguous().view([-1])).unwrap();
-        let rows = FirstLayer {
-            per_state: floats(per_state),
-            skill_cols: floats(skill_cols),
-            k: 7,
-        };
+        let (rows, h1) = inference.first_layer(&z0);
         let mut row = vec![0.0f32; h1];
         for r in 0..states.len() * 7 {
             rows.write_row(r, &mut row);
@@ -854,6 +854,8 @@ mod tests {
         }
     }
 
+    /// The GPU's path (run here on the CPU) packs the float32 mode's states into words: the
+    /// same successors as the CPU's path, for states of one, two and three words.
     #[test]
     fn the_device_path_gives_the_float32_successors() {
         use rand::RngExt;

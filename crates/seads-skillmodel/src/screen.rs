@@ -72,12 +72,14 @@ pub(crate) struct Int8Screen {
 
 /// First-layer activations (≥ 0), one row of H₁ per (state, skill) pair, written on demand: a
 /// batch's rows need not be held at once (the successor function builds each from its state's
-/// part and its skill's column, `model.rs`). A slice is its own rows, H₁ = the row's length.
+/// part and its skill's column, `model.rs`).
 pub(crate) trait Activations {
     /// Writes row `r`'s activations into `out` (H₁ values).
     fn write_row(&self, r: usize, out: &mut [f32]);
 }
 
+/// The tests' rows: a slice holds them one after another, H₁ = the row's length.
+#[cfg(test)]
 impl Activations for [f32] {
     fn write_row(&self, r: usize, out: &mut [f32]) {
         let h1 = out.len();
@@ -288,7 +290,7 @@ impl Int8Screen {
         // Blocks of `ROW_STEP` rows, their buffers reused: a block's integers and activations
         // stay in cache, and every integer product has one shape (oneDNN compiles a kernel per
         // shape; the last block is padded with rows of zeros).
-        let mut padded = vec![0i8; ROW_STEP * h1];
+        let mut padded = Vec::new();
         let mut products = vec![0i32; ROW_STEP * h2];
         let mut h2v = vec![0.0f32; ROW_STEP * h2];
         let mut logits = vec![0.0f32; ROW_STEP * d];
@@ -299,7 +301,9 @@ impl Int8Screen {
             let q = if n == ROW_STEP {
                 q
             } else {
-                padded[..n * h1].copy_from_slice(q);
+                // The last block only: its rows, then zeros.
+                padded.extend_from_slice(q);
+                padded.resize(ROW_STEP * h1, 0);
                 &padded[..]
             };
             Tensor::from_slice(q)
