@@ -5,7 +5,10 @@ approximation with tie correction and continuity correction).
 
 Each case also holds the exact permutation p-value of the same one-sided test with ties kept
 (`permutation_test` over every split of the pooled values, `p_exact`), which the report gives
-beside SciPy's p for small samples.
+beside SciPy's p for small samples, and two effect sizes the report gives beside them: Cliff's
+delta by counting every (x, y) pair (`delta`: the share of pairs with y > x minus the share with
+y < x) and Cohen's d from NumPy's sample standard deviations (`d`: mean(y) - mean(x) over the
+pooled standard deviation; null where no group has any spread).
 
 The cases are the shapes a Table 1 comparison takes: five or ten final skill coverages per
 variant, often tied at the maximum (25.0 or 12.0), plus samples beyond 8 values and small
@@ -59,11 +62,24 @@ def exact_p(x, y):
                          n_resamples=np.inf, vectorized=True)
     return float(r.pvalue)
 
+def cliffs_delta(x, y):
+    diff = np.subtract.outer(np.asarray(y), np.asarray(x))
+    return float((np.sum(diff > 0) - np.sum(diff < 0)) / diff.size)
+
+
+def cohens_d(x, y):
+    x, y = np.asarray(x), np.asarray(y)
+    dof = len(x) + len(y) - 2
+    pooled = ((len(x) - 1) * np.var(x, ddof=1) + (len(y) - 1) * np.var(y, ddof=1)) / dof
+    return None if pooled == 0 else float((y.mean() - x.mean()) / np.sqrt(pooled))
+
+
 out = []
 for x, y in cases:
     r = mannwhitneyu(x, y, alternative="less")
     out.append({"x": [float(v) for v in x], "y": [float(v) for v in y],
-                "u": float(r.statistic), "p": float(r.pvalue), "p_exact": exact_p(x, y)})
+                "u": float(r.statistic), "p": float(r.pvalue), "p_exact": exact_p(x, y),
+                "delta": cliffs_delta(x, y), "d": cohens_d(x, y)})
 path = pathlib.Path(__file__).resolve().parents[2] / "data/reference/mannwhitneyu.json"
 path.write_text(json.dumps({"scipy": scipy.__version__, "alternative": "less", "cases": out},
                            indent=1) + "\n")

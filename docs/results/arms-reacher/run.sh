@@ -1,25 +1,14 @@
 #!/usr/bin/env bash
-# Core A from 2026-11-29 on: the four Reacher cells (issue 48 item 2), seeds 1-3 (replaces
-# chainA2.sh: each SEADS run is evaluated as soon as it has trained, and only SEADS runs are).
-# Training by the study's frozen binary (90d8a6b), outside the sweep (arms-train/), so that no
-# 2^22-state evaluation holds the core and restarts from scratch at each stop. A SEADS run is then
-# evaluated by the frozen a58a2c4 binary, whose evaluations resume (planning only; the sweep's
-# protocol: 20 boards per depth 1-5, 2^22 expanded states per search, most-likely plans). Task
-# success is reported for the SEADS rows only (Table 1 gives the ablations' coverage), so a
-# no-relabelling run is copied into the sweep without one (`seads report` leaves it out of the
-# success table). Resumable: rerun this script (resuming a finished run is a no-op).
+# The four Reacher cells (issue 48 item 2), from 2026-11-29 (second machine): the runs named on the
+# command line, in order, one shared core. Training by the study's frozen binary (90d8a6b) outside
+# the sweep (arms-train/); a SEADS run is then evaluated by the frozen a58a2c4 binary in the
+# sweep's protocol; each finished run is copied into the sweep. Resumable: rerun with the same list.
 T=/root/seads-frozen/90d8a6b/bin/seads
 E=/root/seads-frozen/a58a2c4/bin/seads
 S=/root/seads-sweeps/arms-reacher/runs
 W=/root/seads-sweeps/arms-train
 cd /root/seads-sweeps
-runs=(tileswap-reacher/seads/seed-1 tileswap-reacher/no-relabelling/seed-1)
-for s in 2 3; do
-  for c in lightsout-reacher/seads lightsout-reacher/no-relabelling tileswap-reacher/seads tileswap-reacher/no-relabelling; do
-    runs+=($c/seed-$s)
-  done
-done
-for r in "${runs[@]}"; do
+for r in "$@"; do
   R=$W/$r
   if [ -f $R/metrics.jsonl ]; then
     A=(--resume $R)

@@ -209,6 +209,16 @@ fn a_sweep_is_planned_once_run_to_the_end_and_reported() {
     assert!(md.contains("U = ") && md.contains("n = 2"), "{md}");
     let csv = std::fs::read_to_string(report.join("table1.csv")).unwrap();
     assert_eq!(csv.lines().count(), 3, "{csv}");
+    // Two runs a side cannot reach p < 0.01 (1 / C(4, 2) = 1/6), and both variants are the
+    // paper's: beside its Table 1 with the effect sizes.
+    assert!(md.contains("exact") && md.contains(" †)"), "{md}");
+    assert!(md.contains("## Against the paper's Table 1") && md.contains("| 1/6 |"), "{md}");
+    let paper = std::fs::read_to_string(report.join("paper.csv")).unwrap();
+    assert_eq!(paper.lines().count(), 3, "{paper}");
+    assert!(
+        paper.contains("lightsout-cursor,no-relabelling,2,") && paper.contains(",10,24.72,0.39,"),
+        "{paper}"
+    );
     // Failed tasks and deviations, counted from the runs' per-task files: one row per variant,
     // whose task count is every task of the final re-planning evaluations (2 runs × 5 depths ×
     // 1 board).

@@ -9,6 +9,7 @@ mod deep;
 mod failed_tasks;
 mod failures;
 mod figures;
+mod paper;
 mod runs;
 pub mod stats;
 mod tables;
@@ -88,6 +89,10 @@ pub fn write_report(options: &ReportOptions, out: &Path) -> Result<ReportSummary
     };
     let cells = tables::coverage_cells(&groups, reference.as_deref());
     write("table1.csv", &tables::coverage_csv(&cells))?;
+    let against_paper = paper::comparison(&cells, reference.as_deref());
+    if let Some((_, csv)) = &against_paper {
+        write("paper.csv", csv)?;
+    }
     let over_training = curves::coverage_over_training(&groups, reference.as_deref());
     if let Some((_, csv)) = &over_training {
         write("coverage-over-training.csv", csv)?;
@@ -196,6 +201,11 @@ pub fn write_report(options: &ReportOptions, out: &Path) -> Result<ReportSummary
     let _ = writeln!(md, "## Skill coverage at the end of training (Table 1)\n");
     md += &tables::coverage_markdown(&cells, reference.as_deref());
     let _ = writeln!(md, "\nAs CSV: `table1.csv`.\n");
+    if let Some((paper_md, _)) = &against_paper {
+        let _ = writeln!(md, "## Against the paper's Table 1\n");
+        md += paper_md;
+        let _ = writeln!(md, "\nAs CSV: `paper.csv`.\n");
+    }
     if let Some((curve_md, _)) = &over_training {
         let _ = writeln!(md, "## Skill coverage over training\n");
         md += curve_md;

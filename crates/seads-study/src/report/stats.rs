@@ -75,6 +75,15 @@ pub struct Test {
     /// send SciPy to the normal approximation, small samples can get a p below what any split
     /// allows (3 against 5 runs: 0.0084 against the exact minimum 1/56).
     pub p_exact: f64,
+    /// The smallest exact one-sided p that samples of these sizes allow, reached when every
+    /// variant value lies below every reference value: 1 / C(n₁ + n₂, n₁). Three runs against
+    /// three cannot go below 1/20 = 0.05, so [`ALPHA`] is out of reach whatever the runs give.
+    pub min_p: f64,
+    /// Cliff's δ, an effect size that needs no distribution: over every (variant, reference)
+    /// pair, the share where the reference is higher minus the share where the variant is
+    /// (ties count for neither); 1 − 2U / (n₁n₂). From −1 to 1; 1 when every variant value lies
+    /// below every reference value.
+    pub delta: f64,
 }
 
 impl Test {
@@ -82,6 +91,32 @@ impl Test {
     pub fn significant(&self) -> bool {
         self.p < ALPHA && self.p_exact < ALPHA
     }
+
+    /// Whether the sample sizes allow an exact p below [`ALPHA`] at all.
+    pub fn can_be_significant(&self) -> bool {
+        self.min_p < ALPHA
+    }
+}
+
+/// Cohen's d of a variant against the reference: the reference's mean minus the variant's, over
+/// the pooled sample standard deviation, so positive when the variant is lower. It needs only the
+/// groups' mean ± std (and sizes), so it also measures the paper's Table 1, which gives nothing
+/// else. `None` where it is undefined: fewer than three values in all, or no spread in either
+/// group.
+pub fn cohens_d(variant: &Summary, reference: &Summary) -> Option<f64> {
+    let dof = (variant.n + reference.n)
+        .checked_sub(2)
+        .filter(|&d| d > 0)?;
+    let pooled = ((variant.n.saturating_sub(1)) as f64 * variant.std.powi(2)
+        + (reference.n.saturating_sub(1)) as f64 * reference.std.powi(2))
+        / dof as f64;
+    let sd = pooled.sqrt();
+    (sd > 0.0 && sd.is_finite()).then(|| (reference.mean - variant.mean) / sd)
+}
+
+/// 1 / C(n₁ + n₂, n₁), as a product of n₁ ratios (no overflow for any run count).
+fn smallest_exact_p(n1: usize, n2: usize) -> f64 {
+    (1..=n1).map(|i| i as f64 / (n2 + i) as f64).product()
 }
 
 /// One-sided Mann–Whitney U test that `variant` is smaller than `reference`. `None` when a
@@ -109,6 +144,8 @@ pub fn worse_than(variant: &[f64], reference: &[f64]) -> Option<Test> {
         u: u1,
         p: p.clamp(0.0, 1.0),
         p_exact: exact_permutation_p(&ranks, n1, r1),
+        min_p: smallest_exact_p(n1, n2),
+        delta: 1.0 - 2.0 * u1 / (n1 * n2) as f64,
     })
 }
 
@@ -240,6 +277,8 @@ mod tests {
             u: f64,
             p: f64,
             p_exact: f64,
+            delta: f64,
+            d: Option<f64>,
         }
         #[derive(serde::Deserialize)]
         struct Reference {
@@ -268,6 +307,79 @@ mod tests {
                 t.p_exact,
                 c.p_exact
             );
+            assert!(
+                (t.delta - c.delta).abs() <= 1e-12,
+                "Cliff's delta of {:?} vs {:?}: {} against the pair count {}",
+                c.x,
+                c.y,
+                t.delta,
+                c.delta
+            );
+            let d = cohens_d(&summary(&c.x).unwrap(), &summary(&c.y).unwrap());
+            match (d, c.d) {
+                (Some(ours), Some(numpy)) => assert!(
+                    (ours - numpy).abs() <= 1e-9 * numpy.abs().max(1.0),
+                    "Cohen's d of {:?} vs {:?}: {ours} against NumPy's {numpy}",
+                    c.x,
+                    c.y
+                ),
+                (ours, numpy) => assert_eq!(ours, numpy, "Cohen's d of {:?} vs {:?}", c.x, c.y),
+            }
+        }
+    }
+
+    #[test]
+    fn the_smallest_p_of_three_against_three_is_one_in_twenty() {
+        // 1 / C(6, 3): three seeds a side cannot reach the paper's 0.01, however far apart.
+        let t = worse_than(&[1.0, 2.0, 3.0], &[7.0, 8.0, 9.0]).unwrap();
+        assert!((t.min_p - 0.05).abs() < 1e-15, "{}", t.min_p);
+        assert!((t.p_exact - 0.05).abs() < 1e-12);
+        assert_eq!(t.delta, 1.0);
+        assert!(!t.can_be_significant() && !t.significant());
+        // 1 / C(10, 5) = 1/252 and 1 / C(20, 10) = 1/184756 can.
+        let t = worse_than(&[5.0; 5], &[6.0; 5]).unwrap();
+        assert!((t.min_p - 1.0 / 252.0).abs() < 1e-15);
+        assert!(t.can_be_significant());
+        let t = worse_than(&[1.0; 10], &[2.0; 10]).unwrap();
+        assert!((t.min_p - 1.0 / 184_756.0).abs() < 1e-18);
+        // One run against one: 1/2.
+        assert_eq!(worse_than(&[1.0], &[2.0]).unwrap().min_p, 0.5);
+    }
+
+    #[test]
+    fn cohens_d_by_hand_and_where_it_is_undefined() {
+        let s = |n, mean, std| Summary {
+            n,
+            mean,
+            std,
+            min: mean,
+            max: mean,
+        };
+        // The paper's LightsOutReacher without relabelling (16.58 ± 4.62) against SEADS
+        // (24.3 ± 0.28), ten agents each: pooled sd √((4.62² + 0.28²) / 2).
+        let d = cohens_d(&s(10, 16.58, 4.62), &s(10, 24.3, 0.28)).unwrap();
+        let by_hand = 7.72 / ((4.62f64 * 4.62 + 0.28 * 0.28) / 2.0).sqrt();
+        assert!((d - by_hand).abs() < 1e-12, "{d} against {by_hand}");
+        assert!(cohens_d(&s(3, 12.0, 0.0), &s(3, 12.0, 0.0)).is_none());
+        assert!(cohens_d(&s(1, 1.0, 0.0), &s(1, 2.0, 0.0)).is_none());
+        assert!(cohens_d(&s(3, 1.0, f64::NAN), &s(3, 2.0, 1.0)).is_none());
+    }
+
+    proptest::proptest! {
+        /// No split of the pooled values gives an exact p below the smallest the sizes allow;
+        /// Cliff's δ lies in [−1, 1] and changes sign when the samples swap.
+        #[test]
+        fn exact_p_is_never_below_the_smallest_and_delta_is_antisymmetric(
+            x in proptest::collection::vec(0u8..6, 1..7),
+            y in proptest::collection::vec(0u8..6, 1..7),
+        ) {
+            let x: Vec<f64> = x.into_iter().map(f64::from).collect();
+            let y: Vec<f64> = y.into_iter().map(f64::from).collect();
+            let t = worse_than(&x, &y).unwrap();
+            proptest::prop_assert!(t.p_exact >= t.min_p * (1.0 - 1e-12), "{} < {}", t.p_exact, t.min_p);
+            proptest::prop_assert!((-1.0..=1.0).contains(&t.delta));
+            let swapped = worse_than(&y, &x).unwrap();
+            proptest::prop_assert!((t.delta + swapped.delta).abs() < 1e-12);
         }
     }
 }

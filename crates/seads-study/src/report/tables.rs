@@ -8,7 +8,7 @@ use seads_planner::DepthResult;
 
 use super::csv_field;
 use super::runs::{Group, RunData};
-use super::stats::{Summary, Test, median, summary, worse_than};
+use super::stats::{Summary, Test, cohens_d, median, summary, worse_than};
 use seads_planner::EvaluationKind as Mode;
 
 /// One cell of Table 1.
@@ -23,6 +23,8 @@ pub struct CoverageCell {
     pub skills: usize,
     /// The test against the reference (none for the reference itself).
     pub test: Option<Test>,
+    /// Cohen's d against the reference (none for the reference itself, or where undefined).
+    pub d: Option<f64>,
 }
 
 /// Skills of a run: the configured K, or the game's moves.
@@ -39,16 +41,24 @@ pub fn coverage_cells(groups: &[Group<'_>], reference: Option<&str>) -> Vec<Cove
         .filter_map(|g| {
             let values = finals(g);
             let summary = summary(&values)?;
-            let test = reference
+            let reference_values = reference
                 .filter(|r| *r != g.variant)
                 .and_then(|r| groups.iter().find(|o| o.env == g.env && o.variant == r))
-                .and_then(|o| worse_than(&values, &finals(o)));
+                .map(finals);
+            let test = reference_values
+                .as_deref()
+                .and_then(|r| worse_than(&values, r));
+            let d = reference_values
+                .as_deref()
+                .and_then(super::stats::summary)
+                .and_then(|r| cohens_d(&summary, &r));
             Some(CoverageCell {
                 env: g.env.clone(),
                 variant: g.variant.clone(),
                 summary,
                 skills: skills(g.runs[0]),
                 test,
+                d,
             })
         })
         .collect()
@@ -93,7 +103,11 @@ pub fn coverage_markdown(cells: &[CoverageCell], reference: Option<&str>) -> Str
                         value
                     };
                     let test = c.test.map_or(String::new(), |t| {
-                        format!("; U = {}, p = {:.4}, exact {:.4}", t.u, t.p, t.p_exact)
+                        let out_of_reach = if t.can_be_significant() { "" } else { " †" };
+                        format!(
+                            "; U = {}, p = {:.4}, exact {:.4}{out_of_reach}",
+                            t.u, t.p, t.p_exact
+                        )
                     });
                     let _ = write!(md, " {value} (n = {}{test}) |", c.summary.n);
                 }
@@ -107,7 +121,10 @@ pub fn coverage_markdown(cells: &[CoverageCell], reference: Option<&str>) -> Str
          moves of the K skills, mean over 20 test initialisations). U and p: one-sided Mann–Whitney U \
          test that the variant is worse than `{}` (SciPy's `mannwhitneyu(variant, reference, \
          alternative=\"less\")`: exact without ties for up to 8 values, tie-corrected normal otherwise), \
-         and its exact permutation p with ties kept (SciPy's `permutation_test`); **bold**: both p < 0.01.\n",
+         and its exact permutation p with ties kept (SciPy's `permutation_test`); **bold**: both p < 0.01. \
+         †: p < 0.01 is out of reach with so few runs, whatever they give: the smallest exact p of n₁ \
+         runs against n₂ is 1 / C(n₁ + n₂, n₁) (3 against 3: 0.05; 5 against 5: 0.004); compare the \
+         effect sizes against the paper's below instead.\n",
         reference.unwrap_or("-")
     );
     md
@@ -115,24 +132,25 @@ pub fn coverage_markdown(cells: &[CoverageCell], reference: Option<&str>) -> Str
 
 /// Table 1 as CSV.
 pub fn coverage_csv(cells: &[CoverageCell]) -> String {
-    let mut csv =
-        String::from("env,variant,skills,n,mean,std,min,max,u,p,p_exact,significantly_worse\n");
+    let mut csv = String::from(
+        "env,variant,skills,n,mean,std,min,max,u,p,p_exact,significantly_worse,min_p,cliffs_delta,cohens_d\n",
+    );
     for c in cells {
         let s = &c.summary;
-        let (u, p, p_exact, sig) = c.test.map_or(
-            (String::new(), String::new(), String::new(), String::new()),
-            |t| {
-                (
-                    t.u.to_string(),
-                    format!("{:.6}", t.p),
-                    format!("{:.6}", t.p_exact),
-                    t.significant().to_string(),
-                )
-            },
-        );
+        let (u, p, p_exact, sig, min_p, delta) = c.test.map_or(Default::default(), |t| {
+            (
+                t.u.to_string(),
+                format!("{:.6}", t.p),
+                format!("{:.6}", t.p_exact),
+                t.significant().to_string(),
+                format!("{:.6}", t.min_p),
+                format!("{:.4}", t.delta),
+            )
+        });
+        let d = c.d.map_or(String::new(), |d| format!("{d:.4}"));
         let _ = writeln!(
             csv,
-            "{},{},{},{},{:.4},{:.4},{:.4},{:.4},{u},{p},{p_exact},{sig}",
+            "{},{},{},{},{:.4},{:.4},{:.4},{:.4},{u},{p},{p_exact},{sig},{min_p},{delta},{d}",
             csv_field(&c.env),
             csv_field(&c.variant),
             c.skills,
