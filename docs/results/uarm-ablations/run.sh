@@ -17,14 +17,15 @@ E=${EVAL:?the frozen binary that evaluates, e.g. /root/seads-frozen/<commit>/bin
 here=$(cd "$(dirname "$0")" && pwd)
 # "paper" names its observation: a new run's default is the pen only since 3ab6aec (13631e6's
 # default was the board and the pen, so the runs here are the same with either line). The settings
-# not yet trained come first; the runs trained before are evaluated again after them.
+# not yet trained come first (late reports last: their weak agents take an hour each to evaluate);
+# the runs trained before are evaluated again after them.
 settings=(
-  "late-reports-0.1|--late-reports 0.1"
   "updates-4|--updates-per-epoch 4"
   "episodes-16|--episodes-per-epoch 16"
   "alpha-0.3|--alpha 0.3"
   "updates-64|--updates-per-epoch 64"
   "episodes-1|--episodes-per-epoch 1"
+  "late-reports-0.1|--late-reports 0.1"
   "paper|--observe board-and-pen"
   "observe-board|--observe board"
   "observe-pen|--observe pen"
