@@ -212,7 +212,10 @@ fn a_sweep_is_planned_once_run_to_the_end_and_reported() {
     // Two runs a side cannot reach p < 0.01 (1 / C(4, 2) = 1/6), and both variants are the
     // paper's: beside its Table 1 with the effect sizes.
     assert!(md.contains("exact") && md.contains(" †)"), "{md}");
-    assert!(md.contains("## Against the paper's Table 1") && md.contains("| 1/6 |"), "{md}");
+    assert!(
+        md.contains("## Against the paper's Table 1") && md.contains("| 1/6 |"),
+        "{md}"
+    );
     let paper = std::fs::read_to_string(report.join("paper.csv")).unwrap();
     assert_eq!(paper.lines().count(), 3, "{paper}");
     assert!(

@@ -168,7 +168,7 @@ pub fn comparison(cells: &[CoverageCell], reference: Option<&str>) -> Option<(St
         "\nThe paper's Table 1 (mean ± std over its agents; SPEC §6.1, `data/paper/table1.csv`) beside \
          ours. Cohen's d: the reference's mean minus the variant's over the pooled sample standard \
          deviation, on each side against its own `{}` (positive: the variant is lower; – where \
-         undefined: fewer than three runs in all, or no spread in either group). Cliff's δ: over every pair of our runs, the share where the \
+         undefined: a group of one run, or no spread in either group). Cliff's δ: over every pair of our runs, the share where the \
          reference is higher minus the share where the variant is. Smallest p possible: the least \
          exact one-sided Mann–Whitney p our run counts allow, 1 / C(n₁ + n₂, n₁); at 0.01 or more \
          the paper's significance level is out of reach and only the effect sizes compare.\n",

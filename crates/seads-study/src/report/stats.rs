@@ -101,15 +101,16 @@ impl Test {
 /// Cohen's d of a variant against the reference: the reference's mean minus the variant's, over
 /// the pooled sample standard deviation, so positive when the variant is lower. It needs only the
 /// groups' mean ± std (and sizes), so it also measures the paper's Table 1, which gives nothing
-/// else. `None` where it is undefined: fewer than three values in all, or no spread in either
-/// group.
+/// else. `None` where it is undefined: a group of one value (its spread unknown, the other
+/// group's alone would stand for both), or no spread in either group.
 pub fn cohens_d(variant: &Summary, reference: &Summary) -> Option<f64> {
-    let dof = (variant.n + reference.n)
-        .checked_sub(2)
-        .filter(|&d| d > 0)?;
-    let pooled = ((variant.n.saturating_sub(1)) as f64 * variant.std.powi(2)
-        + (reference.n.saturating_sub(1)) as f64 * reference.std.powi(2))
-        / dof as f64;
+    if variant.n < 2 || reference.n < 2 {
+        return None;
+    }
+    let dof = variant.n + reference.n - 2;
+    let pooled = (variant.n - 1) as f64 * variant.std.powi(2)
+        + (reference.n - 1) as f64 * reference.std.powi(2);
+    let pooled = pooled / dof as f64;
     let sd = pooled.sqrt();
     (sd > 0.0 && sd.is_finite()).then(|| (reference.mean - variant.mean) / sd)
 }
@@ -362,6 +363,9 @@ mod tests {
         assert!((d - by_hand).abs() < 1e-12, "{d} against {by_hand}");
         assert!(cohens_d(&s(3, 12.0, 0.0), &s(3, 12.0, 0.0)).is_none());
         assert!(cohens_d(&s(1, 1.0, 0.0), &s(1, 2.0, 0.0)).is_none());
+        // One run against two: the pair's spread alone would stand for both groups.
+        assert!(cohens_d(&s(2, 18.2, 0.07), &s(1, 23.6, 0.0)).is_none());
+        assert!(cohens_d(&s(2, 18.2, 0.07), &s(2, 23.6, 0.0)).is_some());
         assert!(cohens_d(&s(3, 1.0, f64::NAN), &s(3, 2.0, 1.0)).is_none());
     }
 
