@@ -123,8 +123,9 @@ pub fn coverage_markdown(cells: &[CoverageCell], reference: Option<&str>) -> Str
          alternative=\"less\")`: exact without ties for up to 8 values, tie-corrected normal otherwise), \
          and its exact permutation p with ties kept (SciPy's `permutation_test`); **bold**: both p < 0.01. \
          †: p < 0.01 is out of reach with so few runs, whatever they give: the smallest exact p of n₁ \
-         runs against n₂ is 1 / C(n₁ + n₂, n₁) (3 against 3: 0.05; 5 against 5: 0.004); compare the \
-         effect sizes against the paper's below instead.\n",
+         runs against n₂ is 1 / C(n₁ + n₂, n₁) (3 against 3: 0.05; 5 against 5: 0.004); compare \
+         effect sizes instead (Cliff's δ and Cohen's d in `table1.csv`; beside the paper's below, \
+         where it has the cell).\n",
         reference.unwrap_or("-")
     );
     md
