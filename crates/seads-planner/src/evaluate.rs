@@ -7,7 +7,7 @@ use seads_embodiment::{EnvConfig, EnvError, SkillPolicy, make_env};
 use seads_games::{Successor, SymbolicState};
 use serde::{Deserialize, Serialize};
 
-use crate::{Protocol, SolveConfig, SolveOutcome, TaskSet, solve};
+use crate::{DEFAULT_MEMO_BYTES, Memo, Protocol, SolveConfig, SolveOutcome, TaskSet, solve};
 
 /// One task of an evaluation, as it ended.
 #[derive(Debug, Clone, Copy)]
@@ -144,7 +144,7 @@ pub fn evaluate(
 /// [`evaluate`], taking the tasks that `finished` knows (by depth and seed) as they ended
 /// before instead of solving them again: an evaluation that was stopped resumes where it
 /// stopped, with the same results (each task depends on nothing but its seed). `each` is called
-/// with the tasks solved now.
+/// with the tasks solved now. The tasks' searches share a [`Memo`] of the successors computed.
 pub fn evaluate_resuming(
     evaluation: &Evaluation,
     policy: &dyn SkillPolicy,
@@ -152,6 +152,7 @@ pub fn evaluate_resuming(
     mut finished: impl FnMut(usize, u64) -> Option<TaskSummary>,
     mut each: impl FnMut(&TaskRecord<'_>),
 ) -> Result<Vec<DepthResult>, EnvError> {
+    let mut successor = Memo::new(successor, DEFAULT_MEMO_BYTES);
     let mut results = Vec::new();
     let seeds = evaluation.tasks.seeds();
     for &depth in &evaluation.tasks.depths {
@@ -176,7 +177,13 @@ pub fn evaluate_resuming(
             env.seed(seed);
             env.reset()?;
             let board = env.board();
-            let outcome = solve(env.as_mut(), policy, successor, goal, &evaluation.solve)?;
+            let outcome = solve(
+                env.as_mut(),
+                policy,
+                &mut successor,
+                goal,
+                &evaluation.solve,
+            )?;
             result.record(&outcome);
             each(&TaskRecord {
                 depth,

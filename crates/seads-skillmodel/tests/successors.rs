@@ -103,3 +103,50 @@ fn successors_are_the_mode_of_the_model() {
         }
     }
 }
+
+/// A state's successors do not depend on the other states of its call: computed in pieces of
+/// any size, or through the planner's memory of successors (which computes only the states it
+/// has not seen, in calls of other compositions), they equal those of one call. An untrained
+/// model has many logits near 0, where a different summation would show.
+#[test]
+fn successors_do_not_depend_on_how_states_are_batched() {
+    use proptest::prelude::*;
+    use proptest::test_runner::{Config, TestRunner};
+    let mut model = ForwardModel::new(25, 25, &SkillModelConfig::default(), Device::Cpu, 5);
+    let states = random_states(3000, 3);
+    let mut whole = Vec::new();
+    model.successors(&states, &mut whole);
+    let mut runner = TestRunner::new(Config {
+        cases: 12,
+        ..Config::default()
+    });
+    let cuts = proptest::collection::vec(1usize..1500, 1..12);
+    let model = std::cell::RefCell::new(model);
+    runner
+        .run(&cuts, |cuts| {
+            // Pieces of the given sizes, cycling, through the memory; every other piece again.
+            let mut model = model.borrow_mut();
+            let mut memo = seads_planner::Memo::new(&mut *model, 64 << 20);
+            let (mut out, mut again) = (Vec::new(), Vec::new());
+            let mut at = 0;
+            for (i, &n) in cuts.iter().cycle().enumerate() {
+                if at == states.len() {
+                    break;
+                }
+                let piece = &states[at..(at + n).min(states.len())];
+                memo.successors(piece, &mut out);
+                if i % 2 == 1 {
+                    memo.successors(piece, &mut again);
+                    let start = at * 25;
+                    prop_assert_eq!(
+                        &again[again.len() - piece.len() * 25..],
+                        &whole[start..start + piece.len() * 25]
+                    );
+                }
+                at += piece.len();
+            }
+            prop_assert_eq!(&out, &whole);
+            Ok(())
+        })
+        .unwrap();
+}

@@ -8,8 +8,8 @@ use seads_embodiment::{Environment as _, SkillPolicy, execute_skill};
 use seads_games::BoardGame;
 use seads_games::Successor;
 use seads_planner::{
-    CheckpointId, DepthResult, EvaluationRecord, Protocol, SearchLimits, SolveConfig, TaskRecord,
-    solve,
+    CheckpointId, DEFAULT_MEMO_BYTES, DepthResult, EvaluationRecord, Memo, Protocol, SearchLimits,
+    SolveConfig, TaskRecord, solve,
 };
 use seads_rl::Agent;
 use seads_uarm::UarmEnv;
@@ -98,6 +98,7 @@ impl RobotEvaluation {
         let mut journal = Place::new(run, &protocol, &id, named, &self.header()).open()?;
         let mut results: BTreeMap<usize, DepthResult> = BTreeMap::new();
         let mut lines = String::new();
+        let mut model = Memo::new(model, DEFAULT_MEMO_BYTES);
         let seeds = protocol.tasks.seeds();
         for &depth in &protocol.tasks.depths {
             for (done, &seed) in seeds.iter().enumerate() {
@@ -121,8 +122,8 @@ impl RobotEvaluation {
                 } else {
                     let board = env.board();
                     let d = game.solution_depth(board).and_then(Result::ok).unwrap_or(0);
-                    let outcome =
-                        solve(env, policy, model, game.goal(), &solve_config).map_err(env_error)?;
+                    let outcome = solve(env, policy, &mut model, game.goal(), &solve_config)
+                        .map_err(env_error)?;
                     results
                         .entry(d)
                         .or_insert_with(|| DepthResult::new(d))
