@@ -9,7 +9,8 @@
 # expanded states. A run with `evaluation-replan-tasks.jsonl` (written only by such an
 # evaluation) is done.
 # EVAL: the frozen 83717a6, from 2026-11-29 07:12 on the frozen a634bb8 (the same evaluations,
-# faster: docs/results/screen-blocks/).
+# faster: docs/results/screen-blocks/), from 2026-11-29 13:40 on the frozen ec1f66d (the same
+# evaluations, remembering successors: docs/results/memo/).
 # The new settings are all trained first (minutes each), then evaluated, the runs of highest
 # coverage first; then the settings trained before, likewise. An agent that lacks moves makes up
 # to 10 plans per failing task, each search after a deviation up to the 2^20 bound, so its
