@@ -33,9 +33,12 @@ pub struct Memo<'a> {
     half: usize,
     /// States answered from memory and computed.
     counts: (u64, u64),
-    /// The states computed in the current call and their successors (kept to reuse the space).
+    /// The current call's states computed (with their index among them), their successors,
+    /// and every state's row (kept to reuse the space from call to call).
     missed: Vec<SymbolicState>,
+    fresh: FxHashMap<u64, u32>,
     computed: Vec<SymbolicState>,
+    rows: Vec<u64>,
 }
 
 /// Remembered states: each one's row of K successors, in pages of [`PAGE`] rows (a page is
@@ -77,7 +80,9 @@ impl<'a> Memo<'a> {
             half: capacity / 2,
             counts: (0, 0),
             missed: Vec::new(),
+            fresh: FxHashMap::default(),
             computed: Vec::new(),
+            rows: Vec::new(),
         }
     }
 
@@ -135,15 +140,16 @@ impl Successor for Memo<'_> {
         // each once, in the order they first appear.
         let base = out.len();
         self.missed.clear();
-        let mut fresh: FxHashMap<u64, u32> = FxHashMap::default();
-        let mut rows = Vec::with_capacity(states.len() * k);
+        self.fresh.clear();
+        let mut rows = std::mem::take(&mut self.rows);
+        rows.clear();
         for z in states {
             let key = z.low_u64();
             match self.young.row(key, k).or_else(|| self.old.row(key, k)) {
                 Some(found) => rows.extend_from_slice(found),
                 None => {
                     let n = self.missed.len() as u32;
-                    fresh.entry(key).or_insert_with(|| {
+                    self.fresh.entry(key).or_insert_with(|| {
                         self.missed.push(*z);
                         n
                     });
@@ -158,7 +164,7 @@ impl Successor for Memo<'_> {
         self.counts.0 += (states.len() - self.missed.len()) as u64;
         self.counts.1 += self.missed.len() as u64;
         for (z, row) in states.iter().zip(rows.chunks_mut(k)) {
-            if let Some(&i) = fresh.get(&z.low_u64()) {
+            if let Some(&i) = self.fresh.get(&z.low_u64()) {
                 let i = i as usize;
                 for (r, s) in row.iter_mut().zip(&self.computed[i * k..(i + 1) * k]) {
                     *r = s.low_u64();
@@ -174,6 +180,7 @@ impl Successor for Memo<'_> {
                 Self::remember(&mut self.young, &mut self.old, self.half, key, row);
             }
         }
+        self.rows = rows;
     }
 
     fn preferred_batch(&self) -> usize {
