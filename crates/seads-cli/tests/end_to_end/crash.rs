@@ -5,7 +5,7 @@
 //! of the run (after collecting an epoch, while SAC updates, after an epoch, after a metrics
 //! append, between the steps of a checkpoint write) and waits there to be killed. CI kills at 32
 //! moments spread over the run plus the first of each kind; `SEADS_CRASH_TEST_ALL=1` kills at
-//! every moment (the long variant, 552 kills), `SEADS_CRASH_TEST_EVERY=N` at every N-th.
+//! every moment (the long variant, about 540 kills), `SEADS_CRASH_TEST_EVERY=N` at every N-th.
 
 use std::path::{Path, PathBuf};
 use std::process::Command;
@@ -17,25 +17,34 @@ use crate::common::{kill_at_moment, metrics_without_clock, park_at_moment};
 
 const SEADS: &str = env!("CARGO_BIN_EXE_seads");
 
-/// A small run: 144 epochs of 8 short episodes, updates from epoch 4, an evaluation every 4
-/// epochs and a checkpoint every 5 (so checkpoints fall between evaluations too); 552 moments.
+/// A small run: about 140 epochs of 8 short episodes, updates from epoch 4 (4 small SAC batches an
+/// epoch: each kill point costs about one whole run), an evaluation every 4 epochs and a
+/// checkpoint every 5 (so checkpoints fall between evaluations too); about 540 moments.
 fn config(dir: &Path) -> PathBuf {
-    let text = std::fs::read_to_string(concat!(
+    let mut text = std::fs::read_to_string(concat!(
         env!("CARGO_MANIFEST_DIR"),
         "/../../configs/lightsout-cursor.toml"
     ))
-    .unwrap()
-    .replace("seed = 1", "seed = 5")
-    .replace("env_steps = 500000", "env_steps = 1600")
-    .replace("episodes_per_epoch = 32", "episodes_per_epoch = 8")
-    .replace("hidden = [256, 256]", "hidden = [32, 32]")
-    .replace("sampled_episodes = 256", "sampled_episodes = 32")
-    .replace("recent_episodes = 256", "recent_episodes = 16")
-    .replace("eval_every = 100", "eval_every = 4")
-    .replace("checkpoint_every = 100", "checkpoint_every = 5")
-    .replace("eval_seeds = 20", "eval_seeds = 1")
-    .replace("sac_threads_alone = 2", "sac_threads_alone = 0")
-    .replace("portable_numerics = false", "portable_numerics = true");
+    .unwrap();
+    for (from, to) in [
+        ("seed = 1", "seed = 5"),
+        ("env_steps = 500000", "env_steps = 1600"),
+        ("episodes_per_epoch = 32", "episodes_per_epoch = 8"),
+        ("hidden = [256, 256]", "hidden = [32, 32]"),
+        ("batch_size = 128", "batch_size = 32"),
+        ("updates_per_epoch = 16", "updates_per_epoch = 4"),
+        ("sampled_episodes = 256", "sampled_episodes = 32"),
+        ("recent_episodes = 256", "recent_episodes = 16"),
+        ("eval_every = 100", "eval_every = 4"),
+        ("checkpoint_every = 100", "checkpoint_every = 5"),
+        ("eval_seeds = 20", "eval_seeds = 1"),
+        ("sac_threads_alone = 2", "sac_threads_alone = 0"),
+        ("portable_numerics = false", "portable_numerics = true"),
+    ] {
+        // A preset that no longer says `from` would leave the run silently larger.
+        assert!(text.contains(from), "the preset no longer says {from:?}");
+        text = text.replace(from, to);
+    }
     let path = dir.join("crash.toml");
     std::fs::write(&path, text).unwrap();
     path
