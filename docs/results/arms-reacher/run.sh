@@ -18,7 +18,7 @@ for r in "$@"; do
     sed 's/^sac_threads_alone = 2$/sac_threads_alone = 0/' $S/$r/config.toml > $R.toml
     A=(--config $R.toml --out $R)
   fi
-  $T train "${A[@]}" --quiet >> $R.log 2>&1 || { echo "$(date +%H:%M) arms $r train exit $?" >> done.log; continue; }
+  $T train "${A[@]}" --quiet >> $R.log 2>&1 || { rc=$?; echo "$(date +%H:%M) arms $r train exit $rc" >> done.log; continue; }
   echo "$(date +%H:%M) arms $r trained" >> done.log
   case $r in
     */seads/*)
@@ -27,7 +27,7 @@ for r in "$@"; do
         [ $mode = replan ] && M=--replan || M=
         $E evaluate --run $R $M --quiet >> $R.eval.log 2>&1
       done
-      echo "$(date +%H:%M) arms $r evaluated exit $?" >> done.log ;;
+      rc=$?; echo "$(date +%H:%M) arms $r evaluated exit $rc" >> done.log ;;
   esac
   cp -a $R/. $S/$r/
 done

@@ -28,7 +28,7 @@ for search in both-ends breadth; do
       [[ -f $d/evaluation-replan-depths-$depth-$depth.json ]] && continue
       "$B" evaluate --run "$d" --replan --depths "$depth-$depth" --boards 20 --search $search \
         --memory-limit 16 --quiet >> "$here/$search.log" 2>&1
-      echo "$(date +%H:%M) $search seed $s depth $depth exit $?" >> "$here/done.log"
+      rc=$?; echo "$(date +%H:%M) $search seed $s depth $depth exit $rc" >> "$here/done.log"
     done
   done
 done

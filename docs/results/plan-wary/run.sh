@@ -19,7 +19,7 @@ for job in 2:10 3:10 2:9 4:9 1:9 3:9 4:10 1:10; do
   [[ -f $d/evaluation-replan-depths-$depth-$depth.json ]] && continue
   $B evaluate --run "$d" --replan --depths $depth-$depth --boards 20 --search both-ends \
     --memory-limit 16 --plan most-likely-wary --quiet >> "$W/run.log" 2>&1
-  echo "$(date +%H:%M) wary seed $s depth $depth exit $?" >> "$W/done.log"
+  rc=$?; echo "$(date +%H:%M) wary seed $s depth $depth exit $rc" >> "$W/done.log"
 done
 # Depths 1-5 (the standard 20 test boards per depth), both choices, the same agents and protocol:
 # whether the wary choice costs anything where repeated failures are rare. A copy per choice.
@@ -34,6 +34,6 @@ for s in 1 2 3 4; do
     [[ -f $d/evaluation-replan.json ]] && continue
     $B evaluate --run "$d" --replan --boards 20 --search both-ends --memory-limit 16 --plan $c \
       --quiet >> "$W/run.log" 2>&1
-    echo "$(date +%H:%M) $c seed $s depths 1-5 exit $?" >> "$W/done.log"
+    rc=$?; echo "$(date +%H:%M) $c seed $s depths 1-5 exit $rc" >> "$W/done.log"
   done
 done

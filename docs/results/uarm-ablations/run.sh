@@ -52,7 +52,7 @@ train() { # SETTING...: train each setting's two seeds that have not trained
         rm -rf $run
         $B uarm train --port sim:$seed --seed $seed $opts --out $run --cores 1 --quiet --max-expanded 1 >> $log 2>&1
       fi
-      echo "$(date +%H:%M) $name-$seed trained, exit $?" >> $here/done.log
+      rc=$?; echo "$(date +%H:%M) $name-$seed trained, exit $rc" >> $here/done.log
     done
   done
 }
@@ -68,7 +68,7 @@ evaluate() { # SETTING...: evaluate their trained runs, the highest final covera
     name=$(basename $run) seed=${run##*-}
     [[ -f $run/evaluation-replan-tasks.jsonl ]] && continue
     $E uarm evaluate --port sim:$seed --run $run --quiet --max-expanded 1048576 >> $here/logs/$name.log 2>&1
-    echo "$(date +%H:%M) $name evaluated, exit $?" >> $here/done.log
+    rc=$?; echo "$(date +%H:%M) $name evaluated, exit $rc" >> $here/done.log
   done
 }
 train "${new[@]}"
