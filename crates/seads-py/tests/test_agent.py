@@ -31,6 +31,7 @@ def test_the_agent_names_its_run(agent):
     assert (agent.env, agent.epoch, agent.num_skills) == ("lightsout-cursor", 510, 25)
 
 
+@pytest.mark.without_gymnasium
 def test_plans_are_the_binarys_first_plans(agent):
     for task in TASKS:
         if task["plan_found"]:
@@ -40,6 +41,7 @@ def test_plans_are_the_binarys_first_plans(agent):
                 agent.plan(board(task), max_expanded=20000)
 
 
+@pytest.mark.without_gymnasium
 def test_tasks_end_as_the_binarys_evaluation_task_for_task(agent):
     solved = 0
     for task in TASKS:
