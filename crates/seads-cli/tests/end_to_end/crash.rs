@@ -5,7 +5,7 @@
 //! of the run (after collecting an epoch, while SAC updates, after an epoch, after a metrics
 //! append, between the steps of a checkpoint write) and waits there to be killed. CI kills at 32
 //! moments spread over the run plus the first of each kind; `SEADS_CRASH_TEST_ALL=1` kills at
-//! every moment (the long variant, about 540 kills), `SEADS_CRASH_TEST_EVERY=N` at every N-th.
+//! every moment (the long variant, 536 kills), `SEADS_CRASH_TEST_EVERY=N` at every N-th.
 
 use std::path::{Path, PathBuf};
 use std::process::Command;
@@ -17,9 +17,9 @@ use crate::common::{kill_at_moment, metrics_without_clock, park_at_moment};
 
 const SEADS: &str = env!("CARGO_BIN_EXE_seads");
 
-/// A small run: about 140 epochs of 8 short episodes, updates from epoch 4 (4 small SAC batches an
+/// A small run: 140 epochs of 8 short episodes, updates from epoch 4 (4 small SAC batches an
 /// epoch: each kill point costs about one whole run), an evaluation every 4 epochs and a
-/// checkpoint every 5 (so checkpoints fall between evaluations too); about 540 moments.
+/// checkpoint every 5 (so checkpoints fall between evaluations too); 536 moments.
 fn config(dir: &Path) -> PathBuf {
     let mut text = std::fs::read_to_string(concat!(
         env!("CARGO_MANIFEST_DIR"),
