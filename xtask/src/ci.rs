@@ -48,10 +48,10 @@ pub fn run() -> Result<()> {
 
 /// The Python package: installed from `crates/seads-py` into the virtual environment
 /// `target/py-venv` (made on first use; pip fetches maturin, NumPy, Gymnasium and pytest), built
-/// with the dev profile into the workspace's `target/` (cargo resolves the features of the
-/// package's dependencies for it alone, so some of them, nalgebra, parry and rapier among them,
-/// compile again), then its pytest suite with the newest Gymnasium and, leaving out the tests that
-/// touch no Gymnasium API, with the lowest; each closing line is added to the totals.
+/// with the dev profile into the workspace's `target/` (reusing the workspace build's
+/// dependencies: the package's manifest asks for the features the workspace turns on, since
+/// maturin builds it alone), then its pytest suite with the newest Gymnasium and, leaving out the
+/// tests that touch no Gymnasium API, with the lowest; each closing line is added to the totals.
 fn python_tests(totals: &mut Totals) -> Result<()> {
     let python = py_venv()?;
     pip_install(
