@@ -1784,7 +1784,7 @@ proptest::proptest! {
     /// or a memory kill; a command that accepts a huge value may still be working at the end.
     #[test]
     fn numeric_options_never_panic(
-        option in 0usize..13,
+        option in 0usize..14,
         value in proptest::sample::select(vec![
             "0", "1", "-1", "nan", "inf", "-inf", "1e300", "1e-300", "4294967297",
             "9223372036854775807", "18446744073709551615", "18446744073709551616", "abc", "",
