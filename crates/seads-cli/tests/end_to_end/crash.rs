@@ -3,9 +3,9 @@
 //!
 //! The moments are deterministic: with `SEADS_CRASH_POINT=N` the binary stops at the N-th moment
 //! of the run (after collecting an epoch, while SAC updates, after an epoch, after a metrics
-//! append, between the steps of a checkpoint write) and waits there to be killed. CI kills at 32
+//! append, between the steps of a checkpoint write) and waits there to be killed. CI kills at 24
 //! moments spread over the run plus the first of each kind; `SEADS_CRASH_TEST_ALL=1` kills at
-//! every moment (the long variant, 536 kills), `SEADS_CRASH_TEST_EVERY=N` at every N-th.
+//! every moment (the long variant, 190 kills), `SEADS_CRASH_TEST_EVERY=N` at every N-th.
 
 use std::path::{Path, PathBuf};
 use std::process::Command;
@@ -17,9 +17,10 @@ use crate::common::{kill_at_moment, metrics_without_clock, park_at_moment};
 
 const SEADS: &str = env!("CARGO_BIN_EXE_seads");
 
-/// A small run: 140 epochs of 8 short episodes, updates from epoch 4 (4 small SAC batches an
-/// epoch: each kill point costs about one whole run), an evaluation every 4 epochs and a
-/// checkpoint every 5 (so checkpoints fall between evaluations too); 536 moments.
+/// A small run: 800 steps in epochs of 8 short episodes, updates from epoch 4 (4 small SAC
+/// batches an epoch: each kill point costs about one whole run), an evaluation every 4 epochs
+/// (14 in all) and a checkpoint every 5 (so checkpoints fall between evaluations too); 190
+/// moments.
 fn config(dir: &Path) -> PathBuf {
     let mut text = std::fs::read_to_string(concat!(
         env!("CARGO_MANIFEST_DIR"),
@@ -28,7 +29,7 @@ fn config(dir: &Path) -> PathBuf {
     .unwrap();
     for (from, to) in [
         ("seed = 1", "seed = 5"),
-        ("env_steps = 500000", "env_steps = 1600"),
+        ("env_steps = 500000", "env_steps = 800"),
         ("episodes_per_epoch = 32", "episodes_per_epoch = 8"),
         ("hidden = [256, 256]", "hidden = [32, 32]"),
         ("batch_size = 128", "batch_size = 32"),
@@ -154,7 +155,7 @@ fn kill_and_resume(point: usize, tear: bool) -> String {
     String::from_utf8_lossy(&output.stderr).into_owned()
 }
 
-/// The moments to kill at: 32 spread over the run and the first of each kind; every moment with
+/// The moments to kill at: 24 spread over the run and the first of each kind; every moment with
 /// `SEADS_CRASH_TEST_ALL=1`, every N-th with `SEADS_CRASH_TEST_EVERY=N`.
 fn points() -> Vec<usize> {
     let moments = &baseline().moments;
@@ -167,7 +168,7 @@ fn points() -> Vec<usize> {
         let every: usize = every.parse().expect("SEADS_CRASH_TEST_EVERY is a number");
         return (1..=n).step_by(every.max(1)).collect();
     }
-    let mut points: Vec<usize> = (0..32).map(|i| 1 + i * (n - 1) / 31).collect();
+    let mut points: Vec<usize> = (0..24).map(|i| 1 + i * (n - 1) / 23).collect();
     for kind in [
         "collected",
         "prepared",
