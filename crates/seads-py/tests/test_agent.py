@@ -16,6 +16,9 @@ import seads
 DATA = pathlib.Path(__file__).with_name("data")
 RUN = DATA / "agent-run"
 TASKS = [json.loads(line) for line in open(RUN / "evaluation-replan-tasks.jsonl")]
+# The bound of every search of that evaluation (`make_agent_run.sh`): a search that finds no plan
+# stops here, as the binary's did.
+MAX_EXPANDED = 2000
 
 
 @pytest.fixture(scope="module")
@@ -35,10 +38,10 @@ def test_the_agent_names_its_run(agent):
 def test_plans_are_the_binarys_first_plans(agent):
     for task in TASKS:
         if task["plan_found"]:
-            assert agent.plan(board(task), max_expanded=20000) == task["first_plan"], task
+            assert agent.plan(board(task), max_expanded=MAX_EXPANDED) == task["first_plan"], task
         else:
             with pytest.raises(ValueError):
-                agent.plan(board(task), max_expanded=20000)
+                agent.plan(board(task), max_expanded=MAX_EXPANDED)
 
 
 @pytest.mark.without_gymnasium
@@ -50,7 +53,7 @@ def test_tasks_end_as_the_binarys_evaluation_task_for_task(agent):
         env.seed(task["seed"])
         env.reset()
         assert list(env.board()) == list(board(task))
-        result = agent.solve(env, max_expanded=20000)
+        result = agent.solve(env, max_expanded=MAX_EXPANDED)
         assert result["solved"] == task["solved"], task
         assert result["skills"] == task["executed"], task
         assert result["steps"] == sum(task["skill_steps"]), task
@@ -62,7 +65,7 @@ def test_a_gymnasium_environment_is_solved_in_place(agent):
     task = next(t for t in TASKS if t["solved"] and t["depth"] >= 2)
     env = gymnasium.make("seads/LightsOutCursor-v0")
     env.reset(seed=1)
-    result = agent.solve(env, board=board(task), max_expanded=20000)
+    result = agent.solve(env, board=board(task), max_expanded=MAX_EXPANDED)
     assert result["solved"]
     assert len(result["moves"]) == len(result["skills"]) >= task["depth"]
     assert env.unwrapped.board().sum() == 0, "the environment's board is solved"
@@ -133,8 +136,8 @@ def test_a_rendered_solution_is_the_same_solution_filmed(agent):
     for env in (plain, filmed):
         env.reset(seed=4)
     before = filmed.render()
-    a = agent.solve(plain, board=board(task), max_expanded=20000)
-    b = agent.solve(filmed, board=board(task), max_expanded=20000, render=True)
+    a = agent.solve(plain, board=board(task), max_expanded=MAX_EXPANDED)
+    b = agent.solve(filmed, board=board(task), max_expanded=MAX_EXPANDED, render=True)
     assert (a["skills"], a["steps"], a["solved"]) == (b["skills"], b["steps"], b["solved"])
     assert "frames" not in a and len(b["frames"]) == b["steps"] + 1
     assert all(f.shape == (256, 256, 3) and f.dtype == np.uint8 for f in b["frames"])

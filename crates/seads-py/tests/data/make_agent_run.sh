@@ -3,7 +3,7 @@
 # binary; run from the workspace root): a LightsOutCursor run with 64-wide networks, 30000
 # steps, portable kernels (agent-run-train.toml), of which the test data keep the config and the
 # last checkpoint's actor and forward model; then `seads evaluate` with re-planning on 5 boards
-# per depth 1-5 and 20000 expanded states per search, whose tasks file the Python agent must
+# per depth 1-5 and 2000 expanded states per search, whose tasks file the Python agent must
 # repeat task for task.
 set -euo pipefail
 data=crates/seads-py/tests/data
@@ -19,6 +19,6 @@ for f in config.toml origin.json forward_model.safetensors sac_actor.safetensors
   cp "$tmp/run/checkpoints/$latest/$f" "$data/agent-run/checkpoints/$latest/"
 done
 cp -r "$data/agent-run" "$tmp/eval"
-"$seads" evaluate --run "$tmp/eval" --replan --boards 5 --max-expanded 20000 --quiet
+"$seads" evaluate --run "$tmp/eval" --replan --boards 5 --max-expanded 2000 --quiet
 cp "$tmp/eval/evaluation-replan-tasks.jsonl" "$data/agent-run/"
 rm -rf "$tmp"
