@@ -105,6 +105,31 @@ fn normal_graph(meta: &serde_json::Value) -> Vec<(String, String, Vec<String>)> 
         .collect()
 }
 
+/// Every package the dev profile names (`[profile.dev.package]`: what it compiles unoptimised)
+/// is one the workspace builds: a dependency renamed or dropped would leave a stale line that
+/// cargo only warns about, and its successor compiled optimised.
+#[test]
+fn the_dev_profile_names_only_packages_the_workspace_builds() {
+    let manifest: toml::Table = toml::from_str(&read("Cargo.toml")).unwrap();
+    let named = manifest["profile"]["dev"]["package"].as_table().unwrap();
+    let meta = metadata();
+    let built: std::collections::BTreeSet<&str> = meta["packages"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|p| p["name"].as_str().unwrap())
+        .collect();
+    let stale: Vec<&String> = named
+        .keys()
+        .filter(|name| *name != "*" && !built.contains(name.as_str()))
+        .collect();
+    assert!(named.len() > 10, "{named:?}");
+    assert!(
+        stale.is_empty(),
+        "Cargo.toml's [profile.dev.package] names {stale:?}, which nothing builds"
+    );
+}
+
 /// The internal dependencies are the ones docs/ARCHITECTURE.md states, and only the crates it
 /// names link libtorch (tch), counting dependencies of dependencies.
 #[test]
