@@ -214,7 +214,13 @@ fn usage_error(e: clap::Error) -> ! {
     if !e.use_stderr() {
         e.exit();
     }
-    // The first paragraph: the message, and any arguments it lists on the lines below it.
+    eprintln!("{}", usage_message(&e));
+    std::process::exit(2)
+}
+
+/// A usage error on one line: the first paragraph of clap's message (the message, and any
+/// arguments it lists on the lines below it), pointing to `--help`.
+fn usage_message(e: &clap::Error) -> String {
     let text = e.to_string();
     let message: Vec<&str> = text
         .lines()
@@ -223,11 +229,10 @@ fn usage_error(e: clap::Error) -> ! {
         .take_while(|l| !l.is_empty())
         .collect();
     if message.is_empty() {
-        eprintln!("error: invalid arguments (see --help)");
+        "error: invalid arguments (see --help)".to_owned()
     } else {
-        eprintln!("{} (see --help)", message.join(" "));
+        format!("{} (see --help)", message.join(" "))
     }
-    std::process::exit(2)
 }
 
 /// Whether `command` trains or plans, where libtorch runs parallel regions on several threads
@@ -313,6 +318,89 @@ fn main() -> ExitCode {
             } else {
                 ExitCode::FAILURE
             }
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use clap::CommandFactory;
+    use clap::error::ErrorKind;
+
+    use super::*;
+
+    /// Every command that runs (a command without subcommands), with the words that name it.
+    fn leaves(
+        command: &clap::Command,
+        path: &[String],
+        out: &mut Vec<(Vec<String>, clap::Command)>,
+    ) {
+        if command.get_subcommands().next().is_none() {
+            out.push((path.to_vec(), command.clone()));
+        }
+        for sub in command.get_subcommands() {
+            let mut path = path.to_vec();
+            path.push(sub.get_name().to_owned());
+            leaves(sub, &path, out);
+        }
+    }
+
+    /// clap's refusal of `seads PATH --OPTION=VALUE` for that value, if it refuses the value
+    /// (other errors, such as a required argument left out, come after the values are read).
+    fn refusal(path: &[String], option: &str, value: &str) -> Option<clap::Error> {
+        let arg = format!("--{option}={value}");
+        let args = std::iter::once("seads")
+            .chain(path.iter().map(String::as_str))
+            .chain([arg.as_str()]);
+        let refused = [ErrorKind::ValueValidation, ErrorKind::InvalidValue];
+        Cli::try_parse_from(args)
+            .err()
+            .filter(|e| refused.contains(&e.kind()))
+    }
+
+    /// Every option that takes a number (accepts one of 1, 5, 0.5 and refuses a word) refuses
+    /// negative, NaN and infinite values as a one-line usage error, so no such value reaches
+    /// the code (issue 13: `--timeout=-1` and `--timeout nan` panicked). Found from the command
+    /// line's definition, so a new option is checked without being listed.
+    #[test]
+    fn every_numeric_option_refuses_negative_nan_and_infinite_values() {
+        let mut commands = Vec::new();
+        leaves(&Cli::command(), &[], &mut commands);
+        let mut checked = Vec::new();
+        for (path, command) in &commands {
+            for arg in command.get_arguments() {
+                let Some(long) = arg.get_long() else { continue };
+                let numeric = arg.get_action().takes_values()
+                    && ["1", "5", "0.5"]
+                        .iter()
+                        .any(|v| refusal(path, long, v).is_none())
+                    && refusal(path, long, "word").is_some();
+                if !numeric {
+                    continue;
+                }
+                for value in ["-1", "nan", "inf", "-inf"] {
+                    let e = refusal(path, long, value)
+                        .unwrap_or_else(|| panic!("seads {path:?} --{long}={value} is accepted"));
+                    let message = usage_message(&e);
+                    assert!(
+                        message.starts_with("error") && message.lines().count() == 1,
+                        "seads {path:?} --{long}={value}: {message}"
+                    );
+                }
+                checked.push(format!("{} --{long}", path.join(" ")));
+            }
+        }
+        // The options the end-to-end test listed by hand before this one found them.
+        for known in [
+            "run --timeout",
+            "render --spacing",
+            "uarm calibrate --d-max-mm",
+            "plan-bench --threads",
+        ] {
+            assert!(
+                checked.iter().any(|c| c == known),
+                "{known} not found: {checked:?}"
+            );
         }
     }
 }

@@ -75,6 +75,18 @@ pub fn non_negative_finite(text: &str) -> Result<f64, String> {
     }
 }
 
+/// A command-line probability: a number from 0 to 1 (NaN refused).
+pub fn probability(text: &str) -> Result<f64, String> {
+    let value: f64 = text
+        .parse()
+        .map_err(|_| format!("{text:?} is not a number"))?;
+    if (0.0..=1.0).contains(&value) {
+        Ok(value)
+    } else {
+        Err(format!("{text} must be a probability, from 0 to 1"))
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -209,11 +209,12 @@ pub struct UarmTrainArgs {
     observe: Option<Observation>,
     /// The twin only: standard deviation, mm, of where a tap lands around the commanded point
     /// (pen offset, the arm's repeatability). A resumed run keeps its own.
-    #[arg(long, default_value_t = 0.0, value_name = "MM")]
+    #[arg(long, default_value_t = 0.0, value_name = "MM",
+          value_parser = crate::numbers::non_negative_finite)]
     tap_sd_mm: f64,
     /// The twin only: probability that the tablet logs a tap too late for its press (the report
     /// comes with the next press's). A resumed run keeps its own.
-    #[arg(long, default_value_t = 0.0, value_name = "P")]
+    #[arg(long, default_value_t = 0.0, value_name = "P", value_parser = crate::numbers::probability)]
     late_reports: f64,
     /// The training settings that a new run may change from the robot's (`seads uarm train`'s
     /// defaults); a resumed run keeps its `config.toml`.

@@ -11,8 +11,9 @@ pub struct PlanBenchArgs {
     /// The game whose move table the model is fitted to (one whose boards can be listed).
     #[arg(long, default_value = "lightsout")]
     game: seads_games::GameKind,
-    /// Hidden layer sizes of the forward model (the paper's: 256,256).
-    #[arg(long, default_value = "256,256", value_delimiter = ',')]
+    /// Hidden layer sizes of the forward model (the paper's: 256,256), each from 1 to 16384.
+    #[arg(long, default_value = "256,256", value_delimiter = ',',
+          value_parser = clap::value_parser!(i64).range(1..=MAX_WIDTH))]
     hidden: Vec<i64>,
     /// Solution depths of the benchmark boards.
     #[arg(long, default_value = "5,7,9", value_delimiter = ',')]
@@ -47,7 +48,8 @@ pub struct PlanBenchArgs {
     json: bool,
 }
 
-/// The widest hidden layer `--hidden` may ask for (the paper's is 256).
+/// The widest hidden layer `--hidden` may ask for (the paper's is 256): a size beyond it would
+/// exhaust memory inside libtorch.
 const MAX_WIDTH: i64 = 16_384;
 
 /// `seads plan-bench`: BFS with a forward model fitted to a game's move table.
@@ -55,14 +57,6 @@ pub fn plan_bench(args: PlanBenchArgs) -> Result<()> {
     let device = crate::usable_device(args.device)?;
     let threads = args.threads as usize;
     crate::check_threads("--threads", threads)?;
-    // The fitted model's layers: a size beyond these would exhaust memory inside libtorch.
-    if args.hidden.is_empty() || args.hidden.iter().any(|&h| !(1..=MAX_WIDTH).contains(&h)) {
-        return Err(crate::BadInput(anyhow::anyhow!(
-            "--hidden {:?}: one or more layer sizes, each from 1 to {MAX_WIDTH}",
-            args.hidden
-        ))
-        .into());
-    }
     // The search's parts and bookkeeping run on the pool, each part on one libtorch thread.
     seads_rl::set_threads(1);
     let pool = rayon::ThreadPoolBuilder::new()

@@ -971,7 +971,7 @@ fn thread_counts_beyond_the_machine_are_refused() {
     );
     check_bad_input(
         &["plan-bench", "--depths", "1", "--hidden", "1000000,1000000"],
-        "each from 1 to 16384",
+        "not in 1..=16384",
     );
     assert_eq!(snapshot(&out), planned, "nothing trained or written");
 }
