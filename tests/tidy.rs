@@ -233,20 +233,13 @@ fn crate_dependencies_point_one_way_and_only_five_crates_link_libtorch() {
     );
 }
 
-/// The packages `cargo tree` lists for `args` (normal dependencies only), one name per entry.
-fn tree(args: &[&str]) -> Vec<String> {
+/// `cargo tree`'s lines for `args`, following the dependencies of kinds `edges`, each package
+/// as `format` writes it (without the mark of one already listed).
+fn cargo_tree(edges: &str, format: &str, args: &[&str]) -> Vec<String> {
     let cargo = std::env::var("CARGO").unwrap_or_else(|_| "cargo".into());
     let out = std::process::Command::new(cargo)
-        .args([
-            "tree",
-            "--offline",
-            "-e",
-            "normal",
-            "--prefix",
-            "none",
-            "--format",
-            "{p}",
-        ])
+        .args(["tree", "--offline", "--locked", "-e", edges])
+        .args(["--prefix", "none", "--format", format])
         .args(args)
         .current_dir(root())
         .output()
@@ -258,6 +251,14 @@ fn tree(args: &[&str]) -> Vec<String> {
     );
     String::from_utf8_lossy(&out.stdout)
         .lines()
+        .map(|l| l.trim_end_matches(" (*)").trim_end().to_owned())
+        .collect()
+}
+
+/// The packages `cargo tree` lists for `args` (normal dependencies only), one name per entry.
+fn tree(args: &[&str]) -> Vec<String> {
+    cargo_tree("normal", "{p}", args)
+        .iter()
         .filter_map(|l| l.split_whitespace().next().map(str::to_owned))
         .collect()
 }
@@ -300,6 +301,28 @@ fn light_crates_pull_in_neither_libtorch_nor_rapier() {
         tree(&["-p", "seads-embodiment"])
             .iter()
             .any(|p| p == "rapier3d")
+    );
+}
+
+/// The Python package's build (maturin builds `seads-py` alone) compiles every dependency with
+/// the features the workspace's test build gives it, so that `cargo xtask ci` compiles each
+/// once: cargo resolves features for the packages one build names, and the lines of
+/// `crates/seads-py/Cargo.toml` that the code does not use exist to ask for the workspace's.
+/// A dependency that differs here compiles a second time, with its dependents (282 s when
+/// rapier3d's tree did).
+#[test]
+fn the_python_package_compiles_its_dependencies_as_the_workspace_does() {
+    let with_features = |edges: &str, args: &[&str]| -> std::collections::BTreeSet<String> {
+        cargo_tree(edges, "{p} {f}", args).into_iter().collect()
+    };
+    let workspace = with_features("normal,build,dev", &["--workspace"]);
+    let python = with_features("normal,build", &["-p", "seads-py"]);
+    assert!(python.len() > 50, "{python:?}");
+    let differing: Vec<&String> = python.difference(&workspace).collect();
+    assert!(
+        differing.is_empty(),
+        "seads-py alone builds these with other features than the workspace (package, \
+         features): {differing:?}; add them to crates/seads-py/Cargo.toml's list"
     );
 }
 
