@@ -113,9 +113,9 @@ pub struct NoOptions {}
 /// What a configuration states, in the current layout or in the older one that kept the Jaco's
 /// `physics_substeps` beside the board options (committed Jaco runs' files); read into
 /// [`EnvConfig`], which writes the current layout only. A key left out takes
-/// [`EnvConfig::default`]'s value.
+/// [`EnvConfig::default`]'s value; an unknown key is an error that lists the current layout's
+/// keys only.
 #[derive(Deserialize)]
-#[serde(deny_unknown_fields)]
 struct Stated {
     #[serde(default)]
     board_size: Option<usize>,
@@ -131,10 +131,26 @@ struct Stated {
     step_limit: Option<usize>,
     #[serde(default)]
     manipulator: serde_json::Map<String, serde_json::Value>,
-    /// The older layout's place of the Jaco's option.
-    #[serde(default)]
-    physics_substeps: Option<serde_json::Value>,
+    /// Every other key: the older layout's `physics_substeps`, or a mistake.
+    #[serde(flatten)]
+    other: serde_json::Map<String, serde_json::Value>,
 }
+
+/// Keys that the older layout kept beside the board options and the current one keeps in
+/// `manipulator` (the Jaco's `physics_substeps`, in committed Jaco runs' files): such a file
+/// still loads, the key moved into `manipulator`.
+pub const MOVED_TO_MANIPULATOR: [&str; 1] = ["physics_substeps"];
+
+/// The keys of the current layout, as an unknown key's error lists them.
+const KEYS: [&str; 7] = [
+    "board_size",
+    "spacing",
+    "reset_split",
+    "max_solution_depth",
+    "random_solution_depth",
+    "step_limit",
+    "manipulator",
+];
 
 fn train() -> Split {
     EnvConfig::default().reset_split
@@ -153,15 +169,21 @@ impl TryFrom<Stated> for EnvConfig {
 
     fn try_from(stated: Stated) -> Result<Self, String> {
         let mut manipulator = stated.manipulator;
-        if let Some(value) = stated.physics_substeps {
-            const KEY: &str = "physics_substeps";
-            if manipulator.contains_key(KEY) {
+        for (key, value) in stated.other {
+            if !MOVED_TO_MANIPULATOR.contains(&key.as_str()) {
+                let expected: Vec<String> = KEYS.iter().map(|k| format!("`{k}`")).collect();
                 return Err(format!(
-                    "{KEY} is given twice: beside the board options (the older layout) and in \
+                    "unknown field `{key}`, expected one of {}",
+                    expected.join(", ")
+                ));
+            }
+            if manipulator.contains_key(&key) {
+                return Err(format!(
+                    "{key} is given twice: beside the board options (the older layout) and in \
                      `manipulator`; keep the one in `manipulator`"
                 ));
             }
-            manipulator.insert(KEY.into(), value);
+            manipulator.insert(key, value);
         }
         Ok(Self {
             board_size: stated.board_size,
@@ -208,6 +230,27 @@ mod tests {
         assert!(err.contains("given twice"), "{err}");
         let unknown = parse("substeps = 25").unwrap_err().to_string();
         assert!(unknown.contains("unknown field `substeps`"), "{unknown}");
+        // The older layout's key is read, not offered.
+        assert!(unknown.contains("`manipulator`"), "{unknown}");
+        assert!(!unknown.contains("physics_substeps"), "{unknown}");
+    }
+
+    #[test]
+    fn an_unknown_keys_error_lists_every_key_written() {
+        let mut full = EnvConfig {
+            board_size: Some(7),
+            spacing: Some(0.5),
+            step_limit: Some(10),
+            ..EnvConfig::default()
+        };
+        full.manipulator
+            .insert("physics_substeps".into(), 25.into());
+        let written: toml::Table = toml::from_str(&toml::to_string(&full).unwrap()).unwrap();
+        let mut keys: Vec<&str> = written.keys().map(String::as_str).collect();
+        keys.sort_unstable();
+        let mut listed = KEYS.to_vec();
+        listed.sort_unstable();
+        assert_eq!(keys, listed);
     }
 
     #[test]

@@ -65,7 +65,7 @@ mod spec;
 mod task;
 
 pub use board::BoardState;
-pub use config::{EnvConfig, NoOptions};
+pub use config::{EnvConfig, MOVED_TO_MANIPULATOR, NoOptions};
 pub use cursor::Cursor;
 pub use embodied::{Embodied, Environment, Manipulator, Touch};
 pub use error::EnvError;

@@ -1,6 +1,6 @@
 //! The training configuration: one TOML file per run, with a preset per environment.
 
-use seads_embodiment::{EnvConfig, env_names};
+use seads_embodiment::{EnvConfig, MOVED_TO_MANIPULATOR, env_names};
 use seads_nn::ComputeDevice;
 use serde::{Deserialize, Serialize};
 
@@ -220,6 +220,7 @@ impl TrainConfig {
             .to_toml()
             .parse()
             .expect("a serialised preset parses");
+        forget_what_the_older_layout_states(&mut merged, &table);
         merge_toml(&mut merged, &table);
         Self::from_table(merged)
     }
@@ -426,6 +427,25 @@ pub fn machine_memory_bytes() -> u64 {
             kib.checked_mul(1024)
         })
         .unwrap_or(u64::MAX)
+}
+
+/// Removes from `preset` each manipulator option that `stated` gives in the older layout of
+/// `[env_config]` (beside the board options), so that the file's value replaces the preset's
+/// when `stated` is laid over it, as in the current layout.
+fn forget_what_the_older_layout_states(preset: &mut toml::Table, stated: &toml::Table) {
+    let Some(toml::Value::Table(stated)) = stated.get("env_config") else {
+        return;
+    };
+    let Some(toml::Value::Table(env_config)) = preset.get_mut("env_config") else {
+        return;
+    };
+    if let Some(toml::Value::Table(manipulator)) = env_config.get_mut("manipulator") {
+        for key in MOVED_TO_MANIPULATOR {
+            if stated.contains_key(key) {
+                manipulator.remove(key);
+            }
+        }
+    }
 }
 
 /// Lays `layer` over `base`: a key of `layer` replaces `base`'s, except that two tables merge,
@@ -645,6 +665,43 @@ mod tests {
             }
         }
         assert_eq!(jaco, 9);
+    }
+
+    /// A Jaco run's file in the older layout (`physics_substeps` beside the board options, as
+    /// the committed Jaco runs' `config.toml`) loads over the preset, which states the option in
+    /// `[env_config.manipulator]`, and its own value is the one taken.
+    #[test]
+    fn a_jaco_file_in_the_older_layout_loads_with_its_own_value() {
+        let older = |substeps: u64| {
+            format!(
+                "env = \"lightsout-jaco\"\n[env_config]\nmax_solution_depth = 5\nphysics_substeps = {substeps}\n"
+            )
+        };
+        for substeps in [25, 10] {
+            let config = TrainConfig::from_user_toml(&older(substeps), None, None).unwrap();
+            assert_eq!(
+                config.env_config.manipulator.get("physics_substeps"),
+                Some(&serde_json::Value::from(substeps))
+            );
+            let mut current = TrainConfig::preset("lightsout-jaco").unwrap();
+            current
+                .env_config
+                .manipulator
+                .insert("physics_substeps".into(), substeps.into());
+            assert_eq!(config, current);
+        }
+        let committed =
+            "../../docs/results/jaco/runs/arms/runs/lightsout-jaco/seads/seed-1/config.toml";
+        let text = std::fs::read_to_string(committed).unwrap();
+        assert!(text.contains("\nphysics_substeps = 25"), "{text}");
+        TrainConfig::from_user_toml(&text, None, None).unwrap();
+        // Both layouts in one file are still refused.
+        let twice = format!(
+            "{}[env_config.manipulator]\nphysics_substeps = 25\n",
+            older(25)
+        );
+        let err = TrainConfig::from_user_toml(&twice, None, None).unwrap_err();
+        assert!(err.to_string().contains("given twice"), "{err}");
     }
 
     #[test]

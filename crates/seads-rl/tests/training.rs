@@ -492,7 +492,7 @@ fn presets_parse_and_round_trip() {
 }
 
 /// Every run configuration committed with a study (and the test data's) loads, whichever layout
-/// it was written in, and keeps every value it states: a flat file's SEADS keys reappear in
+/// it was written in, alone and as its run directory is read, and keeps every value it states: a flat file's SEADS keys reappear in
 /// `[seads]`, its `[baseline]` in the baseline's own section (the SEADS keys a baseline's flat
 /// file carried at their defaults are dropped).
 #[test]
@@ -563,6 +563,11 @@ fn every_committed_run_config_loads() {
             );
         }
         assert_eq!(TrainConfig::from_toml(&config.to_toml()).unwrap(), config);
+        // As a run directory is read (the file laid over its preset): every command that opens
+        // the run, `seads report` among them.
+        let dir = path.parent().unwrap();
+        let loaded = seads_rl::load_config(dir).unwrap_or_else(|e| panic!("{e}"));
+        assert_eq!(loaded, config, "{}", path.display());
     }
     assert!(flat > 100, "only {flat} files in the flat layout");
 }
