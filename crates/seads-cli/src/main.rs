@@ -288,6 +288,8 @@ fn main() -> ExitCode {
     if runs_libtorch_in_parallel(&cli.command) {
         seads_nn::process::spin_briefly_in_libgomp();
     }
+    // Every evaluation file this process writes names the binary (`evaluated_by`).
+    build().declare();
     let result = match cli.command {
         Command::Games(cmd) => games::run(cmd),
         Command::Run(args) => demo::run(args),

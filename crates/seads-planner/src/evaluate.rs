@@ -306,7 +306,21 @@ pub struct CheckpointId {
     pub env_steps: Option<u64>,
 }
 
-/// An evaluation file: what was evaluated, how, and the results per depth.
+/// A binary that evaluated: the seads version, the commit it was built from, and whether that
+/// working tree had uncommitted changes. It decides nothing of the results (the protocol does),
+/// so it is recorded beside them, never compared.
+#[derive(Debug, Clone, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Evaluator {
+    /// The seads version.
+    pub seads: String,
+    /// The git commit.
+    pub commit: String,
+    /// Whether tracked files differed from that commit.
+    pub dirty: bool,
+}
+
+/// An evaluation file: what was evaluated, how, by which binaries, and the results per depth.
 #[derive(Debug, Clone, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct EvaluationRecord {
@@ -314,6 +328,11 @@ pub struct EvaluationRecord {
     pub checkpoint: Option<CheckpointId>,
     /// The protocol (`None` in files written before evaluations recorded it).
     pub protocol: Option<Protocol>,
+    /// The binaries that solved its tasks, in the order they began (more than one where a
+    /// stopped evaluation was resumed by another); empty in files written before evaluations
+    /// recorded them, or by a library caller that names none.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub evaluated_by: Vec<Evaluator>,
     /// Per depth.
     pub results: Vec<DepthResult>,
 }
@@ -335,6 +354,7 @@ impl EvaluationRecord {
             Stored::Bare(results) => Self {
                 checkpoint: None,
                 protocol: None,
+                evaluated_by: Vec::new(),
                 results,
             },
         })
@@ -375,6 +395,11 @@ mod tests {
                 }),
                 action_noise: None,
             }),
+            evaluated_by: vec![Evaluator {
+                seads: "0.1.0".into(),
+                commit: "abc".into(),
+                dirty: false,
+            }],
             results: vec![DepthResult::new(1)],
         };
         let noisy = Protocol {
@@ -396,6 +421,7 @@ mod tests {
         assert!(!record.made_with(&noisy));
         let back = EvaluationRecord::from_json(&record.to_json()).unwrap();
         assert_eq!(back.checkpoint, record.checkpoint);
+        assert_eq!(back.evaluated_by, record.evaluated_by);
         assert!(back.made_with(record.protocol.as_ref().unwrap()));
         let other = Protocol {
             tasks: TaskSet::standard(10),
@@ -405,6 +431,7 @@ mod tests {
         let old = serde_json::to_string(&vec![DepthResult::new(2)]).unwrap();
         let old = EvaluationRecord::from_json(&old).unwrap();
         assert_eq!((old.checkpoint, old.protocol), (None, None));
+        assert!(old.evaluated_by.is_empty());
         assert_eq!(old.results[0].depth, 2);
         assert!(EvaluationRecord::from_json("{\"results\": 3}").is_err());
     }

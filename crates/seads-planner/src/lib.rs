@@ -36,8 +36,8 @@ mod protocol;
 
 pub use bfs::{Plan, PlanChoice, PlanError, PlannerConfig, Search, bfs_plan};
 pub use evaluate::{
-    CheckpointId, DepthResult, Evaluation, EvaluationRecord, EvaluationSummary, TaskRecord,
-    TaskSummary, evaluate, evaluate_resuming, summarise,
+    CheckpointId, DepthResult, Evaluation, EvaluationRecord, EvaluationSummary, Evaluator,
+    TaskRecord, TaskSummary, evaluate, evaluate_resuming, summarise,
 };
 pub use execute::{Deviation, SolveConfig, SolveOutcome, solve};
 pub use meet::meet_plan;

@@ -8,8 +8,8 @@ use std::path::Path;
 
 use seads_games::BoardGame;
 use seads_planner::{
-    CheckpointId, DepthResult, Evaluation, EvaluationKind, EvaluationRecord, PlanChoice, Protocol,
-    SearchLimits, SolveConfig, TaskRecord, TaskSet, TaskSummary, evaluate_resuming,
+    CheckpointId, DepthResult, Evaluation, EvaluationKind, EvaluationRecord, Evaluator, PlanChoice,
+    Protocol, SearchLimits, SolveConfig, TaskRecord, TaskSet, TaskSummary, evaluate_resuming,
 };
 use seads_rl::{Agent, TrainConfig};
 use serde::{Deserialize, Serialize};
@@ -92,6 +92,9 @@ pub struct CheckpointEvaluation {
     /// Memory of each search, MiB, if not the planner's default.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub memory_limit_mib: Option<usize>,
+    /// The binary that evaluated (lines written before evaluations recorded it: none).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub evaluated_by: Option<Evaluator>,
     /// Per depth.
     pub results: Vec<DepthResult>,
 }
@@ -257,6 +260,7 @@ pub fn run_evaluation(
     let record = EvaluationRecord {
         checkpoint: Some(checkpoint),
         protocol: Some(protocol.clone()),
+        evaluated_by: journal.evaluated_by(),
         results,
     };
     journal.finish(|| save_evaluation(run, &record, named, Some(&lines)))?;
@@ -307,6 +311,10 @@ pub fn run_policy_evaluation(
             limits: None,
             action_noise: None,
         }),
+        evaluated_by: crate::provenance::this_binary()
+            .into_iter()
+            .cloned()
+            .collect(),
         results,
     };
     save_evaluation(run, &record, named, Some(&lines))?;

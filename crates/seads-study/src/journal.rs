@@ -2,12 +2,14 @@
 //! the tasks file's `.partial` beside it, headed by what decides the evaluation (its protocol and
 //! checkpoint, and for a robot whether it plays the twin). An evaluation that finds a journal
 //! under the same header counts the tasks written there instead of solving them again; the
-//! journal is removed once the record is saved.
+//! journal is removed once the record is saved. Each task's line also names the binary that
+//! solved it (`by`, when the process declared one), so that a record finished by another binary
+//! names both.
 
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
-use seads_planner::{CheckpointId, Protocol, TaskSummary};
+use seads_planner::{CheckpointId, Evaluator, Protocol, TaskSummary};
 
 use crate::{Context as _, Result, StudyError};
 
@@ -20,6 +22,8 @@ pub(crate) struct Journal {
     partial: PathBuf,
     /// Finished tasks from before, by protocol depth and seed.
     earlier: BTreeMap<(usize, u64), Finished>,
+    /// The binaries named by the tasks from before, in the order they first appear.
+    earlier_by: Vec<Evaluator>,
     /// The first failed append (reported at the end: a task's outcome stands without its line).
     append_error: Option<StudyError>,
 }
@@ -52,13 +56,13 @@ impl Place {
 
     /// How many tasks a stopped evaluation wrote under this header.
     pub(crate) fn finished_before(&self) -> Result<usize> {
-        Ok(finished_tasks(&self.partial, &self.header)?.len())
+        Ok(finished_tasks(&self.partial, &self.header)?.0.len())
     }
 
     /// Opens the journal: reads the tasks a stopped evaluation under the same header wrote, or
     /// starts a new journal with the header.
     pub(crate) fn open(self) -> Result<Journal> {
-        let earlier = finished_tasks(&self.partial, &self.header)?;
+        let (earlier, earlier_by) = finished_tasks(&self.partial, &self.header)?;
         if earlier.is_empty() {
             let mut text = self.header.to_string();
             text.push('\n');
@@ -67,6 +71,7 @@ impl Place {
         Ok(Journal {
             partial: self.partial,
             earlier,
+            earlier_by,
             append_error: None,
         })
     }
@@ -86,13 +91,28 @@ impl Journal {
             .collect()
     }
 
-    /// Writes a task's `line` as it ends, with its search time.
+    /// The binaries that solved the evaluation's tasks: those named by the tasks from before,
+    /// then this process's (if it declared one), each once.
+    pub(crate) fn evaluated_by(&self) -> Vec<Evaluator> {
+        let mut by = self.earlier_by.clone();
+        if let Some(this) = crate::provenance::this_binary()
+            && !by.contains(this)
+        {
+            by.push(this.clone());
+        }
+        by
+    }
+
+    /// Writes a task's `line` as it ends, with its search time and the binary that solved it.
     pub(crate) fn append(&mut self, line: &serde_json::Value, planning_s: f64) {
         if self.append_error.is_some() {
             return;
         }
         let mut resumable = line.clone();
         resumable["planning_s"] = planning_s.into();
+        if let Some(this) = crate::provenance::this_binary() {
+            resumable[BY] = serde_json::json!(this);
+        }
         if let Err(e) = seads_rl::store::append_json_line(&self.partial, &resumable) {
             self.append_error = Some(e.into());
         }
@@ -114,37 +134,50 @@ impl Journal {
     }
 }
 
+/// The key of a journal line that names the binary that solved the task.
+const BY: &str = "by";
+
+/// Finished tasks by depth and seed, and the binaries their lines name.
+type Earlier = (BTreeMap<(usize, u64), Finished>, Vec<Evaluator>);
+
 /// The tasks an earlier, stopped evaluation wrote into `partial` under `header`, by depth and
-/// seed, with their lines. None where there is no such file, or it was written under another
-/// header (another protocol or checkpoint) or cannot be read back whole: the evaluation then
-/// starts afresh and rewrites it.
-fn finished_tasks(
-    partial: &Path,
-    header: &serde_json::Value,
-) -> Result<BTreeMap<(usize, u64), Finished>> {
+/// seed, with their lines (without what only the journal keeps: the search time and the
+/// binary), and the binaries those lines name, in the order they first appear. None where
+/// there is no such file, or it was written under another header (another protocol or
+/// checkpoint) or cannot be read back whole: the evaluation then starts afresh and rewrites it.
+fn finished_tasks(partial: &Path, header: &serde_json::Value) -> Result<Earlier> {
+    let none = || Ok((BTreeMap::new(), Vec::new()));
     if !partial.exists() {
-        return Ok(BTreeMap::new());
+        return none();
     }
     let Ok((lines, _torn)) = seads_rl::store::read_json_lines::<serde_json::Value>(partial) else {
-        return Ok(BTreeMap::new());
+        return none();
     };
     if lines.first() != Some(header) {
-        return Ok(BTreeMap::new());
+        return none();
     }
-    let mut tasks = BTreeMap::new();
+    let (mut tasks, mut by) = (BTreeMap::new(), Vec::new());
     for line in lines.into_iter().skip(1) {
         let key = (line["depth"].as_u64(), line["seed"].as_u64());
         let (Some(depth), Some(seed)) = key else {
-            return Ok(BTreeMap::new());
+            return none();
         };
         let Ok(summary) = serde_json::from_value::<TaskSummary>(line.clone()) else {
-            return Ok(BTreeMap::new());
+            return none();
         };
         let mut line = line;
         if let Some(fields) = line.as_object_mut() {
             fields.remove("planning_s");
+            if let Some(named) = fields.remove(BY) {
+                let Ok(evaluator) = serde_json::from_value::<Evaluator>(named) else {
+                    return none();
+                };
+                if !by.contains(&evaluator) {
+                    by.push(evaluator);
+                }
+            }
         }
         tasks.insert((depth as usize, seed), (summary, line));
     }
-    Ok(tasks)
+    Ok((tasks, by))
 }

@@ -184,6 +184,7 @@ pub fn evaluate_checkpoints(
             plan: limits.plan,
             search: limits.search,
             memory_limit_mib: limits.memory_limit_mib,
+            evaluated_by: crate::provenance::this_binary().cloned(),
             results,
         };
         seads_rl::store::append_json_line(&path, &line)?;

@@ -9,6 +9,7 @@
 
 use std::path::Path;
 
+use seads_planner::Evaluator;
 use seads_rl::ComputeDevice;
 use serde::{Deserialize, Serialize};
 
@@ -43,6 +44,32 @@ impl Build<'_> {
         }
         Ok(())
     }
+
+    /// The binary as an evaluation file records it.
+    pub fn evaluator(&self) -> Evaluator {
+        Evaluator {
+            seads: self.version.to_owned(),
+            commit: self.commit.to_owned(),
+            dirty: self.dirty,
+        }
+    }
+
+    /// Declares this process's binary, once, before it evaluates: every evaluation file it
+    /// writes names it (`evaluated_by`), and a stopped evaluation's journal names it beside each
+    /// task it finished. A later declaration is ignored. The binary knows its own commit (it is
+    /// stamped at build time); a library cannot, so a process that declares none writes
+    /// evaluations that name no binary.
+    pub fn declare(&self) {
+        let _ = THIS_BINARY.set(self.evaluator());
+    }
+}
+
+/// The binary this process declared ([`Build::declare`]).
+static THIS_BINARY: std::sync::OnceLock<Evaluator> = std::sync::OnceLock::new();
+
+/// The binary this process declared, if it did.
+pub(crate) fn this_binary() -> Option<&'static Evaluator> {
+    THIS_BINARY.get()
 }
 
 /// One training process of a run.

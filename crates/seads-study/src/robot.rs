@@ -149,6 +149,7 @@ impl RobotEvaluation {
         let record = EvaluationRecord {
             checkpoint: Some(id),
             protocol: Some(protocol),
+            evaluated_by: journal.evaluated_by(),
             results: results.into_values().collect(),
         };
         journal.finish(|| save_evaluation(run, &record, named, Some(&lines)))?;

@@ -2430,8 +2430,8 @@ fn the_golden_runs_first_100_epochs_repeat_line_for_line() {
 
 /// A stopped evaluation resumes: the tasks its `.partial` file holds under the same protocol and
 /// checkpoint are counted as written there (a planted outcome shows it), a torn last line is
-/// dropped, the other tasks are solved, and the file is gone at the end. A `.partial` of another
-/// protocol is ignored.
+/// dropped, the other tasks are solved, and the file is gone at the end; the record names the
+/// binary of the planted task and this one. A `.partial` of another protocol is ignored.
 #[test]
 fn a_stopped_evaluation_resumes_from_its_finished_tasks() {
     let dir = tempfile::tempdir().unwrap();
@@ -2477,6 +2477,9 @@ fn a_stopped_evaluation_resumes_from_its_finished_tasks() {
     ] {
         planted[key] = value;
     }
+    // Solved by another binary, which the journal names beside the task.
+    let earlier = serde_json::json!({"seads": "0.1.0", "commit": "0123abc", "dirty": false});
+    planted["by"] = earlier.clone();
     let resumed = dir.path().join("resumed");
     copy_tiny_run(&resumed);
     // A `.partial` line also holds the task's search time (the tasks file does not).
@@ -2497,7 +2500,29 @@ fn a_stopped_evaluation_resumes_from_its_finished_tasks() {
     let mut expected = whole_lines.clone();
     expected[0] = planted.clone();
     expected[0].as_object_mut().unwrap().remove("planning_s");
+    expected[0].as_object_mut().unwrap().remove("by");
     assert_eq!(lines(&resumed), expected);
+    // The record names both binaries, the one that began first first; a whole evaluation names
+    // this one alone.
+    let this = &record["evaluated_by"][0];
+    assert_eq!(
+        record["evaluated_by"].as_array().unwrap().len(),
+        1,
+        "{record}"
+    );
+    let version = String::from_utf8(seads_ok(&["--version"]).stdout).unwrap();
+    assert!(
+        version.contains(this["commit"].as_str().unwrap()),
+        "{version} {this}"
+    );
+    let resumed_record: serde_json::Value = serde_json::from_str(
+        &std::fs::read_to_string(resumed.join("evaluation-replan-depths-1-2.json")).unwrap(),
+    )
+    .unwrap();
+    assert_eq!(
+        resumed_record["evaluated_by"],
+        serde_json::json!([earlier, this])
+    );
     let second = f64::from(u8::from(whole_lines[1]["solved"] == true));
     assert_eq!(
         v["success_rate"]["1"].as_f64().unwrap(),

@@ -6,7 +6,9 @@ use std::path::{Path, PathBuf};
 
 use crate::error::{fail, failure};
 use crate::{Context as _, Result};
-use seads_planner::{DepthResult, EvaluationKind, Protocol, STANDARD_DEPTHS, SearchLimits};
+use seads_planner::{
+    DepthResult, EvaluationKind, Evaluator, Protocol, STANDARD_DEPTHS, SearchLimits,
+};
 use seads_rl::{Algorithm, Metrics, TaskMetrics, TrainConfig};
 
 use crate::evaluation::CheckpointEvaluation;
@@ -54,6 +56,9 @@ pub struct RunData {
     pub over_training: Vec<CheckpointEvaluation>,
     /// The processors that trained it (`provenance.jsonl`; empty for older runs).
     pub processors: Vec<String>,
+    /// The binaries that made the evaluations the tables take, each once, in the order met
+    /// (empty where every such file was written before evaluations named their binary).
+    pub evaluated_by: Vec<Evaluator>,
     /// Evaluation files left out of the end-of-training tables because they evaluated an
     /// earlier checkpoint: one line each.
     pub evaluation_notes: Vec<String>,
@@ -83,6 +88,17 @@ impl RunData {
         }
     }
 
+    /// Whether any evaluation of the run is in the tables (end of training, further ones, or
+    /// over training).
+    pub fn has_evaluations(&self) -> bool {
+        self.replan.is_some()
+            || self.plan_once.is_some()
+            || self.policy.is_some()
+            || !self.noisy.is_empty()
+            || self.deep.is_some()
+            || !self.over_training.is_empty()
+    }
+
     /// Skill coverage at the end of training.
     pub fn final_coverage(&self) -> Option<f64> {
         self.metrics.last().map(|m| m.skill_coverage)
@@ -105,6 +121,7 @@ impl RunData {
         };
         let mut evaluation_notes = Vec::new();
         let mut unrecorded_evaluations = 0;
+        let mut evaluated_by = Vec::new();
         let mut evaluation = |kind: EvaluationKind| -> Result<Option<Vec<DepthResult>>> {
             let file = kind.results_file(&STANDARD_DEPTHS, None);
             let record = match crate::evaluation::read_evaluation(&dir.join(&file)) {
@@ -124,9 +141,13 @@ impl RunData {
                     ));
                     Ok(None)
                 }
-                Some(_) => Ok(Some(record.results)),
+                Some(_) => {
+                    add_evaluators(&mut evaluated_by, record.evaluated_by);
+                    Ok(Some(record.results))
+                }
                 None => {
                     unrecorded_evaluations += 1;
+                    add_evaluators(&mut evaluated_by, record.evaluated_by);
                     Ok(Some(record.results))
                 }
             }
@@ -136,8 +157,11 @@ impl RunData {
             evaluation(EvaluationKind::PlanOnce)?,
             evaluation(EvaluationKind::Policy)?,
         );
-        let further = further_evaluations(dir, last_epoch, &mut damage);
+        let further = further_evaluations(dir, last_epoch, &mut damage, &mut evaluated_by);
         let (noisy, deep) = (noisy_evaluations(&further), deep_search(&further));
+        let over_training = crate::evaluation::read_over_training(dir)?;
+        let over_training_by = over_training.iter().filter_map(|l| l.evaluated_by.clone());
+        add_evaluators(&mut evaluated_by, over_training_by.collect());
         Ok(Self {
             dir: dir.to_path_buf(),
             copy_to,
@@ -151,9 +175,10 @@ impl RunData {
             unrecorded_evaluations,
             damage,
             busy: crate::sweep::is_claimed(dir),
-            over_training: crate::evaluation::read_over_training(dir)?,
+            over_training,
             processors: crate::provenance::Provenance::processors(dir)
                 .doing(|| format!("reading the provenance of {}", dir.display()))?,
+            evaluated_by,
             config,
             metrics,
             task_metrics,
@@ -161,14 +186,24 @@ impl RunData {
     }
 }
 
+/// Adds the binaries `more` names to `all`, each once.
+fn add_evaluators(all: &mut Vec<Evaluator>, more: Vec<Evaluator>) {
+    for evaluator in more {
+        if !all.contains(&evaluator) {
+            all.push(evaluator);
+        }
+    }
+}
+
 /// The run's planning evaluations, other than the standard ones, that evaluated its last
 /// checkpoint on the test split with the standard seeds (`evaluation-replan-noise-0.05.json`,
-/// `evaluation-replan-depths-6-10.json`, …), in the order of their files' names; an
-/// unreadable one is damage.
+/// `evaluation-replan-depths-6-10.json`, …), in the order of their files' names, with the
+/// binaries they name added to `evaluated_by`; an unreadable one is damage.
 fn further_evaluations(
     dir: &Path,
     last_epoch: Option<u64>,
     damage: &mut Vec<String>,
+    evaluated_by: &mut Vec<Evaluator>,
 ) -> Vec<(Protocol, Vec<DepthResult>)> {
     let standard_files = [
         EvaluationKind::Replan,
@@ -206,6 +241,7 @@ fn further_evaluations(
             && protocol.tasks.seed.is_none()
             && protocol.kind != EvaluationKind::Policy
         {
+            add_evaluators(evaluated_by, record.evaluated_by);
             found.push((protocol, record.results));
         }
     }
@@ -478,6 +514,7 @@ pub(crate) fn bare_run(seed: u32) -> RunData {
         plan_once: None,
         noisy: Vec::new(),
         deep: None,
+        evaluated_by: Vec::new(),
         over_training: Vec::new(),
         processors: Vec::new(),
         evaluation_notes: Vec::new(),

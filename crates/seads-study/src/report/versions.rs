@@ -1,6 +1,7 @@
 //! Which code versions trained a study's runs: each run's distinct (commit, dirty) pairs from its
 //! `provenance.jsonl`, counted per version, with the runs that trained from a dirty working tree,
-//! from a commit the repository lacks, or without any provenance marked.
+//! from a commit the repository lacks, or without any provenance marked; and which binaries made
+//! the evaluations the report's tables take (`evaluated_by` of the evaluation files).
 
 use std::collections::BTreeMap;
 use std::fmt::Write as _;
@@ -16,6 +17,17 @@ use crate::provenance::{PROVENANCE, Provenance};
 struct Version {
     commit: String,
     dirty: bool,
+}
+
+impl Version {
+    /// The commit, marked `(dirty)` if the tree had uncommitted changes.
+    fn named(&self) -> String {
+        if self.dirty {
+            format!("{} (dirty)", self.commit)
+        } else {
+            self.commit.clone()
+        }
+    }
 }
 
 /// Whether the git repository at `repository` has `commit`; `None` where git cannot say (no git,
@@ -83,9 +95,27 @@ pub fn version_tables(runs: &[&RunData], known: &dyn Fn(&str) -> Option<bool>) -
             .or_insert_with(|| known(commit))
     };
     let mut marked: Vec<(String, String)> = Vec::new();
-    let mut csv = String::from("env,variant,run,commits,dirty,not_in_repository\n");
+    let mut csv = String::from("env,variant,run,commits,dirty,not_in_repository,evaluated_by\n");
+    let mut evaluations: BTreeMap<Version, usize> = BTreeMap::new();
+    let mut unnamed = 0;
     for run in runs {
         let name = run.dir.display().to_string();
+        let evaluators: Vec<Version> = run
+            .evaluated_by
+            .iter()
+            .map(|e| Version {
+                commit: e.commit.clone(),
+                dirty: e.dirty,
+            })
+            .collect();
+        if evaluators.is_empty() {
+            unnamed += usize::from(run.has_evaluations());
+        }
+        let evaluated_by: Vec<String> = evaluators.iter().map(Version::named).collect();
+        let evaluated_by = evaluated_by.join(";");
+        for v in evaluators {
+            *evaluations.entry(v).or_default() += 1;
+        }
         match run_versions(run) {
             Ok(versions) => {
                 let dirty = versions.iter().any(|v| v.dirty);
@@ -110,7 +140,7 @@ pub fn version_tables(runs: &[&RunData], known: &dyn Fn(&str) -> Option<bool>) -
                 let commits: Vec<&str> = versions.iter().map(|v| v.commit.as_str()).collect();
                 let _ = writeln!(
                     csv,
-                    "{},{},{},{},{dirty},{}",
+                    "{},{},{},{},{dirty},{},{evaluated_by}",
                     csv_field(&run.config.env),
                     csv_field(&run.variant),
                     csv_field(&name),
@@ -124,7 +154,7 @@ pub fn version_tables(runs: &[&RunData], known: &dyn Fn(&str) -> Option<bool>) -
             Err(why) => {
                 let _ = writeln!(
                     csv,
-                    "{},{},{},,,",
+                    "{},{},{},,,,{evaluated_by}",
                     csv_field(&run.config.env),
                     csv_field(&run.variant),
                     csv_field(&name)
@@ -170,6 +200,21 @@ pub fn version_tables(runs: &[&RunData], known: &dyn Fn(&str) -> Option<bool>) -
         for (run, why) in &marked {
             let _ = writeln!(md, "- `{run}`: {why}");
         }
+    }
+    if !evaluations.is_empty() || unnamed > 0 {
+        md += "\nThe evaluations the tables take were made by:";
+        for (v, n) in &evaluations {
+            let _ = write!(md, " `{}`, {n} run(s);", v.named());
+        }
+        if unnamed > 0 {
+            let _ = write!(
+                md,
+                " {unnamed} run(s) whose evaluation files name no binary (written before they \
+                 did);"
+            );
+        }
+        md.pop();
+        md += ".\n";
     }
     (md, csv)
 }
@@ -226,10 +271,38 @@ mod tests {
         assert!(!md.contains("Every run trained on this one clean commit"));
         let rows: Vec<&str> = csv.lines().skip(1).collect();
         assert_eq!(rows.len(), 4);
-        assert!(rows[0].ends_with(",aaa1,false,false"), "{}", rows[0]);
-        assert!(rows[1].ends_with(",aaa1,true,false"), "{}", rows[1]);
-        assert!(rows[2].ends_with(",bbb2,false,true"), "{}", rows[2]);
-        assert!(rows[3].ends_with(",,,"), "{}", rows[3]);
+        assert!(rows[0].ends_with(",aaa1,false,false,"), "{}", rows[0]);
+        assert!(rows[1].ends_with(",aaa1,true,false,"), "{}", rows[1]);
+        assert!(rows[2].ends_with(",bbb2,false,true,"), "{}", rows[2]);
+        assert!(rows[3].ends_with(",,,,"), "{}", rows[3]);
+        // Evaluations name their binaries: two runs by `ccc3`, one of them resumed by a dirty
+        // `ddd4`; a run with an evaluation that names none is counted apart.
+        let evaluator = |commit: &str, dirty| seads_planner::Evaluator {
+            seads: "0.1.0".into(),
+            commit: commit.into(),
+            dirty,
+        };
+        runs[0].evaluated_by = vec![evaluator("ccc3", false)];
+        runs[1].evaluated_by = vec![evaluator("ccc3", false), evaluator("ddd4", true)];
+        runs[2].replan = Some(vec![seads_planner::DepthResult::new(1)]);
+        let refs: Vec<&RunData> = runs.iter().collect();
+        let (md, csv) = version_tables(&refs, &known);
+        let rows: Vec<&str> = csv.lines().skip(1).collect();
+        assert!(rows[0].ends_with(",aaa1,false,false,ccc3"), "{}", rows[0]);
+        assert!(
+            rows[1].ends_with(",true,false,ccc3;ddd4 (dirty)"),
+            "{}",
+            rows[1]
+        );
+        assert!(rows[2].ends_with(",bbb2,false,true,"), "{}", rows[2]);
+        assert!(
+            md.contains(
+                "The evaluations the tables take were made by: `ccc3`, 2 run(s); `ddd4 (dirty)`, \
+                 1 run(s); 1 run(s) whose evaluation files name no binary (written before they \
+                 did).\n"
+            ),
+            "{md}"
+        );
         // One clean known commit for every run: said in one sentence.
         let (md, _) = version_tables(&refs[..1], &known);
         assert!(
