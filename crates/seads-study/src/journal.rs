@@ -4,7 +4,7 @@
 //! under the same header counts the tasks written there instead of solving them again; the
 //! journal is removed once the record is saved. Each task's line also names the binary that
 //! solved it (`by`, when the process declared one), so that a record finished by another binary
-//! names both.
+//! names both; one with a task whose binary is unknown names none.
 
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
@@ -22,8 +22,10 @@ pub(crate) struct Journal {
     partial: PathBuf,
     /// Finished tasks from before, by protocol depth and seed.
     earlier: BTreeMap<(usize, u64), Finished>,
-    /// The binaries named by the tasks from before, in the order they first appear.
-    earlier_by: Vec<Evaluator>,
+    /// The binaries named by the tasks from before, in the order they first appear; `None` if
+    /// a task from before names none (written before journals did), so that not every binary
+    /// can be named.
+    earlier_by: Option<Vec<Evaluator>>,
     /// The first failed append (reported at the end: a task's outcome stands without its line).
     append_error: Option<StudyError>,
 }
@@ -92,12 +94,15 @@ impl Journal {
     }
 
     /// The binaries that solved the evaluation's tasks: those named by the tasks from before,
-    /// then this process's (if it declared one), each once.
+    /// then this process's, each once; none where one of them is unknown (a task from before
+    /// that names no binary, or a process that declared none).
     pub(crate) fn evaluated_by(&self) -> Vec<Evaluator> {
-        let mut by = self.earlier_by.clone();
-        if let Some(this) = crate::provenance::this_binary()
-            && !by.contains(this)
-        {
+        let (Some(earlier), Some(this)) = (&self.earlier_by, crate::provenance::this_binary())
+        else {
+            return Vec::new();
+        };
+        let mut by = earlier.clone();
+        if !by.contains(this) {
             by.push(this.clone());
         }
         by
@@ -137,16 +142,18 @@ impl Journal {
 /// The key of a journal line that names the binary that solved the task.
 const BY: &str = "by";
 
-/// Finished tasks by depth and seed, and the binaries their lines name.
-type Earlier = (BTreeMap<(usize, u64), Finished>, Vec<Evaluator>);
+/// Finished tasks by depth and seed, and the binaries their lines name (`None` if a line names
+/// none).
+type Earlier = (BTreeMap<(usize, u64), Finished>, Option<Vec<Evaluator>>);
 
 /// The tasks an earlier, stopped evaluation wrote into `partial` under `header`, by depth and
 /// seed, with their lines (without what only the journal keeps: the search time and the
-/// binary), and the binaries those lines name, in the order they first appear. None where
+/// binary), and the binaries those lines name, in the order they first appear (`None` if a
+/// line names none). No tasks where
 /// there is no such file, or it was written under another header (another protocol or
 /// checkpoint) or cannot be read back whole: the evaluation then starts afresh and rewrites it.
 fn finished_tasks(partial: &Path, header: &serde_json::Value) -> Result<Earlier> {
-    let none = || Ok((BTreeMap::new(), Vec::new()));
+    let none = || Ok((BTreeMap::new(), Some(Vec::new())));
     if !partial.exists() {
         return none();
     }
@@ -156,7 +163,7 @@ fn finished_tasks(partial: &Path, header: &serde_json::Value) -> Result<Earlier>
     if lines.first() != Some(header) {
         return none();
     }
-    let (mut tasks, mut by) = (BTreeMap::new(), Vec::new());
+    let (mut tasks, mut by) = (BTreeMap::new(), Some(Vec::new()));
     for line in lines.into_iter().skip(1) {
         let key = (line["depth"].as_u64(), line["seed"].as_u64());
         let (Some(depth), Some(seed)) = key else {
@@ -168,13 +175,18 @@ fn finished_tasks(partial: &Path, header: &serde_json::Value) -> Result<Earlier>
         let mut line = line;
         if let Some(fields) = line.as_object_mut() {
             fields.remove("planning_s");
-            if let Some(named) = fields.remove(BY) {
-                let Ok(evaluator) = serde_json::from_value::<Evaluator>(named) else {
-                    return none();
-                };
-                if !by.contains(&evaluator) {
-                    by.push(evaluator);
+            match fields.remove(BY) {
+                Some(named) => {
+                    let Ok(evaluator) = serde_json::from_value::<Evaluator>(named) else {
+                        return none();
+                    };
+                    if let Some(by) = by.as_mut()
+                        && !by.contains(&evaluator)
+                    {
+                        by.push(evaluator);
+                    }
                 }
+                None => by = None,
             }
         }
         tasks.insert((depth as usize, seed), (summary, line));

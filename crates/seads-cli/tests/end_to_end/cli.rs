@@ -2431,7 +2431,8 @@ fn the_golden_runs_first_100_epochs_repeat_line_for_line() {
 /// A stopped evaluation resumes: the tasks its `.partial` file holds under the same protocol and
 /// checkpoint are counted as written there (a planted outcome shows it), a torn last line is
 /// dropped, the other tasks are solved, and the file is gone at the end; the record names the
-/// binary of the planted task and this one. A `.partial` of another protocol is ignored.
+/// binary of the planted tasks and this one (none where a planted task names none). A `.partial`
+/// of another protocol is ignored.
 #[test]
 fn a_stopped_evaluation_resumes_from_its_finished_tasks() {
     let dir = tempfile::tempdir().unwrap();
@@ -2485,6 +2486,7 @@ fn a_stopped_evaluation_resumes_from_its_finished_tasks() {
     // A `.partial` line also holds the task's search time (the tasks file does not).
     let mut second: serde_json::Value = serde_json::from_str(&first_two[1]).unwrap();
     second["planning_s"] = serde_json::json!(0.25);
+    second["by"] = earlier.clone();
     let partial = format!(
         "{}\n{planted}\n{second}\n{{\"depth\": 2, \"se",
         header(&record["protocol"])
@@ -2522,6 +2524,23 @@ fn a_stopped_evaluation_resumes_from_its_finished_tasks() {
     assert_eq!(
         resumed_record["evaluated_by"],
         serde_json::json!([earlier, this])
+    );
+    // A task from before that names no binary (a journal of older code): the record cannot name
+    // every binary, so it names none.
+    let unnamed = dir.path().join("unnamed");
+    copy_tiny_run(&unnamed);
+    let mut anonymous = second.clone();
+    anonymous.as_object_mut().unwrap().remove("by");
+    let partial = format!("{}\n{planted}\n{anonymous}\n", header(&record["protocol"]));
+    std::fs::write(unnamed.join(format!("{TASKS}.partial")), partial).unwrap();
+    evaluate(&unnamed);
+    let unnamed_record: serde_json::Value = serde_json::from_str(
+        &std::fs::read_to_string(unnamed.join("evaluation-replan-depths-1-2.json")).unwrap(),
+    )
+    .unwrap();
+    assert!(
+        unnamed_record.get("evaluated_by").is_none(),
+        "{unnamed_record}"
     );
     let second = f64::from(u8::from(whole_lines[1]["solved"] == true));
     assert_eq!(
