@@ -64,20 +64,21 @@ fn row(
     reference: Option<&str>,
 ) {
     let _ = write!(md, "| {} | {} | {} |", g.env, g.variant, runs.len());
+    // A CSV line: the group, the measure (at `steps`, or over training) and its summary.
+    let mut line = |measure: &str, steps: String, v: &super::stats::Summary| {
+        let (env, variant) = (csv_field(&g.env), csv_field(&g.variant));
+        let (n, mean, std) = (v.n, v.mean, v.std);
+        let _ = writeln!(
+            csv,
+            "{env},{variant},{n},{measure},{steps},{mean:.4},{std:.4}"
+        );
+    };
     for &s in steps {
         let values: Vec<f64> = runs.iter().filter_map(|c| coverage_at(c, s)).collect();
         match summary(&values) {
             Some(v) => {
                 let _ = write!(md, " {:.2} |", v.mean);
-                let _ = writeln!(
-                    csv,
-                    "{},{},{},coverage_at,{s},{:.4},{:.4}",
-                    csv_field(&g.env),
-                    csv_field(&g.variant),
-                    v.n,
-                    v.mean,
-                    v.std
-                );
+                line("coverage_at", s.to_string(), &v);
             }
             None => *md += " – |",
         }
@@ -86,15 +87,7 @@ fn row(
     match summary(&means) {
         Some(v) => {
             let _ = write!(md, " {:.2} ± {:.2} |", v.mean, v.std);
-            let _ = writeln!(
-                csv,
-                "{},{},{},mean_over_training,,{:.4},{:.4}",
-                csv_field(&g.env),
-                csv_field(&g.variant),
-                v.n,
-                v.mean,
-                v.std
-            );
+            line("mean_over_training", String::new(), &v);
         }
         None => *md += " – |",
     }

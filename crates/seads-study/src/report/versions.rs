@@ -201,20 +201,23 @@ pub fn version_tables(runs: &[&RunData], known: &dyn Fn(&str) -> Option<bool>) -
             let _ = writeln!(md, "- `{run}`: {why}");
         }
     }
-    if !evaluations.is_empty() || unnamed > 0 {
-        md += "\nThe evaluations the tables take were made by:";
-        for (v, n) in &evaluations {
-            let _ = write!(md, " `{}`, {n} run(s);", v.named());
-        }
-        if unnamed > 0 {
-            let _ = write!(
-                md,
-                " {unnamed} run(s) whose evaluation files name no binary (written before they \
-                 did);"
-            );
-        }
-        md.pop();
-        md += ".\n";
+    if !evaluations.is_empty() {
+        let by: Vec<String> = evaluations
+            .iter()
+            .map(|(v, n)| format!("`{}` ({n} run(s))", v.named()))
+            .collect();
+        let _ = writeln!(
+            md,
+            "\nThe evaluations the tables take were made by the binaries of {}.",
+            by.join(", ")
+        );
+    }
+    if unnamed > 0 {
+        let _ = writeln!(
+            md,
+            "\nThe evaluation files of {unnamed} run(s) name no binary (written before evaluation \
+             files did, or resumed from one that did not)."
+        );
     }
     (md, csv)
 }
@@ -297,10 +300,13 @@ mod tests {
         assert!(rows[2].ends_with(",bbb2,false,true,"), "{}", rows[2]);
         assert!(
             md.contains(
-                "The evaluations the tables take were made by: `ccc3`, 2 run(s); `ddd4 (dirty)`, \
-                 1 run(s); 1 run(s) whose evaluation files name no binary (written before they \
-                 did).\n"
+                "The evaluations the tables take were made by the binaries of `ccc3` (2 run(s)), \
+                 `ddd4 (dirty)` (1 run(s)).\n"
             ),
+            "{md}"
+        );
+        assert!(
+            md.contains("The evaluation files of 1 run(s) name no binary"),
             "{md}"
         );
         // One clean known commit for every run: said in one sentence.
