@@ -523,3 +523,56 @@ pub(crate) fn bare_run(seed: u32) -> RunData {
         busy: false,
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Every study committed under `docs/results` reads back whole: each sweep's runs, and each
+    /// run outside a sweep, load (configuration as a run directory is read, metrics, evaluation
+    /// files, provenance) with no run damaged or unreadable, so that every report can be made
+    /// again from its data by the current code.
+    #[test]
+    fn every_committed_study_reads_back_without_damage() {
+        let results = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../docs/results");
+        let in_a_sweep = |dir: &Path| {
+            dir.ancestors()
+                .take_while(|a| *a != results)
+                .any(|a| a.join("sweep.json").is_file())
+        };
+        let mut inputs: Vec<PathBuf> = walkdir::WalkDir::new(&results)
+            .into_iter()
+            .map(|e| e.unwrap().into_path())
+            .filter_map(|path| {
+                let dir = path.parent()?.to_path_buf();
+                let name = path.file_name()?;
+                let sweep = name == "sweep.json";
+                let lone_run = name == "config.toml" && !in_a_sweep(&dir);
+                (sweep || lone_run).then_some(dir)
+            })
+            .collect();
+        inputs.sort();
+        assert!(inputs.len() >= 20, "{inputs:?}");
+        let mut runs = 0;
+        for input in &inputs {
+            let collection = collect(std::slice::from_ref(input))
+                .unwrap_or_else(|e| panic!("{}: {e:#}", input.display()));
+            assert!(
+                collection.unreadable.is_empty(),
+                "{}: {:?}",
+                input.display(),
+                collection.unreadable
+            );
+            for run in &collection.runs {
+                assert!(
+                    run.damage.is_empty(),
+                    "{}: {:?}",
+                    run.dir.display(),
+                    run.damage
+                );
+            }
+            runs += collection.runs.len();
+        }
+        assert!(runs > 250, "{runs} runs");
+    }
+}
