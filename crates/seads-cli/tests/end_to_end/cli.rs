@@ -1421,11 +1421,13 @@ fn a_robot_evaluation_is_the_same_whole_resumed_or_after_training() {
     let record = results(&run);
     let header = serde_json::json!({"evaluation": {
         "protocol": record["protocol"], "checkpoint": record["checkpoint"], "twin": 3}});
+    // As this binary writes it: each task with its search time and the binary that solved it.
     let journal = |lines: &[serde_json::Value]| {
         let mut text = format!("{header}\n");
         for l in lines {
             let mut l = l.clone();
             l["planning_s"] = 0.0.into();
+            l["by"] = record["evaluated_by"][0].clone();
             text += &format!("{l}\n");
         }
         text
