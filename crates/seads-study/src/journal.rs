@@ -149,9 +149,9 @@ type Earlier = (BTreeMap<(usize, u64), Finished>, Option<Vec<Evaluator>>);
 /// The tasks an earlier, stopped evaluation wrote into `partial` under `header`, by depth and
 /// seed, with their lines (without what only the journal keeps: the search time and the
 /// binary), and the binaries those lines name, in the order they first appear (`None` if a
-/// line names none). No tasks where
-/// there is no such file, or it was written under another header (another protocol or
-/// checkpoint) or cannot be read back whole: the evaluation then starts afresh and rewrites it.
+/// line names none). No tasks where there is no such file, or it was written under another
+/// header (another protocol or checkpoint) or cannot be read back whole: the evaluation then
+/// starts afresh and rewrites it.
 fn finished_tasks(partial: &Path, header: &serde_json::Value) -> Result<Earlier> {
     let none = || Ok((BTreeMap::new(), Some(Vec::new())));
     if !partial.exists() {
