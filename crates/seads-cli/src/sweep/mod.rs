@@ -146,6 +146,11 @@ pub struct SlurmArgs {
     /// Time limit per task, in Slurm's format (a task that hits it is resumed when re-queued).
     #[arg(long, default_value = "04:00:00")]
     time: String,
+    /// Memory per task, in Slurm's format (8G, 8000M; default: the cluster's). A task holds its
+    /// run's buffers and networks and, while it evaluates, up to 2 GiB of remembered successors
+    /// beside each search's own bound (`--memory-limit`, 4 GiB unless the study says otherwise).
+    #[arg(long, value_name = "SIZE")]
+    mem: Option<String>,
     /// Cores per task; the task's libtorch threads follow them.
     #[arg(long, default_value_t = 2)]
     cpus_per_task: u64,
@@ -303,6 +308,7 @@ fn slurm(args: SlurmArgs) -> Result<()> {
     let options = slurm::SlurmOptions {
         partition: args.partition,
         time: args.time,
+        mem: args.mem,
         cpus_per_task: at_least_one("--cpus-per-task", args.cpus_per_task)?,
         max_parallel: args
             .max_parallel

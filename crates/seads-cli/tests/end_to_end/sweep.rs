@@ -977,8 +977,8 @@ fn thread_counts_beyond_the_machine_are_refused() {
 }
 
 /// A Slurm script cannot be made to run another command: a `--time` or `--partition` with a
-/// newline, a quote or `%`, or a sweep directory whose path holds `%` (Slurm expands it in
-/// `--output`), is one line of bad input and no script is written.
+/// newline, a quote or `%`, a `--mem` that is not a size, or a sweep directory whose path holds
+/// `%` (Slurm expands it in `--output`), is one line of bad input and no script is written.
 #[test]
 fn slurm_scripts_refuse_values_that_would_change_them() {
     let tmp = tempfile::tempdir().unwrap();
@@ -988,6 +988,10 @@ fn slurm_scripts_refuse_values_that_would_change_them() {
         ("--time", "1%a"),
         ("--partition", "p\n#SBATCH --wrap=x"),
         ("--partition", "a b"),
+        ("--mem", "8G\n#SBATCH --wrap=x"),
+        ("--mem", "eight"),
+        ("--mem", "8GB"),
+        ("--mem", "G"),
     ] {
         check_bad_input(&["sweep", "slurm", s(&out), option, value], option);
         assert!(
@@ -1001,11 +1005,15 @@ fn slurm_scripts_refuse_values_that_would_change_them() {
         &["sweep", "slurm", s(&odd)],
         "holds a newline, a quote or %",
     );
-    // An ordinary call writes both scripts, the log path quoted.
+    // An ordinary call writes both scripts, the log path quoted; memory only when asked.
     seads_ok(&["sweep", "slurm", s(&out), "--time", "01:00:00"]);
     let array = std::fs::read_to_string(out.join("slurm").join("array.sbatch")).unwrap();
     assert!(array.contains("#SBATCH --time=01:00:00\n"), "{array}");
     assert!(array.contains("--output=\""), "{array}");
+    assert!(!array.contains("--mem"), "{array}");
+    seads_ok(&["sweep", "slurm", s(&out), "--mem", "8000M"]);
+    let array = std::fs::read_to_string(out.join("slurm").join("array.sbatch")).unwrap();
+    assert!(array.contains("#SBATCH --mem=8000M\n"), "{array}");
 }
 
 /// The test manifest written into `dir` and planned into `dir/sweep`: the manifest's path and the

@@ -23,6 +23,9 @@ pub struct SlurmOptions {
     pub partition: Option<String>,
     /// Time limit per task (`--time`, Slurm's format).
     pub time: String,
+    /// Memory per task (`--mem`, Slurm's format: a number with an optional unit K, M, G or T);
+    /// `None`: the cluster's default.
+    pub mem: Option<String>,
     /// Cores per task; the task's libtorch threads follow them.
     pub cpus_per_task: usize,
     /// At most this many tasks at once (`%M`), if any.
@@ -56,6 +59,10 @@ pub fn scripts(dir: &Path, sweep: &Sweep, options: &SlurmOptions) -> (String, St
         .partition
         .as_ref()
         .map_or(String::new(), |p| format!("#SBATCH --partition={p}\n"));
+    let mem = options
+        .mem
+        .as_ref()
+        .map_or(String::new(), |m| format!("#SBATCH --mem={m}\n"));
     let (gres, device) = match options.device {
         ComputeDevice::Cpu => (String::new(), String::new()),
         ComputeDevice::Cuda(_) => (
@@ -90,6 +97,7 @@ pub fn scripts(dir: &Path, sweep: &Sweep, options: &SlurmOptions) -> (String, St
          #SBATCH --array=0-{last}{throttle}\n\
          #SBATCH --cpus-per-task={cpus}\n\
          #SBATCH --time={time}\n\
+         {mem}\
          {partition}\
          {gres}\
          #SBATCH --output=\"{logs}/task-%a.out\"\n\
@@ -148,6 +156,15 @@ pub fn check_options(dir: &Path, options: &SlurmOptions) -> Result<()> {
     word("--time", &options.time)?;
     if let Some(partition) = &options.partition {
         word("--partition", partition)?;
+    }
+    if let Some(mem) = &options.mem {
+        let digits = mem.trim_end_matches(['K', 'M', 'G', 'T']);
+        let unit = mem.len() - digits.len();
+        if digits.is_empty() || !digits.chars().all(|c| c.is_ascii_digit()) || unit > 1 {
+            return Err(crate::StudyError::invalid(format!(
+                "--mem {mem:?} must be a number with an optional unit K, M, G or T (8G, 8000M)"
+            )));
+        }
     }
     for (name, path) in [("the sweep directory", dir), ("--seads", &options.seads)] {
         let text = path.to_string_lossy();
