@@ -56,9 +56,8 @@ pub struct RunData {
     pub over_training: Vec<CheckpointEvaluation>,
     /// The processors that trained it (`provenance.jsonl`; empty for older runs).
     pub processors: Vec<String>,
-    /// The binaries that made the evaluations the tables take, each once, in the order met
-    /// (empty where every such file was written before evaluations named their binary).
-    pub evaluated_by: Vec<Evaluator>,
+    /// The binaries that made the evaluations the tables take.
+    pub evaluated_by: Evaluators,
     /// Evaluation files left out of the end-of-training tables because they evaluated an
     /// earlier checkpoint: one line each.
     pub evaluation_notes: Vec<String>,
@@ -88,17 +87,6 @@ impl RunData {
         }
     }
 
-    /// Whether any evaluation of the run is in the tables (end of training, further ones, or
-    /// over training).
-    pub fn has_evaluations(&self) -> bool {
-        self.replan.is_some()
-            || self.plan_once.is_some()
-            || self.policy.is_some()
-            || !self.noisy.is_empty()
-            || self.deep.is_some()
-            || !self.over_training.is_empty()
-    }
-
     /// Skill coverage at the end of training.
     pub fn final_coverage(&self) -> Option<f64> {
         self.metrics.last().map(|m| m.skill_coverage)
@@ -121,7 +109,7 @@ impl RunData {
         };
         let mut evaluation_notes = Vec::new();
         let mut unrecorded_evaluations = 0;
-        let mut evaluated_by = Vec::new();
+        let mut evaluated_by = Evaluators::default();
         let mut evaluation = |kind: EvaluationKind| -> Result<Option<Vec<DepthResult>>> {
             let file = kind.results_file(&STANDARD_DEPTHS, None);
             let record = match crate::evaluation::read_evaluation(&dir.join(&file)) {
@@ -142,12 +130,12 @@ impl RunData {
                     Ok(None)
                 }
                 Some(_) => {
-                    add_evaluators(&mut evaluated_by, record.evaluated_by);
+                    evaluated_by.add(record.evaluated_by);
                     Ok(Some(record.results))
                 }
                 None => {
                     unrecorded_evaluations += 1;
-                    add_evaluators(&mut evaluated_by, record.evaluated_by);
+                    evaluated_by.add(record.evaluated_by);
                     Ok(Some(record.results))
                 }
             }
@@ -160,8 +148,9 @@ impl RunData {
         let further = further_evaluations(dir, last_epoch, &mut damage, &mut evaluated_by);
         let (noisy, deep) = (noisy_evaluations(&further), deep_search(&further));
         let over_training = crate::evaluation::read_over_training(dir)?;
-        let over_training_by = over_training.iter().filter_map(|l| l.evaluated_by.clone());
-        add_evaluators(&mut evaluated_by, over_training_by.collect());
+        for line in &over_training {
+            evaluated_by.add(line.evaluated_by.iter().cloned().collect());
+        }
         Ok(Self {
             dir: dir.to_path_buf(),
             copy_to,
@@ -186,11 +175,26 @@ impl RunData {
     }
 }
 
-/// Adds the binaries `more` names to `all`, each once.
-fn add_evaluators(all: &mut Vec<Evaluator>, more: Vec<Evaluator>) {
-    for evaluator in more {
-        if !all.contains(&evaluator) {
-            all.push(evaluator);
+/// The binaries that made a run's evaluations, each once in the order met, and how many of its
+/// evaluation files name none (written before evaluation files did).
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct Evaluators {
+    /// The binaries named.
+    pub named: Vec<Evaluator>,
+    /// Evaluation files (or over-training lines) that name no binary.
+    pub unnamed: usize,
+}
+
+impl Evaluators {
+    /// Adds what one evaluation file names.
+    pub(crate) fn add(&mut self, by: Vec<Evaluator>) {
+        if by.is_empty() {
+            self.unnamed += 1;
+        }
+        for evaluator in by {
+            if !self.named.contains(&evaluator) {
+                self.named.push(evaluator);
+            }
         }
     }
 }
@@ -203,7 +207,7 @@ fn further_evaluations(
     dir: &Path,
     last_epoch: Option<u64>,
     damage: &mut Vec<String>,
-    evaluated_by: &mut Vec<Evaluator>,
+    evaluated_by: &mut Evaluators,
 ) -> Vec<(Protocol, Vec<DepthResult>)> {
     let standard_files = [
         EvaluationKind::Replan,
@@ -241,7 +245,7 @@ fn further_evaluations(
             && protocol.tasks.seed.is_none()
             && protocol.kind != EvaluationKind::Policy
         {
-            add_evaluators(evaluated_by, record.evaluated_by);
+            evaluated_by.add(record.evaluated_by);
             found.push((protocol, record.results));
         }
     }
@@ -514,7 +518,7 @@ pub(crate) fn bare_run(seed: u32) -> RunData {
         plan_once: None,
         noisy: Vec::new(),
         deep: None,
-        evaluated_by: Vec::new(),
+        evaluated_by: Evaluators::default(),
         over_training: Vec::new(),
         processors: Vec::new(),
         evaluation_notes: Vec::new(),

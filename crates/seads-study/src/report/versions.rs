@@ -102,15 +102,14 @@ pub fn version_tables(runs: &[&RunData], known: &dyn Fn(&str) -> Option<bool>) -
         let name = run.dir.display().to_string();
         let evaluators: Vec<Version> = run
             .evaluated_by
+            .named
             .iter()
             .map(|e| Version {
                 commit: e.commit.clone(),
                 dirty: e.dirty,
             })
             .collect();
-        if evaluators.is_empty() {
-            unnamed += usize::from(run.has_evaluations());
-        }
+        unnamed += usize::from(run.evaluated_by.unnamed > 0);
         let evaluated_by: Vec<String> = evaluators.iter().map(Version::named).collect();
         let evaluated_by = evaluated_by.join(";");
         for v in evaluators {
@@ -215,7 +214,7 @@ pub fn version_tables(runs: &[&RunData], known: &dyn Fn(&str) -> Option<bool>) -
     if unnamed > 0 {
         let _ = writeln!(
             md,
-            "\nThe evaluation files of {unnamed} run(s) name no binary (written before evaluation \
+            "\nSome evaluation files of {unnamed} run(s) name no binary (written before evaluation \
              files did, or resumed from one that did not)."
         );
     }
@@ -285,9 +284,11 @@ mod tests {
             commit: commit.into(),
             dirty,
         };
-        runs[0].evaluated_by = vec![evaluator("ccc3", false)];
-        runs[1].evaluated_by = vec![evaluator("ccc3", false), evaluator("ddd4", true)];
-        runs[2].replan = Some(vec![seads_planner::DepthResult::new(1)]);
+        runs[0].evaluated_by.add(vec![evaluator("ccc3", false)]);
+        runs[1]
+            .evaluated_by
+            .add(vec![evaluator("ccc3", false), evaluator("ddd4", true)]);
+        runs[2].evaluated_by.add(Vec::new());
         let refs: Vec<&RunData> = runs.iter().collect();
         let (md, csv) = version_tables(&refs, &known);
         let rows: Vec<&str> = csv.lines().skip(1).collect();
@@ -306,7 +307,15 @@ mod tests {
             "{md}"
         );
         assert!(
-            md.contains("The evaluation files of 1 run(s) name no binary"),
+            md.contains("Some evaluation files of 1 run(s) name no binary"),
+            "{md}"
+        );
+        // A run whose files name a binary and none: it counts among the runs naming none too.
+        runs[0].evaluated_by.add(Vec::new());
+        let refs: Vec<&RunData> = runs.iter().collect();
+        let (md, _) = version_tables(&refs, &known);
+        assert!(
+            md.contains("Some evaluation files of 2 run(s) name no binary"),
             "{md}"
         );
         // One clean known commit for every run: said in one sentence.
