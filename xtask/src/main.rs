@@ -18,7 +18,7 @@ Commands:
   run          set up libtorch if needed, build in release mode and run `seads run` (the main job)
   ci           set up, then fmt --check, clippy -D warnings, doc -D warnings, package, every test,
                and the Python package's pytest suite in target/py-venv (CI)
-  setup        install libtorch for tch into .venv / .libtorch (idempotent; scripts/setup.sh);
+  setup        install libtorch for tch (once per machine, linked as .libtorch; scripts/setup.sh);
                `setup --cuda` adds the CUDA libraries (then build with --features cuda)
   package      cargo package every library crate in dependency order, building each package (slow),
                then the Python package's one abi3 wheel (every CPython >= 3.9) into target/wheels
