@@ -2,20 +2,28 @@
 
 use std::path::Path;
 
-use anyhow::{Context, Result};
-use seads_games::tables::{depth_counts_csv, split_counts_csv};
+use anyhow::Result;
 
-/// Writes `data/depth_counts.csv` and `data/split_counts.csv`.
+use crate::step;
+
+/// Writes `data/depth_counts.csv` and `data/split_counts.csv` by seads-games's example `tables`
+/// (built optimised: it enumerates every board of LightsOut 5×5). xtask runs it rather than
+/// linking the crate, so that building xtask, the first thing `cargo xtask ci` does on a fresh
+/// clone, compiles no workspace crate.
 pub fn run(root: &Path) -> Result<()> {
     let data = root.join("data");
-    std::fs::create_dir_all(&data)?;
-    for (name, csv) in [
-        ("depth_counts.csv", depth_counts_csv()),
-        ("split_counts.csv", split_counts_csv()),
-    ] {
-        let path = data.join(name);
-        std::fs::write(&path, csv).with_context(|| format!("writing {}", path.display()))?;
-        eprintln!("xtask: wrote {}", path.display());
-    }
-    Ok(())
+    step(
+        "cargo",
+        &[
+            "run",
+            "--release",
+            "--quiet",
+            "--package",
+            "seads-games",
+            "--example",
+            "tables",
+            "--",
+            &data.to_string_lossy(),
+        ],
+    )
 }

@@ -1,4 +1,5 @@
-//! The depth and split tables written to `data/` by `cargo xtask gen-splits` (SPEC §1.3, §1.4).
+//! The depth and split tables written to `data/` by `cargo xtask gen-splits` (the example
+//! `tables`; SPEC §1.3, §1.4).
 
 use std::fmt::Write as _;
 

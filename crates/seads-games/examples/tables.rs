@@ -1,0 +1,42 @@
+//! Writes the depth and split tables (`depth_counts.csv`, `split_counts.csv`: SPEC §1.3, §1.4)
+//! into a folder, from a fresh enumeration; `cargo xtask gen-splits` runs it for `data/`, and
+//! `tests/tables.rs` checks that the committed tables are what it writes.
+//!
+//! ```sh
+//! cargo run --release -p seads-games --example tables -- data
+//! ```
+#![allow(clippy::print_stderr)] // an example says what it wrote
+
+use std::io::Write as _;
+use std::path::Path;
+
+use seads_games::tables::{depth_counts_csv, split_counts_csv};
+
+/// Writes `text` to `path` whole or not at all: a temporary file beside it, synced, renamed.
+fn write_atomically(path: &Path, text: &str) -> std::io::Result<()> {
+    let temporary = path.with_extension("csv.tmp");
+    let mut file = std::fs::File::create(&temporary)?;
+    file.write_all(text.as_bytes())?;
+    file.sync_all()?;
+    std::fs::rename(&temporary, path)
+}
+
+fn main() -> std::io::Result<()> {
+    let Some(folder) = std::env::args_os().nth(1) else {
+        eprintln!(
+            "usage: tables FOLDER (writes FOLDER/depth_counts.csv and FOLDER/split_counts.csv)"
+        );
+        std::process::exit(2);
+    };
+    let folder = Path::new(&folder);
+    std::fs::create_dir_all(folder)?;
+    for (name, csv) in [
+        ("depth_counts.csv", depth_counts_csv()),
+        ("split_counts.csv", split_counts_csv()),
+    ] {
+        let path = folder.join(name);
+        write_atomically(&path, &csv)?;
+        eprintln!("wrote {}", path.display());
+    }
+    Ok(())
+}
