@@ -33,7 +33,12 @@ cuda_stamp="$stamp-cuda"
 # Slurm and munge for the Slurm test (root and apt-get only; otherwise the test skips).
 bash "$root/scripts/slurm/install.sh"
 
-ready() { [[ -f "$stamp" && -f "$link/lib/libtorch_cpu.so" ]] && { ! $cuda || [[ -f "$cuda_stamp" ]]; }; }
+# Ready: this version installed and the link pointing into it (a link left by an older version,
+# or by the in-repository .venv of earlier set-ups, is made again).
+ready() {
+  [[ -f "$stamp" && -f "$link/lib/libtorch_cpu.so" ]] && { ! $cuda || [[ -f "$cuda_stamp" ]]; } \
+    && [[ "$(readlink -f "$link")" == "$(readlink -f "$venv")"/* ]]
+}
 ready && exit 0
 
 mkdir -p "$store"

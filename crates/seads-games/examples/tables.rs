@@ -12,13 +12,11 @@ use std::path::Path;
 
 use seads_games::tables::{depth_counts_csv, split_counts_csv};
 
-/// Writes `text` to `path` whole or not at all: a temporary file beside it, synced, renamed.
+/// Writes `text` to `path` whole or not at all (temporary file, fsync, rename, the folder fsynced).
 fn write_atomically(path: &Path, text: &str) -> std::io::Result<()> {
-    let temporary = path.with_extension("csv.tmp");
-    let mut file = std::fs::File::create(&temporary)?;
+    let mut file = atomic_write_file::AtomicWriteFile::open(path)?;
     file.write_all(text.as_bytes())?;
-    file.sync_all()?;
-    std::fs::rename(&temporary, path)
+    file.commit()
 }
 
 fn main() -> std::io::Result<()> {
@@ -39,4 +37,18 @@ fn main() -> std::io::Result<()> {
         eprintln!("wrote {}", path.display());
     }
     Ok(())
+}
+
+#[test]
+fn a_table_is_written_whole_over_the_old_one_and_no_temporary_file_stays() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("depth_counts.csv");
+    std::fs::write(&path, "old\n").unwrap();
+    write_atomically(&path, "game,size,depth,count\n").unwrap();
+    assert_eq!(
+        std::fs::read_to_string(&path).unwrap(),
+        "game,size,depth,count\n"
+    );
+    let names: Vec<_> = std::fs::read_dir(dir.path()).unwrap().collect();
+    assert_eq!(names.len(), 1, "only the table is left: {names:?}");
 }
