@@ -296,7 +296,11 @@ fn build_env(
     };
     let arm = connection.arm(twin)?;
     let tablet = connection.tablet(twin)?;
-    Ok(UarmEnv::new(arm, tablet, calibration, config)?)
+    let env = UarmEnv::new(arm, tablet, calibration, config)?;
+    Ok(match twin {
+        Some(twin) => env.on_twin(twin.clone()),
+        None => env,
+    })
 }
 
 /// The twin calibrated on the spot, as a person would calibrate the arm (silently: `seads uarm

@@ -49,6 +49,22 @@ pub trait Environment: Send + Sync {
     }
     /// A boxed copy (same state, same random streams).
     fn box_clone(&self) -> Box<dyn Environment>;
+    /// What of the environment outlives [`Environment::reset`] and [`Environment::seed`], as
+    /// text that a checkpoint keeps: a world whose episodes start where the last one ended (the
+    /// robot under the paper's protocol, with its tablet and its noise streams). `None`, the
+    /// default, when a reset after a seed depends on nothing else, as in every simulation.
+    fn carried_state(&self) -> Option<String> {
+        None
+    }
+    /// Puts back what [`Environment::carried_state`] gave, so that a resumed run goes on in the
+    /// world the stopped one left. An environment that carries nothing refuses.
+    fn restore_carried_state(&mut self, state: &str) -> Result<(), EnvError> {
+        let _ = state;
+        Err(EnvError::Unsupported {
+            env: self.spec().name.clone(),
+            what: "restoring a state carried between episodes".into(),
+        })
+    }
 
     /// The current observation as a new vector.
     fn observation(&self) -> Vec<f32> {

@@ -67,6 +67,12 @@ impl Environment for Filmed {
     fn move_point(&self) -> Option<[f64; 2]> {
         self.inner.move_point()
     }
+    fn carried_state(&self) -> Option<String> {
+        self.inner.carried_state()
+    }
+    fn restore_carried_state(&mut self, state: &str) -> Result<(), EnvError> {
+        self.inner.restore_carried_state(state)
+    }
     /// A clone films nothing: only this environment's steps are frames.
     fn box_clone(&self) -> Box<dyn Environment> {
         self.inner.box_clone()

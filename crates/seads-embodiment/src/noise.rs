@@ -100,6 +100,12 @@ impl Environment for ActionNoise {
     fn move_point(&self) -> Option<[f64; 2]> {
         self.inner.move_point()
     }
+    fn carried_state(&self) -> Option<String> {
+        self.inner.carried_state()
+    }
+    fn restore_carried_state(&mut self, state: &str) -> Result<(), EnvError> {
+        self.inner.restore_carried_state(state)
+    }
     fn box_clone(&self) -> Box<dyn Environment> {
         Box::new(Self {
             inner: self.inner.box_clone(),

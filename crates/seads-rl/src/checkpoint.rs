@@ -16,6 +16,9 @@ pub const EPISODES_FILE: &str = "episodes.safetensors";
 pub const PREPARED_FILE: &str = "prepared.safetensors";
 /// Epoch, environment steps, time per phase and the random streams.
 pub const PROGRESS_FILE: &str = "progress.json";
+/// What the environments carry from one episode to the next (absent when they carry nothing):
+/// a JSON list of each training slot's state, then the coverage environment's.
+pub const ENVIRONMENT_FILE: &str = "environment.json";
 
 /// Every file of a checkpoint that only resuming needs (evaluation needs the actor and the
 /// skill model's parameters): they are dropped from all but the two newest checkpoints.
@@ -23,7 +26,12 @@ pub fn resume_only_files() -> Vec<&'static str> {
     crate::sac::RESUME_FILES
         .iter()
         .chain(&seads_skillmodel::OPTIMISER_FILES)
-        .chain(&[EPISODES_FILE, PREPARED_FILE, PROGRESS_FILE])
+        .chain(&[
+            EPISODES_FILE,
+            PREPARED_FILE,
+            PROGRESS_FILE,
+            ENVIRONMENT_FILE,
+        ])
         .copied()
         .collect()
 }

@@ -420,7 +420,61 @@ impl Trainer {
         }
         let path = dir.join(checkpoint::PROGRESS_FILE);
         let text = serde_json::to_string(&self.progress).map_err(|e| RlError::io(&path, e))?;
+        std::fs::write(&path, text).map_err(|e| RlError::io(&path, e))?;
+        self.save_carried(dir)
+    }
+
+    /// Every environment, the training slots then the coverage environment.
+    fn all_envs(&mut self) -> impl Iterator<Item = &mut Box<dyn Environment>> {
+        self.envs
+            .iter_mut()
+            .chain(std::iter::once(&mut self.eval_env))
+    }
+
+    /// Writes [`checkpoint::ENVIRONMENT_FILE`] if any environment carries state between
+    /// episodes (the robot); simulations write nothing.
+    fn save_carried(&self, dir: &Path) -> Result<(), RlError> {
+        let states: Vec<Option<String>> = self
+            .envs
+            .iter()
+            .chain(std::iter::once(&self.eval_env))
+            .map(|env| env.carried_state())
+            .collect();
+        if states.iter().all(Option::is_none) {
+            return Ok(());
+        }
+        let path = dir.join(checkpoint::ENVIRONMENT_FILE);
+        let text = serde_json::to_string(&states).map_err(|e| RlError::io(&path, e))?;
         std::fs::write(&path, text).map_err(|e| RlError::io(&path, e))
+    }
+
+    /// Restores what [`Trainer::save_carried`] wrote. A checkpoint without the file (from
+    /// before it, or of environments that carry nothing) leaves the environments as they are.
+    fn load_carried(&mut self, dir: &Path) -> Result<(), RlError> {
+        let path = dir.join(checkpoint::ENVIRONMENT_FILE);
+        let text = match std::fs::read_to_string(&path) {
+            Ok(text) => text,
+            Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok(()),
+            Err(e) => return Err(RlError::io(&path, e)),
+        };
+        let states: Vec<Option<String>> =
+            serde_json::from_str(&text).map_err(|e| RlError::unreadable(&path, e))?;
+        let count = self.envs.len() + 1;
+        if states.len() != count {
+            return Err(RlError::Checkpoint {
+                path: path.display().to_string(),
+                reason: format!(
+                    "it holds {} environment states where the run has {count} environments",
+                    states.len()
+                ),
+            });
+        }
+        for (env, state) in self.all_envs().zip(states) {
+            if let Some(state) = state {
+                env.restore_carried_state(&state)?;
+            }
+        }
+        Ok(())
     }
 
     /// Writes what is needed to execute and plan with the agent: the actor and the skill model.
@@ -451,7 +505,7 @@ impl Trainer {
         let path = dir.join(checkpoint::PROGRESS_FILE);
         let text = std::fs::read_to_string(&path).map_err(|e| RlError::io(&path, e))?;
         self.progress = serde_json::from_str(&text).map_err(|e| RlError::unreadable(&path, e))?;
-        Ok(())
+        self.load_carried(dir)
     }
 }
 

@@ -16,7 +16,7 @@ use crate::UarmError;
 use crate::calibration::Calibration;
 use crate::driver::Swift;
 use crate::tablet::Tablet;
-use crate::twin::TwinNoise;
+use crate::twin::{Twin, TwinNoise, TwinState};
 
 /// How actions move the pen.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
@@ -246,6 +246,19 @@ pub struct UarmEnv {
     config: UarmConfig,
     hardware: Arc<Mutex<Hardware>>,
     steps: usize,
+    /// The twin the hardware is, whose state the environment carries between episodes.
+    twin: Option<Twin>,
+}
+
+/// What a run on the twin carries from one episode to the next ([`Environment::carried_state`]):
+/// the environment's view (the pen over the screen, the last report and its board) and the twin.
+#[derive(Debug, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct Carried {
+    cursor: [f64; 2],
+    seq: u64,
+    board: SymbolicState,
+    twin: TwinState,
 }
 
 impl UarmEnv {
@@ -310,7 +323,17 @@ impl UarmEnv {
             config,
             hardware: Arc::new(Mutex::new(hardware)),
             steps: 0,
+            twin: None,
         })
+    }
+
+    /// Tells the environment that its arm and tablet are `twin`'s, so that it carries the twin's
+    /// state with its own between episodes (a checkpoint keeps both; a resumed run goes on with
+    /// the twin the stopped run left). On the real arm nothing is carried: the arm and the
+    /// tablet keep their own state.
+    pub fn on_twin(mut self, twin: Twin) -> Self {
+        self.twin = Some(twin);
+        self
     }
 
     fn lock(&self) -> MutexGuard<'_, Hardware> {
@@ -536,5 +559,48 @@ impl Environment for UarmEnv {
 
     fn box_clone(&self) -> Box<dyn Environment> {
         Box::new(self.clone())
+    }
+
+    fn carried_state(&self) -> Option<String> {
+        let twin = self.twin.as_ref()?;
+        let hw = self.lock();
+        let carried = Carried {
+            cursor: hw.cursor,
+            seq: hw.seq,
+            board: hw.board.board(),
+            twin: twin.state(),
+        };
+        Some(serde_json::to_string(&carried).expect("plain fields serialise"))
+    }
+
+    fn restore_carried_state(&mut self, state: &str) -> Result<(), EnvError> {
+        let invalid = |reason: String| EnvError::InvalidState {
+            env: self.spec.name.clone(),
+            reason,
+        };
+        let Some(twin) = &self.twin else {
+            return Err(EnvError::Unsupported {
+                env: self.spec.name.clone(),
+                what: "restoring a state carried between episodes on the real arm".into(),
+            });
+        };
+        let carried: Carried = serde_json::from_str(state)
+            .map_err(|e| invalid(format!("a carried state that does not read: {e}")))?;
+        if !carried.cursor.iter().all(|v| (0.0..=1.0).contains(v)) {
+            return Err(invalid(format!(
+                "a pen position is 2 values in [0, 1], got {:?}",
+                carried.cursor
+            )));
+        }
+        if !crate::game().is_valid(carried.board) {
+            return Err(invalid("not a LightsOut 5×5 board".into()));
+        }
+        twin.restore(&carried.twin)
+            .map_err(|e| invalid(e.to_string()))?;
+        let mut hw = self.lock();
+        hw.board.set(carried.board)?;
+        hw.cursor = carried.cursor;
+        hw.seq = carried.seq;
+        Ok(())
     }
 }

@@ -73,7 +73,7 @@ pub fn game() -> seads_games::LightsOut {
 pub use driver::{DriverConfig, SerialTransport, Swift, Transport};
 pub use env::{ActionSpace, Observation, RobotSettings, UarmConfig, UarmEnv};
 pub use tablet::{AdbTablet, Tablet, TabletReport};
-pub use twin::{Faults, Twin, TwinNoise, twin_screen_corners};
+pub use twin::{Faults, Twin, TwinNoise, TwinState, twin_screen_corners};
 
 /// What can go wrong with the robot.
 #[derive(Debug, thiserror::Error)]

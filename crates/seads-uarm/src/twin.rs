@@ -106,6 +106,23 @@ struct World {
     late: bool,
 }
 
+/// What of the twin outlives an episode: the pen, the board and its log, and where the noise's
+/// stream stands. A checkpoint keeps it ([`Twin::state`], [`Twin::restore`]), so that a resumed
+/// run goes on with the twin it left, as the real arm stays where it was. Faults and the trail
+/// are for tests and are not part of it.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct TwinState {
+    pen: [f64; 3],
+    touching: bool,
+    board: SymbolicState,
+    seq: u64,
+    last_move: Option<usize>,
+    timed: u64,
+    late: bool,
+    noise_rng: ChaCha8Rng,
+}
+
 /// The shared simulated world; hand out its arm transport and its tablet.
 #[derive(Clone)]
 pub struct Twin {
@@ -220,6 +237,50 @@ impl Twin {
     /// Every G0 target the arm received.
     pub fn trail(&self) -> Vec<[f64; 3]> {
         self.lock().trail.clone()
+    }
+
+    /// The state a resumed run needs to go on with this twin.
+    pub fn state(&self) -> TwinState {
+        let w = self.lock();
+        TwinState {
+            pen: w.pen,
+            touching: w.touching,
+            board: w.board,
+            seq: w.seq,
+            last_move: w.last_move,
+            timed: w.timed,
+            late: w.late,
+            noise_rng: w.noise_rng.clone(),
+        }
+    }
+
+    /// Puts the twin into `state` (from [`Twin::state`] of a twin of the same noise). A state no
+    /// twin can be in (a pen off the numbers, a board that is not LightsOut's, a move that is
+    /// not one, a report timed ahead of the log) is refused and changes nothing.
+    pub fn restore(&self, state: &TwinState) -> Result<(), UarmError> {
+        let mut w = self.lock();
+        let bad = |what: &str| Err(UarmError::Config(format!("the twin's saved state: {what}")));
+        if !state.pen.iter().all(|v| v.is_finite()) {
+            return bad("the pen's position is not finite");
+        }
+        if !w.game.is_valid(state.board) {
+            return bad("not a LightsOut 5×5 board");
+        }
+        if state.last_move.is_some_and(|m| m >= w.game.num_moves()) {
+            return bad("a move LightsOut 5×5 does not have");
+        }
+        if state.timed > state.seq {
+            return bad("a report timed after the newest");
+        }
+        w.pen = state.pen;
+        w.touching = state.touching;
+        w.board = state.board;
+        w.seq = state.seq;
+        w.last_move = state.last_move;
+        w.timed = state.timed;
+        w.late = state.late;
+        w.noise_rng = state.noise_rng.clone();
+        Ok(())
     }
 
     /// Moves the detached arm by hand (calibration: a person places the pen on a corner).

@@ -576,3 +576,102 @@ fn robot_settings_from_before_the_observation_read_as_the_defaults() {
         Err(UarmError::Config(_))
     ));
 }
+
+/// Presses at `points` (absolute pushes under the paper's protocol: no resets of board or pen),
+/// each what the robot saw of it and the observation after it.
+fn presses(env: &mut UarmEnv, points: &[[f32; 2]]) -> Vec<(Push, Vec<f32>)> {
+    points
+        .iter()
+        .map(|p| {
+            env.reset().unwrap();
+            let push = env.step(p).unwrap().push;
+            (push, env.observation())
+        })
+        .collect()
+}
+
+/// A noisy twin under the paper's protocol, with its environment carrying its state.
+fn carrying_env(seed: u64) -> (Twin, UarmEnv) {
+    let noise = TwinNoise {
+        tap_sd_mm: 12.0,
+        late_report_p: 0.3,
+    };
+    let twin = Twin::with_noise(seed, noise).unwrap();
+    let env = env_with(&twin, ActionSpace::Absolute, false).on_twin(twin.clone());
+    (twin, env)
+}
+
+proptest::proptest! {
+    #![proptest_config(proptest::prelude::ProptestConfig::with_cases(12))]
+
+    /// A run stopped after any press and resumed on a fresh twin from the carried state presses
+    /// as the run that was never stopped: the same taps, reports, boards and observations (the
+    /// paper's protocol resets nothing, so the twin's pen, board and noise carry history). A
+    /// fresh twin that is not given the state goes elsewhere.
+    #[test]
+    fn a_twin_run_resumed_from_its_carried_state_is_the_run_never_stopped(
+        seed in 0u64..1000,
+        stop in 1usize..30,
+    ) {
+        use rand::{RngExt, SeedableRng};
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(seed);
+        let points: Vec<[f32; 2]> = (0..40).map(|_| [rng.random(), rng.random()]).collect();
+        let (whole_twin, mut whole) = carrying_env(seed);
+        let all = presses(&mut whole, &points);
+        let (twin, mut stopped) = carrying_env(seed);
+        presses(&mut stopped, &points[..stop]);
+        let state = stopped.carried_state().expect("an environment on the twin carries state");
+        drop((twin, stopped));
+        let (twin, mut resumed) = carrying_env(seed);
+        resumed.restore_carried_state(&state).unwrap();
+        proptest::prop_assert_eq!(&presses(&mut resumed, &points[stop..]), &all[stop..]);
+        let (_, mut fresh) = carrying_env(seed);
+        proptest::prop_assert_ne!(&presses(&mut fresh, &points[stop..]), &all[stop..]);
+        proptest::prop_assert_eq!(twin.state(), whole_twin.state());
+    }
+}
+
+/// The real arm carries nothing (it stays where it is); a state that does not read, or one no
+/// twin can be in, is refused and changes nothing.
+#[test]
+fn carried_states_that_cannot_be_are_refused() {
+    let twin = Twin::new(4);
+    let mut plain = env_with(&twin, ActionSpace::Absolute, false);
+    assert_eq!(
+        plain.carried_state(),
+        None,
+        "without on_twin nothing is carried"
+    );
+    let (twin, mut env) = carrying_env(4);
+    presses(&mut env, &[[0.3, 0.7], [0.9, 0.1]]);
+    let good = env.carried_state().unwrap();
+    assert!(matches!(
+        plain.restore_carried_state(&good),
+        Err(EnvError::Unsupported { .. })
+    ));
+    let v: serde_json::Value = serde_json::from_str(&good).unwrap();
+    let with = |pointer: &str, value: serde_json::Value| {
+        let mut v = v.clone();
+        *v.pointer_mut(pointer).unwrap() = value;
+        v.to_string()
+    };
+    let (before, pen, board) = (env.observation(), twin.pen(), twin.board());
+    for bad in [
+        "{".to_string(),
+        "null".to_string(),
+        with("/cursor/0", serde_json::json!(1.5)),
+        with("/board/words/0", serde_json::json!(u64::MAX)),
+        with("/twin/pen/2", serde_json::json!(null)),
+        with("/twin/noise_rng/word_pos", serde_json::json!(-1)),
+        with("/twin/board/words/0", serde_json::json!(u64::MAX)),
+        with("/twin/last_move", serde_json::json!(25)),
+        with("/twin/timed", serde_json::json!(u64::MAX)),
+    ] {
+        let err = env.restore_carried_state(&bad).unwrap_err();
+        assert!(matches!(err, EnvError::InvalidState { .. }), "{bad}: {err}");
+        assert_eq!(env.observation(), before, "{bad}");
+        assert_eq!((twin.pen(), twin.board()), (pen, board), "{bad}");
+    }
+    env.restore_carried_state(&good).unwrap();
+    assert_eq!(env.carried_state().unwrap(), good);
+}
