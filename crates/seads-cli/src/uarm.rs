@@ -414,6 +414,14 @@ pub fn train(mut args: UarmTrainArgs) -> Result<()> {
             })?;
         }
         let run = crate::train::resume(&args.out, Run::resume_with(&args.out, trainer))?;
+        if run.trainer().resumed_without_carried_state() {
+            eprintln!(
+                "seads: {}: its checkpoint holds no state of the twin (it was written before \
+                 checkpoints kept it), so training goes on with a fresh twin and parts from the \
+                 run never stopped",
+                args.out.display()
+            );
+        }
         (run, lock)
     } else {
         let config = robot_config(&env, &args)?;

@@ -97,6 +97,8 @@ pub struct Trainer {
     prepared: Option<Prepared>,
     /// Sees each joint relabelling (diagnostics only; not part of a checkpoint).
     relabel_observer: Option<Box<RelabelObserver>>,
+    /// The last [`Trainer::load`] found no carried state for environments that carry one.
+    carried_missing: bool,
 }
 
 impl Trainer {
@@ -175,6 +177,7 @@ impl Trainer {
             progress,
             prepared: None,
             relabel_observer: None,
+            carried_missing: false,
         })
     }
 
@@ -452,9 +455,14 @@ impl Trainer {
     /// before it, or of environments that carry nothing) leaves the environments as they are.
     fn load_carried(&mut self, dir: &Path) -> Result<(), RlError> {
         let path = dir.join(checkpoint::ENVIRONMENT_FILE);
+        self.carried_missing = false;
         let text = match std::fs::read_to_string(&path) {
             Ok(text) => text,
-            Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok(()),
+            Err(e) if e.kind() == std::io::ErrorKind::NotFound => {
+                let carries = self.all_envs().any(|env| env.carried_state().is_some());
+                self.carried_missing = carries;
+                return Ok(());
+            }
             Err(e) => return Err(RlError::io(&path, e)),
         };
         let states: Vec<Option<String>> =
@@ -475,6 +483,13 @@ impl Trainer {
             }
         }
         Ok(())
+    }
+
+    /// Whether the last [`Trainer::load`] found no state for environments that carry one from
+    /// episode to episode (a robot run's checkpoint from before checkpoints kept the twin's):
+    /// training goes on in the world as it is now, so the run parts from the one never stopped.
+    pub fn resumed_without_carried_state(&self) -> bool {
+        self.carried_missing
     }
 
     /// Writes what is needed to execute and plan with the agent: the actor and the skill model.

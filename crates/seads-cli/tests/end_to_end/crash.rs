@@ -13,7 +13,7 @@ use std::sync::OnceLock;
 
 use serde_json::Value;
 
-use crate::common::{kill_at_moment, metrics_without_clock, park_at_moment};
+use crate::common::{copy_dir, kill_at_moment, metrics_without_clock, park_at_moment};
 
 const SEADS: &str = env!("CARGO_BIN_EXE_seads");
 
@@ -397,8 +397,8 @@ fn damaged_runs_are_repaired_with_a_word_or_refused_never_retrained() {
 /// checkpoint at epoch 100 and resumed, ends as the run never killed: the same metrics, the same
 /// twin in its last checkpoint and the same evaluation. The paper's protocol resets neither the
 /// board nor the pen, and the twin's noise draws go on from run to run, so this holds only
-/// because the checkpoint keeps what the twin carries (without it the resumed run's coverage,
-/// losses and boards part from the whole run's after the resume).
+/// because the checkpoint keeps what the twin carries: a checkpoint without it (as before it was
+/// kept) is resumed with a fresh twin, says so, and parts from the whole run.
 #[test]
 fn a_twin_run_killed_and_resumed_is_the_run_never_killed() {
     let dir = tempfile::tempdir().unwrap();
@@ -444,8 +444,20 @@ fn a_twin_run_killed_and_resumed_is_the_run_never_killed() {
             .0;
     let resumed = dir.path().join("resumed");
     kill_at_moment(uarm(&resumed, &new), point);
+    // The same run with a checkpoint from before checkpoints kept the twin: it says that it goes
+    // on with a fresh twin, and it parts from the whole run.
+    let stale = dir.path().join("stale");
+    copy_dir(&resumed, &stale);
+    std::fs::remove_file(stale.join("checkpoints/epoch-000100/environment.json")).unwrap();
+    let output = uarm(&stale, &["--resume"]).output().unwrap();
+    assert!(output.status.success(), "{output:?}");
+    let stderr = String::from_utf8_lossy(&output.stderr);
+    assert!(stderr.contains("holds no state of the twin"), "{stderr}");
+    assert_ne!(metrics_without_clock(&stale), metrics_without_clock(&whole));
     let output = uarm(&resumed, &["--resume"]).output().unwrap();
     assert!(output.status.success(), "{output:?}");
+    let stderr = String::from_utf8_lossy(&output.stderr);
+    assert!(!stderr.contains("twin"), "{stderr}");
     assert_eq!(
         metrics_without_clock(&resumed),
         metrics_without_clock(&whole)
