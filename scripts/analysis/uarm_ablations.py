@@ -10,7 +10,7 @@ import sys
 
 study = pathlib.Path(sys.argv[1])
 ORDER = ["paper", "observe-board", "observe-pen", "observe-nothing", "alpha-0.01", "alpha-0.3",
-         "tap-sd-5mm", "late-reports-0.1", "updates-4", "updates-64", "episodes-16", "episodes-1"]
+         "tap-sd-5mm", "late-reports-0.1", "late-reports-0.1-pen", "updates-4", "updates-64", "episodes-16", "episodes-1"]
 WHAT = {
     "paper": "the paper's protocol (4 one-press episodes per epoch, 16 SAC updates, α 0.1, board and pen seen, a perfect twin)",
     "observe-board": "the skills see the board, not the pen",
@@ -20,6 +20,7 @@ WHAT = {
     "alpha-0.3": "SAC α 0.3",
     "tap-sd-5mm": "taps scatter by 5 mm (σ per axis)",
     "late-reports-0.1": "10 % of the tablet's reports come a press late",
+    "late-reports-0.1-pen": "10 % of the reports a press late, the skills see the pen only",
     "updates-4": "4 SAC updates per epoch",
     "updates-64": "64 SAC updates per epoch",
     "episodes-16": "16 episodes per epoch",
