@@ -186,7 +186,8 @@ pub struct UarmTrainArgs {
     /// The search limits of the evaluation.
     #[command(flatten)]
     search: crate::plan::SearchArgs,
-    /// Continue the run in --out from its last checkpoint.
+    /// Continue the run in --out from its last checkpoint (on the twin, with the twin as the
+    /// checkpoint left it: the same run as one never stopped).
     #[arg(long)]
     resume: bool,
     /// One line per evaluation instead of a progress bar.
