@@ -434,15 +434,19 @@ impl Trainer {
             .chain(std::iter::once(&mut self.eval_env))
     }
 
-    /// Writes [`checkpoint::ENVIRONMENT_FILE`] if any environment carries state between
-    /// episodes (the robot); simulations write nothing.
-    fn save_carried(&self, dir: &Path) -> Result<(), RlError> {
-        let states: Vec<Option<String>> = self
-            .envs
+    /// What each environment carries between episodes, in [`Trainer::all_envs`]'s order.
+    fn carried_states(&self) -> Vec<Option<String>> {
+        self.envs
             .iter()
             .chain(std::iter::once(&self.eval_env))
             .map(|env| env.carried_state())
-            .collect();
+            .collect()
+    }
+
+    /// Writes [`checkpoint::ENVIRONMENT_FILE`] if any environment carries state between
+    /// episodes (the robot); simulations write nothing.
+    fn save_carried(&self, dir: &Path) -> Result<(), RlError> {
+        let states = self.carried_states();
         if states.iter().all(Option::is_none) {
             return Ok(());
         }
@@ -459,8 +463,7 @@ impl Trainer {
         let text = match std::fs::read_to_string(&path) {
             Ok(text) => text,
             Err(e) if e.kind() == std::io::ErrorKind::NotFound => {
-                let carries = self.all_envs().any(|env| env.carried_state().is_some());
-                self.carried_missing = carries;
+                self.carried_missing = self.carried_states().iter().any(Option::is_some);
                 return Ok(());
             }
             Err(e) => return Err(RlError::io(&path, e)),
