@@ -878,3 +878,55 @@ fn no_manipulator_is_named_outside_the_embodiment_crate() {
     assert!(checked > 50, "{checked} source files checked");
     assert!(offenders.is_empty(), "{offenders:#?}");
 }
+
+/// The methods a block of code defines: the names after `fn` in the braces that follow the first
+/// line containing `head` (the braces counted in code only).
+fn methods_in_block(file: &str, head: &str) -> Vec<String> {
+    let code = code_only(&read(file));
+    let start = code
+        .find(head)
+        .unwrap_or_else(|| panic!("{file} has no {head:?}"));
+    let body = &code[start..];
+    let open = body.find('{').unwrap();
+    let mut depth = 0;
+    let mut end = open;
+    for (i, c) in body[open..].char_indices() {
+        match c {
+            '{' => depth += 1,
+            '}' => depth -= 1,
+            _ => {}
+        }
+        if depth == 0 {
+            end = open + i;
+            break;
+        }
+    }
+    let block = &body[open..end];
+    let words: Vec<&str> = words(block).collect();
+    words
+        .windows(2)
+        .filter(|w| w[0] == "fn")
+        .map(|w| w[1].to_owned())
+        .collect()
+}
+
+/// A wrapped environment (action noise, filming) forwards every method of `Environment` to the
+/// one it wraps, defaults included, in the one generic impl of `wrapper.rs`: a method added to
+/// the trait (as the state carried between episodes was) cannot be dropped by a layer.
+#[test]
+fn the_wrapper_forwards_every_method_of_the_environment() {
+    let trait_methods = methods_in_block(
+        "crates/seads-embodiment/src/embodied.rs",
+        "pub trait Environment",
+    );
+    let forwarded = methods_in_block(
+        "crates/seads-embodiment/src/wrapper.rs",
+        "impl<L: Layer> Environment for Wrapped<L>",
+    );
+    assert!(trait_methods.len() >= 15, "{trait_methods:?}");
+    let missing: Vec<_> = trait_methods
+        .iter()
+        .filter(|m| !forwarded.contains(m))
+        .collect();
+    assert!(missing.is_empty(), "Wrapped does not forward {missing:?}");
+}

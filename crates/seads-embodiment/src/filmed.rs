@@ -1,80 +1,72 @@
 //! An environment that films itself: its scene after every step, for animations (`seads solve
 //! --render`, `seads plot --animate`, Python's `Agent.solve(render=True)`).
 
-use seads_games::SymbolicState;
-
-use crate::{EnvError, EnvSpec, Environment, Scene, StepOutcome};
+use crate::wrapper::{Layer, Wrapped};
+use crate::{EnvError, Environment, Scene, StepOutcome};
 
 /// An environment that keeps its scene after every step (and at the start), for an animation.
-pub struct Filmed {
-    inner: Box<dyn Environment>,
-    /// The scenes: the first when filming started, then one per step.
-    pub frames: Vec<Scene>,
+pub type Filmed = Wrapped<Film>;
+
+/// The layer of a [`Filmed`] environment: the scenes, the first when filming started, then one
+/// per step.
+pub struct Film {
+    frames: Vec<Scene>,
+}
+
+impl Layer for Film {
+    fn step(
+        &mut self,
+        inner: &mut dyn Environment,
+        action: &[f32],
+    ) -> Result<StepOutcome, EnvError> {
+        let outcome = inner.step(action)?;
+        self.frames.push(inner.scene());
+        Ok(outcome)
+    }
+    /// A copy films nothing: only this environment's steps are frames.
+    fn for_copy(&self) -> Option<Self> {
+        None
+    }
 }
 
 impl Filmed {
     /// Films `inner` from now on.
     pub fn new(inner: Box<dyn Environment>) -> Self {
         let frames = vec![inner.scene()];
-        Self { inner, frames }
+        Self::wrap(inner, Film { frames })
     }
 
-    /// The environment, no longer filmed (in the state the filmed steps left it).
-    pub fn into_inner(self) -> Box<dyn Environment> {
-        self.inner
+    /// The scenes filmed so far.
+    pub fn frames(&self) -> &[Scene] {
+        &self.layer().frames
+    }
+
+    /// The scenes filmed so far, taken; filming goes on from the current scene.
+    pub fn take_frames(&mut self) -> Vec<Scene> {
+        let now = vec![self.scene()];
+        std::mem::replace(&mut self.layer_mut().frames, now)
     }
 }
 
-impl Environment for Filmed {
-    fn spec(&self) -> &EnvSpec {
-        self.inner.spec()
-    }
-    fn seed(&mut self, seed: u64) {
-        self.inner.seed(seed);
-    }
-    fn reset(&mut self) -> Result<(), EnvError> {
-        self.inner.reset()
-    }
-    fn step(&mut self, action: &[f32]) -> Result<StepOutcome, EnvError> {
-        let outcome = self.inner.step(action)?;
-        self.frames.push(self.inner.scene());
-        Ok(outcome)
-    }
-    fn observe(&self, out: &mut [f32]) {
-        self.inner.observe(out);
-    }
-    fn board(&self) -> SymbolicState {
-        self.inner.board()
-    }
-    fn set_board(&mut self, board: SymbolicState) -> Result<(), EnvError> {
-        self.inner.set_board(board)
-    }
-    fn reset_step_counter(&mut self) {
-        self.inner.reset_step_counter();
-    }
-    fn set_step_limit(&mut self, limit: Option<usize>) {
-        self.inner.set_step_limit(limit);
-    }
-    fn restore_manipulator(&mut self, state: &[f32]) -> Result<(), EnvError> {
-        self.inner.restore_manipulator(state)
-    }
-    fn scene(&self) -> Scene {
-        self.inner.scene()
-    }
-    fn end_effector(&self) -> [f64; 2] {
-        self.inner.end_effector()
-    }
-    fn move_point(&self) -> Option<[f64; 2]> {
-        self.inner.move_point()
-    }
-    fn carried_state(&self) -> Option<String> {
-        self.inner.carried_state()
-    }
-    fn restore_carried_state(&mut self, state: &str) -> Result<(), EnvError> {
-        self.inner.restore_carried_state(state)
-    }
-    /// A clone films nothing: only this environment's steps are frames.
-    fn box_clone(&self) -> Box<dyn Environment> {
-        self.inner.box_clone()
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::{EnvConfig, make_env};
+
+    #[test]
+    fn a_film_has_the_start_and_a_scene_per_step_and_its_copies_film_nothing() {
+        let mut filmed = Filmed::new(make_env("lightsout-cursor", &EnvConfig::default()).unwrap());
+        let start = filmed.scene();
+        for _ in 0..3 {
+            filmed.step(&[0.1, 0.0, -1.0]).unwrap();
+        }
+        assert_eq!(filmed.frames().len(), 4);
+        assert_eq!(filmed.frames()[0], start);
+        assert_eq!(filmed.frames()[3], filmed.scene());
+        let mut copy = filmed.box_clone();
+        copy.step(&[0.1, 0.0, -1.0]).unwrap();
+        assert_eq!(filmed.frames().len(), 4, "the copy's steps are not filmed");
+        let taken = filmed.take_frames();
+        assert_eq!((taken.len(), filmed.frames()), (4, &[filmed.scene()][..]));
     }
 }

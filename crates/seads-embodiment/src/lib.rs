@@ -63,17 +63,18 @@ mod runner;
 mod scene;
 mod spec;
 mod task;
+mod wrapper;
 
 pub use board::BoardState;
 pub use config::{EnvConfig, MOVED_TO_MANIPULATOR, NoOptions};
 pub use cursor::Cursor;
 pub use embodied::{Embodied, Environment, Manipulator, Touch};
 pub use error::EnvError;
-pub use filmed::Filmed;
+pub use filmed::{Film, Filmed};
 #[cfg(feature = "jaco")]
 pub use jaco::{DEFAULT_SUBSTEPS as JACO_DEFAULT_SUBSTEPS, Jaco, JacoBoard, JacoOptions};
 pub use layout::Layout;
-pub use noise::{ACTION_NOISE_STREAM, ActionNoise};
+pub use noise::{ACTION_NOISE_STREAM, ActionNoise, Noise};
 pub use policy::{SkillPolicy, SkillRun, execute_skill};
 pub use reacher::Reacher;
 pub use reacher3::Reacher3;
@@ -86,3 +87,4 @@ pub use runner::{Throughput, random_rollout};
 pub use scene::{FieldView, Scene, Shape};
 pub use spec::{EnvSpec, Push, StepOutcome};
 pub use task::{TaskEnv, TaskStep};
+pub use wrapper::{Layer, Wrapped};

@@ -5,19 +5,21 @@
 //! apart from the board's and the manipulator's streams, so a task sees the same noise on every
 //! machine and the board it plays is the board it plays without noise.
 
+use crate::wrapper::{Layer, Wrapped};
+use crate::{EnvError, Environment, StepOutcome};
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 use rand_distr::{Distribution, StandardNormal};
-use seads_games::SymbolicState;
-
-use crate::{EnvError, EnvSpec, Environment, Scene, StepOutcome};
 
 /// The ChaCha8 stream of the action noise (the ASCII of "noise").
 pub const ACTION_NOISE_STREAM: u64 = 0x6e_6f_69_73_65;
 
 /// An environment whose actions get Gaussian noise of standard deviation `std` before they act.
-pub struct ActionNoise {
-    inner: Box<dyn Environment>,
+pub type ActionNoise = Wrapped<Noise>;
+
+/// The layer of an [`ActionNoise`] environment: the noise's standard deviation and stream.
+#[derive(Clone)]
+pub struct Noise {
     std: f32,
     rng: ChaCha8Rng,
     noisy: Vec<f32>,
@@ -32,12 +34,12 @@ impl ActionNoise {
             )));
         }
         let noisy = vec![0.0; inner.spec().action_dim];
-        Ok(Self {
-            inner,
+        let noise = Noise {
             std: std as f32,
             rng: noise_rng(0),
             noisy,
-        })
+        };
+        Ok(Self::wrap(inner, noise))
     }
 }
 
@@ -48,22 +50,19 @@ fn noise_rng(seed: u64) -> ChaCha8Rng {
     rng
 }
 
-impl Environment for ActionNoise {
-    fn spec(&self) -> &EnvSpec {
-        self.inner.spec()
-    }
+impl Layer for Noise {
     fn seed(&mut self, seed: u64) {
-        self.inner.seed(seed);
         self.rng = noise_rng(seed);
     }
-    fn reset(&mut self) -> Result<(), EnvError> {
-        self.inner.reset()
-    }
-    fn step(&mut self, action: &[f32]) -> Result<StepOutcome, EnvError> {
+    fn step(
+        &mut self,
+        inner: &mut dyn Environment,
+        action: &[f32],
+    ) -> Result<StepOutcome, EnvError> {
         if action.len() != self.noisy.len() {
-            return self.inner.step(action); // the environment names the error
+            return inner.step(action); // the environment names the error
         }
-        let spec = self.inner.spec();
+        let spec = inner.spec();
         for (i, (out, &a)) in self.noisy.iter_mut().zip(action).enumerate() {
             let e: f32 = StandardNormal.sample(&mut self.rng);
             *out = (a + self.std * e).clamp(spec.action_low[i], spec.action_high[i]);
@@ -71,48 +70,10 @@ impl Environment for ActionNoise {
                 *out = a; // a non-finite action stays one, and the environment refuses it
             }
         }
-        self.inner.step(&self.noisy)
+        inner.step(&self.noisy)
     }
-    fn observe(&self, out: &mut [f32]) {
-        self.inner.observe(out);
-    }
-    fn board(&self) -> SymbolicState {
-        self.inner.board()
-    }
-    fn set_board(&mut self, board: SymbolicState) -> Result<(), EnvError> {
-        self.inner.set_board(board)
-    }
-    fn reset_step_counter(&mut self) {
-        self.inner.reset_step_counter();
-    }
-    fn set_step_limit(&mut self, limit: Option<usize>) {
-        self.inner.set_step_limit(limit);
-    }
-    fn restore_manipulator(&mut self, state: &[f32]) -> Result<(), EnvError> {
-        self.inner.restore_manipulator(state)
-    }
-    fn scene(&self) -> Scene {
-        self.inner.scene()
-    }
-    fn end_effector(&self) -> [f64; 2] {
-        self.inner.end_effector()
-    }
-    fn move_point(&self) -> Option<[f64; 2]> {
-        self.inner.move_point()
-    }
-    fn carried_state(&self) -> Option<String> {
-        self.inner.carried_state()
-    }
-    fn restore_carried_state(&mut self, state: &str) -> Result<(), EnvError> {
-        self.inner.restore_carried_state(state)
-    }
-    fn box_clone(&self) -> Box<dyn Environment> {
-        Box::new(Self {
-            inner: self.inner.box_clone(),
-            std: self.std,
-            rng: self.rng.clone(),
-            noisy: self.noisy.clone(),
-        })
+    fn for_copy(&self) -> Option<Self> {
+        Some(self.clone())
     }
 }
 

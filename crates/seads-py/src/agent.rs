@@ -273,7 +273,7 @@ impl Agent {
             // environment's place: the environment ends as an unfilmed solve leaves it.
             let mut filmed = Filmed::new(environment.box_clone());
             let outcome = seads_planner::solve(&mut filmed, policy, model, goal, &config);
-            let scenes = std::mem::take(&mut filmed.frames);
+            let scenes = filmed.take_frames();
             *environment = filmed.into_inner();
             (outcome, scenes)
         } else {
@@ -334,7 +334,7 @@ impl Agent {
         let environment = self.own_env(&mut core)?;
         let mut filmed = Filmed::new(environment.box_clone());
         let run = execute_skill(&mut filmed, &self.inner.policy, skill);
-        let scenes = std::mem::take(&mut filmed.frames);
+        let scenes = filmed.take_frames();
         *environment = filmed.into_inner();
         let run = run.map_err(value_error)?;
         let frames = scenes

@@ -27,11 +27,11 @@ pub fn skill_clips(
             filmed
                 .reset()
                 .map_err(|e| StudyError::file("resetting the environment", e))?;
-            filmed.frames = vec![filmed.scene()];
+            filmed.take_frames(); // from the board just drawn
             let run = execute_skill(&mut filmed, policy, skill)
                 .map_err(|e| StudyError::file("executing a skill", e))?;
             let caption = |t: usize| format!("skill {skill} · start {} · step {t}", start + 1);
-            for (t, scene) in filmed.frames.drain(..).enumerate() {
+            for (t, scene) in filmed.take_frames().into_iter().enumerate() {
                 frames.push((scene, caption(t)));
             }
             let moved = if run.outcome.moved() {

@@ -69,8 +69,8 @@ pub fn solve_board(args: SolveArgs) -> Result<()> {
     if let Some(out) = animate {
         let mut filmed = seads_embodiment::Filmed::new(env);
         let outcome = solve(&mut filmed, policy, model, game.goal(), &config)?;
-        let captions = captions(&agent.config.env, &outcome, filmed.frames.len());
-        let frames: Vec<_> = filmed.frames.into_iter().zip(captions).collect();
+        let captions = captions(&agent.config.env, &outcome, filmed.frames().len());
+        let frames: Vec<_> = filmed.take_frames().into_iter().zip(captions).collect();
         seads_study::animation::write_gif(&frames, 150, 1500, out)?;
         return report(&args, &game.format(board), &agent.checkpoint, &outcome);
     }
