@@ -107,6 +107,17 @@ pub struct PlannerConfig {
     pub search: Search,
 }
 
+impl PlannerConfig {
+    /// What an evaluation whose searches have these limits keeps of the successors they
+    /// computed ([`Memo`](crate::Memo)): half the search's memory bound, so that one memory
+    /// option bounds both. By default 2 GiB, about 9.6 million states of 25 skills: on the
+    /// twin's weakest agents, enough that a board met again in a later task is answered from
+    /// memory (`docs/results/memo/`).
+    pub fn memo_bytes(&self) -> usize {
+        self.memory_limit_mib.saturating_mul(1 << 20) / 2
+    }
+}
+
 impl Default for PlannerConfig {
     fn default() -> Self {
         Self {

@@ -7,7 +7,7 @@ use seads_embodiment::{EnvConfig, EnvError, SkillPolicy, make_env};
 use seads_games::{Successor, SymbolicState};
 use serde::{Deserialize, Serialize};
 
-use crate::{DEFAULT_MEMO_BYTES, Memo, Protocol, SolveConfig, SolveOutcome, TaskSet, solve};
+use crate::{Memo, Protocol, SolveConfig, SolveOutcome, TaskSet, solve};
 
 /// One task of an evaluation, as it ended.
 #[derive(Debug, Clone, Copy)]
@@ -152,7 +152,7 @@ pub fn evaluate_resuming(
     mut finished: impl FnMut(usize, u64) -> Option<TaskSummary>,
     mut each: impl FnMut(&TaskRecord<'_>),
 ) -> Result<Vec<DepthResult>, EnvError> {
-    let mut successor = Memo::new(successor, DEFAULT_MEMO_BYTES);
+    let mut successor = Memo::new(successor, evaluation.solve.planner.memo_bytes());
     let mut results = Vec::new();
     let seeds = evaluation.tasks.seeds();
     for &depth in &evaluation.tasks.depths {

@@ -41,7 +41,7 @@ pub use evaluate::{
 };
 pub use execute::{Deviation, SolveConfig, SolveOutcome, solve};
 pub use meet::meet_plan;
-pub use memo::{DEFAULT_MEMO_BYTES, Memo};
+pub use memo::Memo;
 pub use protocol::{
     DEFAULT_MAX_EXPANDED, EVALUATION_SEEDS, EvaluationKind, Protocol, STANDARD_DEPTHS,
     SearchLimits, TASK_STREAM_SEED, TaskSet,

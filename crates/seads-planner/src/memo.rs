@@ -10,12 +10,6 @@
 use rustc_hash::FxHashMap;
 use seads_games::{Successor, SymbolicState};
 
-/// What a [`Memo`] may hold by default: 2 GiB, taken only as states are computed (an agent that
-/// finds its plans at once takes little of it). About 9.6 million states of 25 skills: on the
-/// twin's weakest agents, enough that a board met again in a later task is answered from memory
-/// (`docs/results/memo/`).
-pub const DEFAULT_MEMO_BYTES: usize = 2 << 30;
-
 /// Bytes a remembered state takes beyond its K successors (its key and row in the index, with
 /// the index's spare capacity).
 const ENTRY_OVERHEAD: usize = 24;
@@ -279,6 +273,22 @@ mod tests {
         let big = LightsOut::new(9).unwrap(); // 81 bits
         let mut inner = GameSuccessor::new(&big);
         assert_eq!(Memo::new(&mut inner, 1 << 30).capacity(), 0);
+    }
+
+    #[test]
+    fn an_evaluation_remembers_half_its_searches_memory_bound() {
+        let default = crate::PlannerConfig::default();
+        assert_eq!(default.memo_bytes(), 2 << 30);
+        let small = crate::PlannerConfig {
+            memory_limit_mib: 1024,
+            ..default
+        };
+        assert_eq!(small.memo_bytes(), 512 << 20);
+        let huge = crate::PlannerConfig {
+            memory_limit_mib: usize::MAX,
+            ..crate::PlannerConfig::default()
+        };
+        assert_eq!(huge.memo_bytes(), usize::MAX / 2);
     }
 
     #[test]

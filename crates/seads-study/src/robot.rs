@@ -8,8 +8,8 @@ use seads_embodiment::{Environment as _, SkillPolicy, execute_skill};
 use seads_games::BoardGame;
 use seads_games::Successor;
 use seads_planner::{
-    CheckpointId, DEFAULT_MEMO_BYTES, DepthResult, EvaluationRecord, Memo, Protocol, SearchLimits,
-    SolveConfig, TaskRecord, solve,
+    CheckpointId, DepthResult, EvaluationRecord, Memo, Protocol, SearchLimits, SolveConfig,
+    TaskRecord, solve,
 };
 use seads_rl::Agent;
 use seads_uarm::UarmEnv;
@@ -98,7 +98,7 @@ impl RobotEvaluation {
         let mut journal = Place::new(run, &protocol, &id, named, &self.header()).open()?;
         let mut results: BTreeMap<usize, DepthResult> = BTreeMap::new();
         let mut lines = String::new();
-        let mut model = Memo::new(model, DEFAULT_MEMO_BYTES);
+        let mut model = Memo::new(model, solve_config.planner.memo_bytes());
         let seeds = protocol.tasks.seeds();
         for &depth in &protocol.tasks.depths {
             for (done, &seed) in seeds.iter().enumerate() {

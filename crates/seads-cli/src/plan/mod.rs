@@ -52,8 +52,8 @@ pub struct SearchArgs {
     #[arg(long, value_name = "SEARCH", default_value = "breadth")]
     search: Search,
     /// Stop each search when its structures outgrow this many GiB (default 4; the paper's
-    /// deeper search stopped at about 16 GB). An evaluation also keeps up to 2 GiB of the
-    /// successors its searches computed, so that a state is computed once.
+    /// deeper search stopped at about 16 GB). An evaluation also keeps up to half as much of the
+    /// successors its searches computed (2 GiB by default), so that a state is computed once.
     #[arg(long, value_name = "GIB", value_parser = clap::value_parser!(u32).range(1..=4096))]
     memory_limit: Option<u32>,
 }

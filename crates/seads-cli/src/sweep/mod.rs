@@ -147,8 +147,9 @@ pub struct SlurmArgs {
     #[arg(long, default_value = "04:00:00")]
     time: String,
     /// Memory per task, in Slurm's format (8G, 8000M; default: the cluster's). A task holds its
-    /// run's buffers and networks and, while it evaluates, up to 2 GiB of remembered successors
-    /// beside each search's own bound (`--memory-limit`, 4 GiB unless the study says otherwise).
+    /// run's buffers and networks and, while it evaluates, each search's own bound
+    /// (`--memory-limit`, 4 GiB unless the study says otherwise) and half as much again of
+    /// remembered successors.
     #[arg(long, value_name = "SIZE")]
     mem: Option<String>,
     /// Cores per task; the task's libtorch threads follow them.
