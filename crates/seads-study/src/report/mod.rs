@@ -89,7 +89,7 @@ pub fn write_report(options: &ReportOptions, out: &Path) -> Result<ReportSummary
     };
     let cells = tables::coverage_cells(&groups, reference.as_deref());
     write("table1.csv", &tables::coverage_csv(&cells))?;
-    let against_paper = paper::comparison(&cells, reference.as_deref());
+    let against_paper = paper::comparison(&cells, reference.as_deref())?;
     if let Some((_, csv)) = &against_paper {
         write("paper.csv", csv)?;
     }

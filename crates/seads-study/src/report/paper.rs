@@ -9,6 +9,7 @@ use std::fmt::Write as _;
 use super::csv_field;
 use super::stats::{Summary, cohens_d};
 use super::tables::CoverageCell;
+use crate::{Result, StudyError};
 
 /// The paper's Table 1 as CSV: `env,variant,n,mean,std`, our environment and variant names.
 const TABLE1: &str = include_str!("../../../../data/paper/table1.csv");
@@ -55,9 +56,10 @@ fn parse(text: &str) -> Result<Vec<PaperCell>, String> {
         .collect()
 }
 
-/// The paper's Table 1 (checked to parse by this module's tests).
-pub fn table1() -> Vec<PaperCell> {
-    parse(TABLE1).unwrap_or_default()
+/// The paper's Table 1; an embedded table that does not parse (a damaged build) is
+/// [`StudyError::Failed`] naming the line, never an empty table that would drop the comparison.
+pub fn table1() -> Result<Vec<PaperCell>> {
+    parse(TABLE1).map_err(StudyError::failed)
 }
 
 /// One row of the comparison: our cell and the paper's, with both sides' Cohen's d against
@@ -107,11 +109,14 @@ fn smallest_p(min_p: Option<f64>) -> String {
 }
 
 /// The comparison as Markdown and CSV, `None` when no cell of ours is one of the paper's.
-pub fn comparison(cells: &[CoverageCell], reference: Option<&str>) -> Option<(String, String)> {
-    let paper = table1();
+pub fn comparison(
+    cells: &[CoverageCell],
+    reference: Option<&str>,
+) -> Result<Option<(String, String)>> {
+    let paper = table1()?;
     let rows = rows(cells, &paper, reference);
     if rows.is_empty() {
-        return None;
+        return Ok(None);
     }
     let mut md = String::from(
         "| environment | variant | ours | paper | ours − paper | Cohen's d, ours | Cohen's d, paper | Cliff's δ, ours | smallest p possible |\n\
@@ -174,7 +179,7 @@ pub fn comparison(cells: &[CoverageCell], reference: Option<&str>) -> Option<(St
          the paper's significance level is out of reach and only the effect sizes compare.\n",
         reference.unwrap_or("-")
     );
-    Some((md, csv))
+    Ok(Some((md, csv)))
 }
 
 #[cfg(test)]
@@ -225,7 +230,7 @@ mod tests {
             cell("no-relabelling", &ablated, Some(&seads)),
             cell("not-in-the-paper", &ablated, Some(&seads)),
         ];
-        let (md, csv) = comparison(&cells, Some("seads")).unwrap();
+        let (md, csv) = comparison(&cells, Some("seads")).unwrap().unwrap();
         // Ours: means 24 and 18, both sds 0.5 and 1 → pooled √((0.25·2 + 1·2) / 4) = √0.625.
         let ours = 6.0 / 0.625f64.sqrt();
         // The paper's: (24.3 − 16.58) / √((0.28² + 4.62²) / 2).
@@ -242,6 +247,6 @@ mod tests {
         assert_eq!(csv.lines().count(), 3, "{csv}"); // header, seads, no-relabelling
         assert!(md.contains("| lightsout-reacher | seads | 24.00 ± 0.50 (n = 3) | 24.30 ± 0.28 (n = 10) | -0.30 |"), "{md}");
         assert!(md.contains("| 1.00 | 1/20 |"), "{md}");
-        assert!(comparison(&cells[2..], Some("seads")).is_none());
+        assert!(comparison(&cells[2..], Some("seads")).unwrap().is_none());
     }
 }
