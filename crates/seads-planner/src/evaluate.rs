@@ -61,6 +61,11 @@ impl DepthResult {
         }
     }
 
+    /// The share of this depth's tasks that were solved (0 before any task).
+    pub fn success_rate(&self) -> f64 {
+        self.solved as f64 / self.tasks.max(1) as f64
+    }
+
     /// Counts one more task of this depth, which ended in `outcome`.
     pub fn record(&mut self, outcome: &SolveOutcome) {
         self.count(&TaskSummary::of(outcome));

@@ -80,10 +80,7 @@ impl TaskMetrics {
         stats: &TaskEpochStats,
     ) -> Self {
         let (epoch, env_steps) = (progress.epoch, progress.env_steps);
-        let success: Vec<f64> = results
-            .iter()
-            .map(|r| r.solved as f64 / r.tasks.max(1) as f64)
-            .collect();
+        let success: Vec<f64> = results.iter().map(DepthResult::success_rate).collect();
         Self {
             epoch,
             env_steps,

@@ -150,7 +150,7 @@ pub fn over_training_table(lines: &[CheckpointEvaluation]) -> String {
         let rates: Vec<String> = l
             .results
             .iter()
-            .map(|r| format!("{:.0}%", 100.0 * r.solved as f64 / r.tasks.max(1) as f64))
+            .map(|r| format!("{:.0}%", 100.0 * r.success_rate()))
             .collect();
         out += &format!(
             "\n{:>10}  {:>10}  {:<14}  {}",

@@ -152,12 +152,7 @@ pub fn success_figure(
             let dx = if *replan { -0.04 } else { 0.04 };
             let points: Vec<(f64, f64)> = results
                 .iter()
-                .map(|r| {
-                    (
-                        r.depth as f64 + dx,
-                        100.0 * r.solved as f64 / r.tasks.max(1) as f64,
-                    )
-                })
+                .map(|r| (r.depth as f64 + dx, 100.0 * r.success_rate()))
                 .collect();
             chart
                 .draw_series(LineSeries::new(points, colour.stroke_width(2)).point_size(4))

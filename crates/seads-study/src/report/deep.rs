@@ -37,10 +37,7 @@ pub fn deep_tables(groups: &[Group<'_>]) -> Option<(String, String)> {
                     Some((d.limits, r))
                 })
                 .collect();
-            let rates: Vec<f64> = rows
-                .iter()
-                .map(|(_, r)| r.solved as f64 / r.tasks.max(1) as f64)
-                .collect();
+            let rates: Vec<f64> = rows.iter().map(|(_, r)| r.success_rate()).collect();
             let Some(rate) = summary(&rates) else {
                 continue;
             };

@@ -249,31 +249,16 @@ pub fn noise_tables(groups: &[Group<'_>]) -> Option<(String, String)> {
                     g.variant,
                     pairs.len()
                 );
-                let mut all = Vec::new();
-                for d in &depths {
-                    let rates: Vec<f64> = pairs
-                        .iter()
-                        .map(|p| if pick == 0 { p.0 } else { p.1 })
-                        .filter_map(|e| e.iter().find(|r| r.depth == *d))
-                        .map(|r| r.solved as f64 / r.tasks.max(1) as f64)
-                        .collect();
-                    all.extend(rates.iter().copied());
-                    match summary(&rates) {
-                        Some(s) => {
-                            let _ = write!(md, " {:.1} % |", 100.0 * s.mean);
-                            let _ = writeln!(
-                                csv,
-                                "{},{},{mode},{sigma},{},{d},{:.4},{:.4}",
-                                csv_field(&g.env),
-                                csv_field(&g.variant),
-                                s.n,
-                                s.mean,
-                                s.std
-                            );
-                        }
-                        None => md += " – |",
-                    }
-                }
+                let evaluations: Vec<&Vec<DepthResult>> = pairs
+                    .iter()
+                    .map(|p| if pick == 0 { p.0 } else { p.1 })
+                    .collect();
+                let row = format!(
+                    "{},{},{mode},{sigma}",
+                    csv_field(&g.env),
+                    csv_field(&g.variant)
+                );
+                let all = depth_cells(&mut md, &mut csv, &row, &depths, &evaluations);
                 match summary(&all) {
                     Some(s) => {
                         let _ = writeln!(md, " {:.1} % |", 100.0 * s.mean);
@@ -287,6 +272,35 @@ pub fn noise_tables(groups: &[Group<'_>]) -> Option<(String, String)> {
            Gaussian noise of standard deviation σ on every low-level action (`seads evaluate \
            --action-noise`), mean over the runs evaluated both ways.\n";
     any.then_some((md, csv))
+}
+
+/// One table row's success cells, a depth each: the mean over `evaluations` of each one's success
+/// rate at that depth in Markdown (`–` where none has the depth), and a CSV line `row,runs,depth,
+/// mean,std`. Returns every rate it counted, for a row's total.
+fn depth_cells(
+    md: &mut String,
+    csv: &mut String,
+    row: &str,
+    depths: &[usize],
+    evaluations: &[&Vec<DepthResult>],
+) -> Vec<f64> {
+    let mut all = Vec::new();
+    for d in depths {
+        let rates: Vec<f64> = evaluations
+            .iter()
+            .filter_map(|e| e.iter().find(|r| r.depth == *d))
+            .map(DepthResult::success_rate)
+            .collect();
+        match summary(&rates) {
+            Some(s) => {
+                let _ = write!(md, " {:.1} % |", 100.0 * s.mean);
+                let _ = writeln!(csv, "{row},{},{d},{:.4},{:.4}", s.n, s.mean, s.std);
+            }
+            None => *md += " – |",
+        }
+        all.extend(rates);
+    }
+    all
 }
 
 /// Final task success per depth (mean over runs of each run's success rate), Markdown and CSV.
@@ -315,28 +329,8 @@ pub fn success_tables(groups: &[Group<'_>]) -> (String, String) {
                 g.variant,
                 evaluated.len()
             );
-            for d in &depths {
-                let rates: Vec<f64> = evaluated
-                    .iter()
-                    .filter_map(|e| e.iter().find(|r| r.depth == *d))
-                    .map(|r| r.solved as f64 / r.tasks.max(1) as f64)
-                    .collect();
-                match summary(&rates) {
-                    Some(s) => {
-                        let _ = write!(md, " {:.1} % |", 100.0 * s.mean);
-                        let _ = writeln!(
-                            csv,
-                            "{},{},{mode},{},{d},{:.4},{:.4}",
-                            csv_field(&g.env),
-                            csv_field(&g.variant),
-                            s.n,
-                            s.mean,
-                            s.std
-                        );
-                    }
-                    None => md += " – |",
-                }
-            }
+            let row = format!("{},{},{mode}", csv_field(&g.env), csv_field(&g.variant));
+            depth_cells(&mut md, &mut csv, &row, &depths, &evaluated);
             md.push('\n');
         }
     }
