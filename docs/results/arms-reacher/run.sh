@@ -1,14 +1,39 @@
 #!/usr/bin/env bash
-# The four Reacher cells (issue 48 item 2), from 2026-11-29 (second machine): the runs named on the
-# command line, in order, one shared core. Training by the study's frozen binary (90d8a6b) outside
-# the sweep (arms-train/); a SEADS run is then evaluated by the frozen a58a2c4 binary in the
-# sweep's protocol; each finished run is copied into the sweep. Resumable: rerun with the same list.
-T=/root/seads-frozen/90d8a6b/bin/seads
-E=/root/seads-frozen/a58a2c4/bin/seads
-S=/root/seads-sweeps/arms-reacher/runs
-W=/root/seads-sweeps/arms-train
-cd /root/seads-sweeps
+# The four Reacher cells (issue 48 item 2): the runs named on the command line, in order, one
+# shared core. Training by the study's frozen binary (90d8a6b) outside the sweep (arms-train/); a
+# SEADS run is then evaluated by the frozen a58a2c4 binary in the sweep's protocol; each finished
+# run is copied into the sweep. A run the sweep already holds finished (its budget trained and,
+# for SEADS, both evaluations written) is skipped, so the whole list can be given on any machine.
+# Resumable: rerun with the same list. `scripts/studies/resume.sh` starts it.
+F=${SEADS_FROZEN:-$HOME/seads-frozen}
+T=$F/90d8a6b/bin/seads
+E=$F/a58a2c4/bin/seads
+D=${SEADS_SWEEPS:-/root/seads-sweeps}
+S=$D/arms-reacher/runs
+W=$D/arms-train
+cd "$D" || exit 2
+# Whether the run folder $1 holds its whole budget of steps.
+trained() {
+  python3 - "$1" <<'PY'
+import json, pathlib, sys, tomllib
+run = pathlib.Path(sys.argv[1])
+try:
+    budget = tomllib.loads((run / "config.toml").read_text())["env_steps"]
+    last = (run / "metrics.jsonl").read_text().strip().splitlines()[-1]
+    sys.exit(0 if json.loads(last)["env_steps"] >= budget else 1)
+except (OSError, KeyError, IndexError, ValueError):
+    sys.exit(1)
+PY
+}
 for r in "$@"; do
+  case $r in
+    */seads/*) evals=(evaluation-replan.json evaluation-plan-once.json) ;;
+    *) evals=() ;;
+  esac
+  done_in_sweep=1
+  trained "$S/$r" || done_in_sweep=0
+  for e in "${evals[@]}"; do [ -f "$S/$r/$e" ] || done_in_sweep=0; done
+  [ $done_in_sweep = 1 ] && continue
   R=$W/$r
   if [ -f $R/metrics.jsonl ]; then
     A=(--resume $R)

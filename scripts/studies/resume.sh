@@ -1,0 +1,126 @@
+#!/usr/bin/env bash
+# Sets up and (re)starts the long studies in progress, on a machine that kept them or on a fresh
+# one, in one command:
+#   scripts/studies/resume.sh            set up what is missing, then start every chain not running
+#   scripts/studies/resume.sh --setup    set up only (freeze binaries, lay out the sweeps)
+# What it does, each step skipped where already done:
+# 1. installs libtorch (scripts/setup.sh) and freezes the studies' binaries from their clean
+#    commits (scripts/freeze.sh; ~10 minutes for the first, less for each other);
+# 2. lays out each study's sweep under $SEADS_SWEEPS (default /root/seads-sweeps): `seads sweep
+#    plan` of the manifest the committed sweep was planned from (the study's manifest at its
+#    commit where none is committed yet) by the study's frozen binary, then the runs committed
+#    under docs/results/ laid over it (a finished run's files as they were; the others train);
+# 3. writes the chains into $SEADS_SWEEPS (atomically: a running chain keeps its own copy) and
+#    starts each that is not running, detached (setsid, nohup): two cores, one chain each, the
+#    second running its studies one after another.
+#      chainR: the Reacher cells (docs/results/arms-reacher/run.sh), at nice 5;
+#      chainV, then chainB, then chainS: VIC, the TileSwapCursor baselines, board size, at nice 10.
+# Runs in progress resume from their checkpoints; runs lost with a machine start again.
+# Progress: $SEADS_SWEEPS/done.log, `seads sweep status <sweep>` by the study's frozen binary.
+set -euo pipefail
+root=$(cd "$(dirname "${BASH_SOURCE[0]}")/../.." && pwd)
+export SEADS_FROZEN=${SEADS_FROZEN:-$HOME/seads-frozen}
+export SEADS_SWEEPS=${SEADS_SWEEPS:-/root/seads-sweeps}
+case ${1:-} in
+  "" | --setup) ;;
+  *) echo "usage: scripts/studies/resume.sh [--setup]" >&2; exit 2 ;;
+esac
+
+# study, its frozen binary, the commit of its manifest, the manifest, its committed sweep
+STUDIES=(
+  "arms-reacher 90d8a6b 90d8a6b experiments/arms-reacher.toml docs/results/arms-reacher/runs/arms-reacher"
+  "vic a634bb8 a634bb8 experiments/vic.toml docs/results/vic-a634bb8/runs/vic"
+  "baselines-tileswap a634bb8 b2bfbff experiments/baselines-tileswap.toml docs/results/baselines-tileswap/runs/baselines-tileswap"
+  "board-size 948442b 948442b experiments/board-size.toml docs/results/board-size-948442b/runs/board-size"
+)
+# The Reacher runs in the order they train (finished ones are skipped).
+REACHER=(
+  lightsout-reacher/seads/seed-1 lightsout-reacher/seads/seed-2 lightsout-reacher/seads/seed-3
+  lightsout-reacher/no-relabelling/seed-1 lightsout-reacher/no-relabelling/seed-3
+  tileswap-reacher/seads/seed-1 tileswap-reacher/no-relabelling/seed-1
+  tileswap-reacher/seads/seed-2 tileswap-reacher/no-relabelling/seed-2
+  tileswap-reacher/seads/seed-3 tileswap-reacher/no-relabelling/seed-3
+  lightsout-reacher/no-relabelling/seed-2
+)
+
+# 1. libtorch (once per machine), then the frozen binaries (a58a2c4 evaluates the Reacher runs).
+"$root/scripts/setup.sh"
+"$root/scripts/freeze.sh" 90d8a6b a58a2c4 a634bb8 948442b
+
+# 2. The sweeps.
+mkdir -p "$SEADS_SWEEPS"
+for line in "${STUDIES[@]}"; do
+  read -r name binary at manifest committed <<< "$line"
+  sweep=$SEADS_SWEEPS/$name
+  [[ -f $sweep/sweep.json ]] && continue
+  echo "resume: laying out $sweep"
+  rm -rf "$sweep.new"
+  # Planned from the manifest the committed sweep was planned from (for a sweep not committed
+  # yet, the study's manifest as it was at its commit), then the committed runs laid over it.
+  if [[ -f $root/$committed/manifest.toml ]]; then
+    cp "$root/$committed/manifest.toml" "$SEADS_SWEEPS/$name.manifest.toml"
+  else
+    git -C "$root" show "$at:$manifest" > "$SEADS_SWEEPS/$name.manifest.toml"
+  fi
+  "$SEADS_FROZEN/$binary/bin/seads" sweep plan "$SEADS_SWEEPS/$name.manifest.toml" \
+    --out "$sweep.new" > /dev/null
+  if [[ -d $root/$committed/runs ]]; then
+    cp -a "$root/$committed/runs/." "$sweep.new/runs/"
+  fi
+  mv "$sweep.new" "$sweep"
+done
+[[ ${1:-} == --setup ]] && exit 0
+
+# 3. The chains.
+write() { # name, then the script's text on standard input
+  cat > "$SEADS_SWEEPS/$1.new" && mv "$SEADS_SWEEPS/$1.new" "$SEADS_SWEEPS/$1"
+}
+write arms-run.sh < "$root/docs/results/arms-reacher/run.sh"
+write chainR.sh <<EOF
+#!/usr/bin/env bash
+# The Reacher cells (issue 48 item 2), one core (scripts/studies/resume.sh).
+cd "$SEADS_SWEEPS"
+nice -n 5 bash arms-run.sh ${REACHER[*]}
+EOF
+write chainV.sh <<EOF
+#!/usr/bin/env bash
+# VIC on both Cursor boards (issue 48 item 3), frozen a634bb8, seed by seed (scripts/studies/resume.sh).
+cd "$SEADS_SWEEPS"
+for s in 1 2 3; do
+  nice -n 10 "$SEADS_FROZEN/a634bb8/bin/seads" sweep run vic --seeds \$s --workers 1 --cores 1 --quiet >> vic.log 2>&1
+  rc=\$?; echo "\$(date +%H:%M) vic seed \$s exit \$rc" >> done.log
+done
+EOF
+write chainB.sh <<EOF
+#!/usr/bin/env bash
+# The TileSwapCursor baselines (issue 48 item 3), frozen a634bb8, after VIC (scripts/studies/resume.sh).
+cd "$SEADS_SWEEPS"
+while pgrep -f "bash chainV.sh" > /dev/null; do sleep 60; done
+for s in 1 2 3; do
+  nice -n 10 "$SEADS_FROZEN/a634bb8/bin/seads" sweep run baselines-tileswap --seeds \$s --workers 1 --cores 1 --quiet >> baselines.log 2>&1
+  rc=\$?; echo "\$(date +%H:%M) baselines seed \$s exit \$rc" >> done.log
+done
+EOF
+write chainS.sh <<EOF
+#!/usr/bin/env bash
+# Board size (issue 48 item 4), frozen 948442b, after the baselines: 7×7 and 9×9 seeds 1-3, then
+# 5×5 seeds 1-3; a finished run is skipped (scripts/studies/resume.sh).
+B="$SEADS_FROZEN/948442b/bin/seads"
+cd "$SEADS_SWEEPS"
+while pgrep -f "bash chainB.sh" > /dev/null || pgrep -f "bash chainV.sh" > /dev/null; do sleep 60; done
+for i in 1 2 6 7 11 12 0 5 10; do
+  st=\$(\$B sweep status board-size --json | python3 -c "import sys, json; print(json.load(sys.stdin)['runs'][\$i]['status'])")
+  case \$st in done | copied) continue ;; esac
+  nice -n 10 \$B sweep task board-size --index \$i --cores 1 >> board-size.log 2>&1
+  rc=\$?; echo "\$(date +%H:%M) board-size index \$i exit \$rc" >> done.log
+done
+EOF
+cd "$SEADS_SWEEPS"
+for chain in chainR chainV chainB chainS; do
+  if pgrep -f "bash $chain.sh" > /dev/null; then
+    echo "resume: $chain is running"
+  else
+    setsid nohup bash "$chain.sh" >> "$chain.out" 2>&1 < /dev/null &
+    echo "resume: started $chain"
+  fi
+done
