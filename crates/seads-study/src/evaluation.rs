@@ -8,8 +8,8 @@ use std::path::Path;
 
 use seads_games::BoardGame;
 use seads_planner::{
-    CheckpointId, DepthResult, Evaluation, EvaluationKind, EvaluationRecord, Evaluator, PlanChoice,
-    Protocol, SearchLimits, SolveConfig, TaskRecord, TaskSet, TaskSummary, evaluate_resuming,
+    CheckpointId, DepthResult, Evaluation, EvaluationKind, EvaluationRecord, Evaluator, Protocol,
+    SearchLimits, SolveConfig, TaskRecord, TaskSet, TaskSummary, evaluate_resuming,
 };
 use seads_rl::{Agent, TrainConfig};
 use serde::{Deserialize, Serialize};
@@ -77,21 +77,11 @@ pub struct CheckpointEvaluation {
     pub replan: bool,
     /// Boards per depth.
     pub boards: usize,
-    /// Seconds per search, if the clock bounded it.
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub timeout_s: Option<f64>,
-    /// States expanded per search, if bounded.
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub max_expanded: Option<usize>,
-    /// Which plan each search returned (lines from before the choice: the first found).
-    #[serde(default = "PlanChoice::paper")]
-    pub plan: PlanChoice,
-    /// How each search went (lines without it: breadth-first).
-    #[serde(default, skip_serializing_if = "seads_planner::Search::is_breadth")]
-    pub search: seads_planner::Search,
-    /// Memory of each search, MiB, if not the planner's default.
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub memory_limit_mib: Option<usize>,
+    /// Each search's limits and plan choice, as fields of the line itself (`timeout_s`,
+    /// `max_expanded`, `plan`, `search`, `memory_limit_mib`; lines from before a field read as
+    /// [`SearchLimits`] reads them: no bound, the first plan found, breadth-first).
+    #[serde(flatten)]
+    pub limits: SearchLimits,
     /// The binary that evaluated (lines written before evaluations recorded it: none).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub evaluated_by: Option<Evaluator>,
@@ -109,13 +99,7 @@ impl CheckpointEvaluation {
                 depths: self.results.iter().map(|r| r.depth).collect(),
                 ..TaskSet::standard(self.boards)
             },
-            limits: Some(SearchLimits {
-                timeout_s: self.timeout_s,
-                max_expanded: self.max_expanded,
-                plan: self.plan,
-                search: self.search,
-                memory_limit_mib: self.memory_limit_mib,
-            }),
+            limits: Some(self.limits),
             action_noise: None,
         }
     }
@@ -353,4 +337,51 @@ pub(crate) fn task_line(game: &dyn BoardGame, task: &TaskRecord<'_>) -> serde_js
         "failure": o.failure,
         "deviations": deviations,
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use seads_planner::PlanChoice;
+
+    /// A line of `evaluation-over-training.jsonl` reads and writes back to the letter, its
+    /// limits as the line's own fields; a line written before a field existed reads as the
+    /// defaults say (no bound, the first plan found, breadth-first). The texts are written out
+    /// by hand, as the files hold them.
+    #[test]
+    fn a_line_keeps_its_limits_as_its_own_fields() {
+        let results = r#""results":[{"depth":1,"tasks":2,"solved":1,"plan_found":2,"planning_s":[0.5,1.0],"timeouts":0,"solution_steps":[7],"skill_steps":[3,4]}]"#;
+        let full = format!(
+            r#"{{"epoch":500,"env_steps":20000,"replan":true,"boards":20,"timeout_s":10.0,"max_expanded":4194304,"plan":"most-likely","search":"both-ends","memory_limit_mib":16384,"evaluated_by":{{"seads":"0.1.0","commit":"a634bb8","dirty":false}},{results}}}"#
+        );
+        let line: CheckpointEvaluation = serde_json::from_str(&full).unwrap();
+        assert_eq!(serde_json::to_string(&line).unwrap(), full);
+        assert_eq!(line.limits.timeout_s, Some(10.0));
+        assert_eq!(line.limits.max_expanded, Some(4_194_304));
+        assert_eq!(line.limits.plan, PlanChoice::MostLikely);
+        assert_eq!(line.limits.search, seads_planner::Search::BothEnds);
+        assert_eq!(line.limits.memory_limit_mib, Some(16384));
+        // The protocol's limits are the line's.
+        assert_eq!(line.protocol().limits, Some(line.limits));
+
+        let old =
+            format!(r#"{{"epoch":100,"env_steps":4218,"replan":false,"boards":20,{results}}}"#);
+        let line: CheckpointEvaluation = serde_json::from_str(&old).unwrap();
+        assert_eq!(
+            line.limits,
+            SearchLimits {
+                timeout_s: None,
+                max_expanded: None,
+                plan: PlanChoice::FirstFound,
+                search: seads_planner::Search::Breadth,
+                memory_limit_mib: None,
+            }
+        );
+        assert_eq!(
+            serde_json::to_string(&line).unwrap(),
+            format!(
+                r#"{{"epoch":100,"env_steps":4218,"replan":false,"boards":20,"plan":"first-found",{results}}}"#
+            )
+        );
+    }
 }

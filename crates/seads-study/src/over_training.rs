@@ -179,11 +179,7 @@ pub fn evaluate_checkpoints(
             env_steps,
             replan: *replan,
             boards: tasks.boards,
-            timeout_s: limits.timeout_s,
-            max_expanded: limits.max_expanded,
-            plan: limits.plan,
-            search: limits.search,
-            memory_limit_mib: limits.memory_limit_mib,
+            limits,
             evaluated_by: crate::provenance::this_binary().cloned(),
             results,
         };
