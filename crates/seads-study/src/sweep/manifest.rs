@@ -460,6 +460,14 @@ env_overrides = { "lightsout-cursor" = { num_skills = 30 }, "tileswap-cursor" = 
             (include_str!("../../../../experiments/vic.toml"), 2 * 4 * 3),
             (include_str!("../../../../experiments/arms.toml"), 5 * 2),
             (
+                include_str!("../../../../experiments/arms-reacher.toml"),
+                2 * 2 * 3,
+            ),
+            (
+                include_str!("../../../../experiments/arms-jaco.toml"),
+                2 * 3,
+            ),
+            (
                 include_str!("../../../../experiments/board-size.toml"),
                 5 * 5,
             ),
