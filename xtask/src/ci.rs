@@ -198,7 +198,17 @@ struct Totals {
 /// Runs `cargo <args>`, echoing its output and adding up its `test result:` lines.
 fn test(args: &[&str], totals: &mut Totals) -> Result<()> {
     eprintln!("xtask: $ cargo {}", args.join(" "));
-    let mut child = Command::new("cargo")
+    let mut command = Command::new("cargo");
+    if std::env::var_os("OMP_WAIT_POLICY").is_none() && std::env::var_os("GOMP_SPINCOUNT").is_none()
+    {
+        // libtorch's OpenMP threads sleep at once when idle instead of spinning: the harness runs
+        // two tests at a time, each with libtorch threads for every core, and on CI's two cores
+        // the spinning held the cores the working threads needed (seads-rl's
+        // `sac_learns_to_track_a_target` beside three busy processes: 175 s, and 12 s passive).
+        // Waiting changes no number (`seads_nn::process::spin_briefly_in_libgomp`).
+        command.env("OMP_WAIT_POLICY", "PASSIVE");
+    }
+    let mut child = command
         .args(args)
         .current_dir(root())
         .stdout(Stdio::piped())

@@ -107,12 +107,19 @@ fn successors_are_the_mode_of_the_model() {
 /// A state's successors do not depend on the other states of its call: computed in pieces of
 /// any size, or through the planner's memory of successors (which computes only the states it
 /// has not seen, in calls of other compositions), they equal those of one call. An untrained
-/// model has many logits near 0, where a different summation would show.
+/// model has many logits near 0, where a different summation would show. Its hidden layers are
+/// narrow: the screen's integer products (libtorch's `_int_mm`, a plain loop on an AMD EPYC) at
+/// the default 256 × 256 made this test take minutes, and the width does not change how calls
+/// are cut.
 #[test]
 fn successors_do_not_depend_on_how_states_are_batched() {
     use proptest::prelude::*;
     use proptest::test_runner::{Config, TestRunner};
-    let mut model = ForwardModel::new(25, 25, &SkillModelConfig::default(), Device::Cpu, 5);
+    let config = SkillModelConfig {
+        hidden: vec![64, 64],
+        ..SkillModelConfig::default()
+    };
+    let mut model = ForwardModel::new(25, 25, &config, Device::Cpu, 5);
     let states = random_states(3000, 3);
     let mut whole = Vec::new();
     model.successors(&states, &mut whole);
