@@ -145,10 +145,6 @@ fn successors_and_their_probabilities_match_libtorchs() {
 fn plans_match_libtorchs_on_a_hundred_boards() {
     let (mut light, torch) = both();
     let mut torch_model = torch.model.unwrap();
-    // Float32 alone: the 8-bit screen gives float32's successors (seads-skillmodel's
-    // `successors` tests), and libtorch's integer product ran as a plain loop on an AMD EPYC
-    // (`_int_mm_out_cpu`), two thirds of this test's minute. The evaluation below keeps it.
-    torch_model.set_int8_screen(false);
     let game = LightsOut::new(5).unwrap();
     let mut rng = ChaCha8Rng::seed_from_u64(11);
     // The agent lacks moves, so most searches run to the bound: 2,000 expansions (of 25

@@ -167,15 +167,16 @@ impl ForwardModel {
             k,
             device,
             network: Trainable::new("forward_model", d + k, d, config, device, seed),
-            int8_screen: true,
+            int8_screen: fast_int8_products(),
             screen: None,
             screen_counts: (0, 0),
         }
     }
 
-    /// Whether the planner's successor function may compute with 8-bit integers first (on by
-    /// default). Either way the successors are those of float32 inference (`screen.rs`); off,
-    /// every logit is computed in float32, which the benches compare against.
+    /// Whether the planner's successor function may compute with 8-bit integers first (by
+    /// default, where [`fast_int8_products`]). Either way the successors are those of float32
+    /// inference (`screen.rs`); off, every logit is computed in float32, which the benches
+    /// compare against.
     pub fn set_int8_screen(&mut self, on: bool) {
         self.int8_screen = on;
     }
@@ -324,6 +325,24 @@ fn mode_flips(logits: &Tensor, z0: &Tensor) -> Tensor {
     logits
         .gt(0.0)
         .logical_or(&ones.logical_and(&logits.eq(0.0)))
+}
+
+/// Whether this processor has 8-bit dot products (VNNI), where libtorch's integer product
+/// (`_int_mm`) runs through oneDNN: the 8-bit screen then made breadth-first search 1.4–1.5×
+/// faster than float32 on a Zen 4 EPYC (docs/results/log-2026-11.md). Without them, libtorch
+/// multiplies in a plain loop: on a Zen 3 EPYC (AVX2 only) `_int_mm_out_cpu` took 97 % of a
+/// search's time, far slower than float32, so the screen stays off. Only speed depends on it: the
+/// screen's successors are float32's.
+pub fn fast_int8_products() -> bool {
+    #[cfg(target_arch = "x86_64")]
+    {
+        std::arch::is_x86_feature_detected!("avx512vnni")
+            || std::arch::is_x86_feature_detected!("avxvnni")
+    }
+    #[cfg(not(target_arch = "x86_64"))]
+    {
+        false
+    }
 }
 
 /// States per part of a CPU successor call: the parts are computed on the rayon pool's threads,

@@ -120,6 +120,8 @@ fn successors_do_not_depend_on_how_states_are_batched() {
         ..SkillModelConfig::default()
     };
     let mut model = ForwardModel::new(25, 25, &config, Device::Cpu, 5);
+    // With the screen on whatever the processor, so that its cuts are among those tested.
+    model.set_int8_screen(true);
     let states = random_states(3000, 3);
     let mut whole = Vec::new();
     model.successors(&states, &mut whole);

@@ -24,7 +24,8 @@ pub struct PlanBench {
     pub depths: Vec<usize>,
     /// Boards per depth.
     pub boards: usize,
-    /// Every logit in float32, without the 8-bit screen.
+    /// Every logit in float32, without the 8-bit screen (otherwise the screen is on, whatever
+    /// `seads_skillmodel::fast_int8_products` says).
     pub float32: bool,
     /// Where the model's successors are computed. The model is fitted on the CPU either way
     /// (the same weights, so the same plans and counts) and then copied there.

@@ -32,7 +32,8 @@ pub struct PlanBenchArgs {
     #[arg(long, value_parser = crate::numbers::positive_finite)]
     timeout: Option<f64>,
     /// Compute every logit in float32, without the 8-bit screen (the same plans, more
-    /// arithmetic; for comparison).
+    /// arithmetic; for comparison). Without it the bench screens on any processor, while the
+    /// planner screens only on processors with 8-bit dot products (VNNI).
     #[arg(long)]
     float32: bool,
     /// Which plan each search returns: most-likely (default), most-likely-wary (the same for a
