@@ -14,7 +14,8 @@
 #    starts each that is not running, detached (setsid, nohup): two cores, one chain each, the
 #    second running its studies one after another.
 #      chainR: the Reacher cells (docs/results/arms-reacher/run.sh), at nice 5;
-#      chainV, then chainB, then chainS: VIC, the TileSwapCursor baselines, board size, at nice 10.
+#      chainV, then chainB, then chainS: VIC, the TileSwapCursor baselines, board size, at nice 10;
+#      chainJ, once chainR is done: the LightsOutJaco cells (experiments/arms-jaco.toml), at nice 5.
 # Runs in progress resume from their checkpoints; runs lost with a machine start again.
 # Progress: $SEADS_SWEEPS/done.log, `seads sweep status <sweep>` by the study's frozen binary.
 set -euo pipefail
@@ -32,6 +33,7 @@ STUDIES=(
   "vic a634bb8 a634bb8 experiments/vic.toml docs/results/vic-a634bb8/runs/vic"
   "baselines-tileswap a634bb8 b2bfbff experiments/baselines-tileswap.toml docs/results/baselines-tileswap/runs/baselines-tileswap"
   "board-size 948442b 948442b experiments/board-size.toml docs/results/board-size-948442b/runs/board-size"
+  "arms-jaco 73dac45 73dac45 experiments/arms-jaco.toml docs/results/arms-jaco/runs/arms-jaco"
 )
 # The Reacher runs in the order they train (finished ones are skipped).
 REACHER=(
@@ -45,7 +47,7 @@ REACHER=(
 
 # 1. libtorch (once per machine), then the frozen binaries (a58a2c4 evaluates the Reacher runs).
 "$root/scripts/setup.sh"
-"$root/scripts/freeze.sh" 90d8a6b a58a2c4 a634bb8 948442b
+"$root/scripts/freeze.sh" 90d8a6b a58a2c4 a634bb8 948442b 73dac45
 
 # 2. The sweeps.
 mkdir -p "$SEADS_SWEEPS"
@@ -115,8 +117,23 @@ for i in 1 2 6 7 11 12 0 5 10; do
   rc=\$?; echo "\$(date +%H:%M) board-size index \$i exit \$rc" >> done.log
 done
 EOF
+write chainJ.sh <<EOF
+#!/usr/bin/env bash
+# The LightsOutJaco cells (issue 48 item 2), frozen 73dac45, on chainR's core once the Reacher
+# cells are done: SEADS and no forward-model relabelling, seed by seed (sweep indices 0-5); a
+# finished run is skipped, one in progress resumes (scripts/studies/resume.sh).
+B="$SEADS_FROZEN/73dac45/bin/seads"
 cd "$SEADS_SWEEPS"
-for chain in chainR chainV chainB chainS; do
+while pgrep -f "bash chainR.sh" > /dev/null; do sleep 60; done
+for i in 0 1 2 3 4 5; do
+  st=\$(\$B sweep status arms-jaco --json | python3 -c "import sys, json; print(json.load(sys.stdin)['runs'][\$i]['status'])")
+  case \$st in done | copied) continue ;; esac
+  nice -n 5 \$B sweep task arms-jaco --index \$i --cores 1 >> arms-jaco.log 2>&1
+  rc=\$?; echo "\$(date +%H:%M) arms-jaco index \$i exit \$rc" >> done.log
+done
+EOF
+cd "$SEADS_SWEEPS"
+for chain in chainR chainV chainB chainS chainJ; do
   if pgrep -f "bash $chain.sh" > /dev/null; then
     echo "resume: $chain is running"
   else
