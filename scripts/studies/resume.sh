@@ -103,35 +103,34 @@ for s in 1 2 3; do
   rc=\$?; echo "\$(date +%H:%M) baselines seed \$s exit \$rc" >> done.log
 done
 EOF
-write chainS.sh <<EOF
+# A chain that trains (and evaluates) a sweep's runs index by index with a frozen binary, once the
+# chains named have ended; a finished run is skipped, one in progress resumes. Arguments: the
+# chain, its comment lines, the frozen commit, the sweep, the niceness, the chains to wait for,
+# the indices in order.
+index_chain() {
+  local chain=$1 comment=$2 commit=$3 sweep=$4 niceness=$5 waits=$6 indices=$7 wait="" w
+  for w in $waits; do
+    wait+="${wait:+ || }pgrep -f \"bash $w.sh\" > /dev/null"
+  done
+  write "$chain.sh" <<EOF
 #!/usr/bin/env bash
-# Board size (issue 48 item 4), frozen 948442b, after the baselines: 7×7 and 9×9 seeds 1-3, then
-# 5×5 seeds 1-3; a finished run is skipped (scripts/studies/resume.sh).
-B="$SEADS_FROZEN/948442b/bin/seads"
+$comment
+B="$SEADS_FROZEN/$commit/bin/seads"
 cd "$SEADS_SWEEPS"
-while pgrep -f "bash chainB.sh" > /dev/null || pgrep -f "bash chainV.sh" > /dev/null; do sleep 60; done
-for i in 1 2 6 7 11 12 0 5 10; do
-  st=\$(\$B sweep status board-size --json | python3 -c "import sys, json; print(json.load(sys.stdin)['runs'][\$i]['status'])")
+while $wait; do sleep 60; done
+for i in $indices; do
+  st=\$(\$B sweep status $sweep --json | python3 -c "import sys, json; print(json.load(sys.stdin)['runs'][\$i]['status'])")
   case \$st in done | copied) continue ;; esac
-  nice -n 10 \$B sweep task board-size --index \$i --cores 1 >> board-size.log 2>&1
-  rc=\$?; echo "\$(date +%H:%M) board-size index \$i exit \$rc" >> done.log
+  nice -n $niceness \$B sweep task $sweep --index \$i --cores 1 >> $sweep.log 2>&1
+  rc=\$?; echo "\$(date +%H:%M) $sweep index \$i exit \$rc" >> done.log
 done
 EOF
-write chainJ.sh <<EOF
-#!/usr/bin/env bash
-# The LightsOutJaco cells (issue 48 item 2), frozen 73dac45, on chainR's core once the Reacher
-# cells are done: SEADS and no forward-model relabelling, seed by seed (sweep indices 0-5); a
-# finished run is skipped, one in progress resumes (scripts/studies/resume.sh).
-B="$SEADS_FROZEN/73dac45/bin/seads"
-cd "$SEADS_SWEEPS"
-while pgrep -f "bash chainR.sh" > /dev/null; do sleep 60; done
-for i in 0 1 2 3 4 5; do
-  st=\$(\$B sweep status arms-jaco --json | python3 -c "import sys, json; print(json.load(sys.stdin)['runs'][\$i]['status'])")
-  case \$st in done | copied) continue ;; esac
-  nice -n 5 \$B sweep task arms-jaco --index \$i --cores 1 >> arms-jaco.log 2>&1
-  rc=\$?; echo "\$(date +%H:%M) arms-jaco index \$i exit \$rc" >> done.log
-done
-EOF
+}
+index_chain chainS "# Board size (issue 48 item 4), frozen 948442b, after the baselines: 7×7 and 9×9 seeds 1-3, then
+# 5×5 seeds 1-3 (scripts/studies/resume.sh)." 948442b board-size 10 "chainB chainV" "1 2 6 7 11 12 0 5 10"
+index_chain chainJ "# The LightsOutJaco cells (issue 48 item 2), frozen 73dac45, on chainR's core once the Reacher
+# cells are done: SEADS and no forward-model relabelling, seed by seed (scripts/studies/resume.sh)." \
+  73dac45 arms-jaco 5 chainR "0 1 2 3 4 5"
 cd "$SEADS_SWEEPS"
 for chain in chainR chainV chainB chainS chainJ; do
   if pgrep -f "bash $chain.sh" > /dev/null; then
