@@ -106,7 +106,7 @@ EOF
 # A chain that trains (and evaluates) a sweep's runs index by index with a frozen binary, once the
 # chains named have ended; a finished run is skipped, one in progress resumes. Arguments: the
 # chain, its comment lines, the frozen commit, the sweep, the niceness, the chains to wait for,
-# the indices in order.
+# the indices in order (no chains to wait for: it starts at once).
 index_chain() {
   local chain=$1 comment=$2 commit=$3 sweep=$4 niceness=$5 waits=$6 indices=$7 wait="" w
   for w in $waits; do
@@ -117,7 +117,7 @@ index_chain() {
 $comment
 B="$SEADS_FROZEN/$commit/bin/seads"
 cd "$SEADS_SWEEPS"
-while $wait; do sleep 60; done
+while ${wait:-false}; do sleep 60; done
 for i in $indices; do
   st=\$(\$B sweep status $sweep --json | python3 -c "import sys, json; print(json.load(sys.stdin)['runs'][\$i]['status'])")
   case \$st in done | copied) continue ;; esac
