@@ -15,7 +15,9 @@
 #    second running its studies one after another.
 #      chainR: the Reacher cells (docs/results/arms-reacher/run.sh), at nice 5;
 #      chainV, then chainB, then chainS: VIC, the TileSwapCursor baselines, board size, at nice 10;
-#      chainJ, once chainR is done: the LightsOutJaco cells (experiments/arms-jaco.toml), at nice 5.
+#      chainJ, once chainR is done: the board-size runs chainS has not reached (taken from the far
+#      end of its list, so that the two cores share them), then the LightsOutJaco cells
+#      (experiments/arms-jaco.toml), at nice 5.
 # Runs in progress resume from their checkpoints; runs lost with a machine start again.
 # Progress: $SEADS_SWEEPS/done.log, `seads sweep status <sweep>` by the study's frozen binary.
 set -euo pipefail
@@ -103,34 +105,45 @@ for s in 1 2 3; do
   rc=\$?; echo "\$(date +%H:%M) baselines seed \$s exit \$rc" >> done.log
 done
 EOF
-# A chain that trains (and evaluates) a sweep's runs index by index with a frozen binary, once the
-# chains named have ended; a finished run is skipped, one in progress resumes. Arguments: the
-# chain, its comment lines, the frozen commit, the sweep, the niceness, the chains to wait for,
-# the indices in order (no chains to wait for: it starts at once).
+# A chain that trains (and evaluates) sweeps' runs index by index with frozen binaries, once the
+# chains named have ended; a finished run is skipped, so is one another chain holds (its lock is
+# taken: status "running"), one in progress resumes. Arguments: the chain, its comment lines, the
+# niceness, the chains to wait for (none: it starts at once), then one "commit sweep indices…"
+# segment per sweep, in order.
 index_chain() {
-  local chain=$1 comment=$2 commit=$3 sweep=$4 niceness=$5 waits=$6 indices=$7 wait="" w
+  local chain=$1 comment=$2 niceness=$3 waits=$4 wait="" w segment commit sweep indices
+  shift 4
   for w in $waits; do
     wait+="${wait:+ || }pgrep -f \"bash $w.sh\" > /dev/null"
   done
-  write "$chain.sh" <<EOF
+  {
+    cat <<EOF
 #!/usr/bin/env bash
 $comment
-B="$SEADS_FROZEN/$commit/bin/seads"
 cd "$SEADS_SWEEPS"
 while ${wait:-false}; do sleep 60; done
+EOF
+    for segment in "$@"; do
+      read -r commit sweep indices <<< "$segment"
+      cat <<EOF
+B="$SEADS_FROZEN/$commit/bin/seads"
 for i in $indices; do
   st=\$(\$B sweep status $sweep --json | python3 -c "import sys, json; print(json.load(sys.stdin)['runs'][\$i]['status'])")
-  case \$st in done | copied) continue ;; esac
+  case \$st in done | copied | running) continue ;; esac
   nice -n $niceness \$B sweep task $sweep --index \$i --cores 1 >> $sweep.log 2>&1
   rc=\$?; echo "\$(date +%H:%M) $sweep index \$i exit \$rc" >> done.log
 done
 EOF
+    done
+  } | write "$chain.sh"
 }
 index_chain chainS "# Board size (issue 48 item 4), frozen 948442b, after the baselines: 7×7 and 9×9 seeds 1-3, then
-# 5×5 seeds 1-3 (scripts/studies/resume.sh)." 948442b board-size 10 "chainB chainV" "1 2 6 7 11 12 0 5 10"
-index_chain chainJ "# The LightsOutJaco cells (issue 48 item 2), frozen 73dac45, on chainR's core once the Reacher
-# cells are done: SEADS and no forward-model relabelling, seed by seed (scripts/studies/resume.sh)." \
-  73dac45 arms-jaco 5 chainR "0 1 2 3 4 5"
+# 5×5 seeds 1-3 (scripts/studies/resume.sh)." 10 "chainB chainV" "948442b board-size 1 2 6 7 11 12 0 5 10"
+index_chain chainJ "# On chainR's core once the Reacher cells are done: the board-size runs chainS has not reached,
+# from the far end of its list (issue 48 item 4, frozen 948442b), then the LightsOutJaco cells
+# (issue 48 item 2, frozen 73dac45): SEADS and no forward-model relabelling, seed by seed
+# (scripts/studies/resume.sh)." 5 chainR "948442b board-size 10 5 0 12 11 7 6 2 1" \
+  "73dac45 arms-jaco 0 1 2 3 4 5"
 cd "$SEADS_SWEEPS"
 for chain in chainR chainV chainB chainS chainJ; do
   if pgrep -f "bash $chain.sh" > /dev/null; then
