@@ -1,6 +1,7 @@
-//! Workspace-level integration tests (one binary): data tables against the paper's numbers, and
-//! the promises the repository makes in its docs and CI script.
+//! Workspace-level integration tests (one binary): data tables against the paper's numbers, the
+//! promises the repository makes in its docs and CI script, and the long studies' scripts.
 
+mod studies;
 mod tables;
 mod tidy;
 

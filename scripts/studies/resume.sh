@@ -3,6 +3,8 @@
 # one, in one command:
 #   scripts/studies/resume.sh            set up what is missing, then start every chain not running
 #   scripts/studies/resume.sh --setup    set up only (freeze binaries, lay out the sweeps)
+#   scripts/studies/resume.sh --chains   write the chains (step 3) into $SEADS_SWEEPS only: no
+#                                        set-up, nothing started (the tests read them)
 # What it does, each step skipped where already done:
 # 1. installs libtorch (scripts/setup.sh) and freezes the studies' binaries from their clean
 #    commits (scripts/freeze.sh; ~10 minutes for the first, less for each other);
@@ -25,8 +27,8 @@ root=$(cd "$(dirname "${BASH_SOURCE[0]}")/../.." && pwd)
 export SEADS_FROZEN=${SEADS_FROZEN:-$HOME/seads-frozen}
 export SEADS_SWEEPS=${SEADS_SWEEPS:-/root/seads-sweeps}
 case ${1:-} in
-  "" | --setup) ;;
-  *) echo "usage: scripts/studies/resume.sh [--setup]" >&2; exit 2 ;;
+  "" | --setup | --chains) ;;
+  *) echo "usage: scripts/studies/resume.sh [--setup | --chains]" >&2; exit 2 ;;
 esac
 
 # study, its frozen binary, the commit of its manifest, the manifest, its committed sweep
@@ -37,6 +39,9 @@ STUDIES=(
   "board-size 948442b 948442b experiments/board-size.toml docs/results/board-size-948442b/runs/board-size"
   "arms-jaco 73dac45 73dac45 experiments/arms-jaco.toml docs/results/arms-jaco/runs/arms-jaco"
 )
+# The binaries the studies run, frozen from these clean commits (a58a2c4 evaluates the Reacher
+# runs); a chain runs no other.
+FROZEN=(90d8a6b a58a2c4 a634bb8 948442b 73dac45)
 # The Reacher runs in the order they train (finished ones are skipped).
 REACHER=(
   lightsout-reacher/seads/seed-1 lightsout-reacher/seads/seed-2 lightsout-reacher/seads/seed-3
@@ -47,32 +52,36 @@ REACHER=(
   lightsout-reacher/no-relabelling/seed-2
 )
 
-# 1. libtorch (once per machine), then the frozen binaries (a58a2c4 evaluates the Reacher runs).
-"$root/scripts/setup.sh"
-"$root/scripts/freeze.sh" 90d8a6b a58a2c4 a634bb8 948442b 73dac45
+# Steps 1 and 2.
+prepare() {
+  # 1. libtorch (once per machine), then the frozen binaries.
+  "$root/scripts/setup.sh"
+  "$root/scripts/freeze.sh" "${FROZEN[@]}"
 
-# 2. The sweeps.
-mkdir -p "$SEADS_SWEEPS"
-for line in "${STUDIES[@]}"; do
-  read -r name binary at manifest committed <<< "$line"
-  sweep=$SEADS_SWEEPS/$name
-  [[ -f $sweep/sweep.json ]] && continue
-  echo "resume: laying out $sweep"
-  rm -rf "$sweep.new"
-  # Planned from the manifest the committed sweep was planned from (for a sweep not committed
-  # yet, the study's manifest as it was at its commit), then the committed runs laid over it.
-  if [[ -f $root/$committed/manifest.toml ]]; then
-    cp "$root/$committed/manifest.toml" "$SEADS_SWEEPS/$name.manifest.toml"
-  else
-    git -C "$root" show "$at:$manifest" > "$SEADS_SWEEPS/$name.manifest.toml"
-  fi
-  "$SEADS_FROZEN/$binary/bin/seads" sweep plan "$SEADS_SWEEPS/$name.manifest.toml" \
-    --out "$sweep.new" > /dev/null
-  if [[ -d $root/$committed/runs ]]; then
-    cp -a "$root/$committed/runs/." "$sweep.new/runs/"
-  fi
-  mv "$sweep.new" "$sweep"
-done
+  # 2. The sweeps.
+  mkdir -p "$SEADS_SWEEPS"
+  for line in "${STUDIES[@]}"; do
+    read -r name binary at manifest committed <<< "$line"
+    sweep=$SEADS_SWEEPS/$name
+    [[ -f $sweep/sweep.json ]] && continue
+    echo "resume: laying out $sweep"
+    rm -rf "$sweep.new"
+    # Planned from the manifest the committed sweep was planned from (for a sweep not committed
+    # yet, the study's manifest as it was at its commit), then the committed runs laid over it.
+    if [[ -f $root/$committed/manifest.toml ]]; then
+      cp "$root/$committed/manifest.toml" "$SEADS_SWEEPS/$name.manifest.toml"
+    else
+      git -C "$root" show "$at:$manifest" > "$SEADS_SWEEPS/$name.manifest.toml"
+    fi
+    "$SEADS_FROZEN/$binary/bin/seads" sweep plan "$SEADS_SWEEPS/$name.manifest.toml" \
+      --out "$sweep.new" > /dev/null
+    if [[ -d $root/$committed/runs ]]; then
+      cp -a "$root/$committed/runs/." "$sweep.new/runs/"
+    fi
+    mv "$sweep.new" "$sweep"
+  done
+}
+if [[ ${1:-} == --chains ]]; then mkdir -p "$SEADS_SWEEPS"; else prepare; fi
 [[ ${1:-} == --setup ]] && exit 0
 
 # 3. The chains.
@@ -144,6 +153,7 @@ index_chain chainJ "# On chainR's core once the Reacher cells are done: the boar
 # (issue 48 item 2, frozen 73dac45): SEADS and no forward-model relabelling, seed by seed
 # (scripts/studies/resume.sh)." 5 chainR "948442b board-size 10 5 0 12 11 7 6 2 1" \
   "73dac45 arms-jaco 0 1 2 3 4 5"
+[[ ${1:-} == --chains ]] && exit 0
 cd "$SEADS_SWEEPS"
 for chain in chainR chainV chainB chainS chainJ; do
   if pgrep -f "bash $chain.sh" > /dev/null; then
