@@ -29,12 +29,12 @@ fn binaries<'a>(text: &'a str, prefix: &str) -> Vec<&'a str> {
 #[test]
 fn the_study_chains_parse_and_run_only_frozen_binaries() {
     let out = tempfile::tempdir().expect("a temporary folder");
-    let fake_frozen = "/nonexistent-frozen-for-the-test/";
+    let fake_frozen = "/nonexistent-frozen-for-the-test";
     let status = std::process::Command::new("bash")
         .arg(root().join("scripts/studies/resume.sh"))
         .arg("--chains")
         .env("SEADS_SWEEPS", out.path())
-        .env("SEADS_FROZEN", fake_frozen.trim_end_matches('/'))
+        .env("SEADS_FROZEN", fake_frozen)
         .status()
         .expect("bash runs");
     assert!(status.success(), "resume.sh --chains: {status}");
@@ -55,7 +55,11 @@ fn the_study_chains_parse_and_run_only_frozen_binaries() {
             String::from_utf8_lossy(&parsed.stderr)
         );
         // The chains name the binaries under $SEADS_FROZEN, `arms-run.sh` under its $F.
-        let used = [binaries(&text, fake_frozen), binaries(&text, "$F/")].concat();
+        let used = [
+            binaries(&text, &format!("{fake_frozen}/")),
+            binaries(&text, "$F/"),
+        ]
+        .concat();
         for commit in used {
             assert!(
                 frozen.iter().any(|f| f == commit),

@@ -66,7 +66,7 @@ def main():
         run = sweep / "runs" / env / variant / seed
         points = curve(run)
         replan, once = success(run, "replan"), success(run, "plan-once")
-        tasks = "–" if replan is None else f"{replan:.0f} / {once:.0f} %"
+        tasks = "–" if replan is None or once is None else f"{replan:.0f} / {once:.0f} %"
         print(f"| {env} | {variant} | {seed.removeprefix('seed-')} | {points[-1][1]:.2f} "
               f"| {held_at(points, args.at):.2f} | {mean_over_training(points):.2f} | {tasks} "
               f"| {processor(row['processor'])} |")
