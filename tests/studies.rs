@@ -76,3 +76,100 @@ fn the_study_chains_parse_and_run_only_frozen_binaries() {
     }
     assert!(chains >= 2, "resume.sh --chains wrote {chains} chains");
 }
+
+/// A restarted chain resumes the runs it had begun before it starts new ones, and leaves alone
+/// the finished runs and those another chain holds. The chain runs against a stand-in `seads`
+/// (a shell script) that reports a sweep's runs from a JSON file and, asked to train one, logs its
+/// index and marks it done.
+#[test]
+fn a_restarted_chain_resumes_its_begun_runs_before_new_ones() {
+    let out = tempfile::tempdir().expect("a temporary folder");
+    let sweeps = out.path().join("sweeps");
+    let frozen = out.path().join("frozen");
+    std::fs::create_dir_all(&sweeps).expect("the sweeps' folder");
+    let status = std::process::Command::new("bash")
+        .arg(root().join("scripts/studies/resume.sh"))
+        .arg("--chains")
+        .env("SEADS_SWEEPS", &sweeps)
+        .env("SEADS_FROZEN", &frozen)
+        .status()
+        .expect("bash runs");
+    assert!(status.success(), "resume.sh --chains: {status}");
+    let chain = std::fs::read_to_string(sweeps.join("chainS.sh")).expect("chainS.sh");
+    let order: Vec<usize> = chain
+        .lines()
+        .find_map(|l| l.trim().strip_prefix("for i in "))
+        .and_then(|l| l.strip_suffix("; do"))
+        .expect("chainS.sh has a `for i in …; do` line")
+        .split_whitespace()
+        .map(|i| i.parse().expect("an index"))
+        .collect();
+    assert!(order.len() >= 4, "chainS.sh trains {order:?}");
+    // The sweep: the first index finished, the second held by another chain, the last begun.
+    let (finished, held, begun) = (order[0], order[1], order[order.len() - 1]);
+    let runs: Vec<serde_json::Value> = (0..=*order.iter().max().unwrap())
+        .map(|i| {
+            let status = match i {
+                _ if i == finished => "done",
+                _ if i == held => "running",
+                _ => "pending",
+            };
+            let steps = if i == begun { 35_412 } else { 0 };
+            serde_json::json!({"index": i, "status": status, "env_steps": steps})
+        })
+        .collect();
+    let state = sweeps.join("board-size.json");
+    std::fs::write(&state, serde_json::json!({ "runs": runs }).to_string()).expect("the state");
+    let fake = frozen.join("948442b/bin");
+    std::fs::create_dir_all(&fake).expect("the stand-in's folder");
+    let seads = r#"#!/usr/bin/env bash
+# sweep status <sweep> --json | sweep task <sweep> --index <i> --cores 1
+state="$(dirname "$0")/../../../sweeps/$3.json"
+case $2 in
+  status) cat "$state" ;;
+  task)
+    echo "$5" >> "$(dirname "$0")/../../../trained"
+    python3 - "$state" "$5" <<'PY'
+import json, sys
+path, i = sys.argv[1], int(sys.argv[2])
+state = json.load(open(path))
+state["runs"][i]["status"] = "done"
+json.dump(state, open(path, "w"))
+PY
+    ;;
+esac
+"#;
+    let bin = fake.join("seads");
+    std::fs::write(&bin, seads).expect("the stand-in");
+    let chmod = std::process::Command::new("chmod")
+        .arg("+x")
+        .arg(&bin)
+        .status()
+        .expect("chmod runs");
+    assert!(chmod.success());
+    // Without its wait for other chains, which a study running on this machine would make long.
+    let unwaited: String = chain
+        .lines()
+        .filter(|l| !l.starts_with("while "))
+        .map(|l| format!("{l}\n"))
+        .collect();
+    let ran = std::process::Command::new("bash")
+        .arg("-c")
+        .arg(unwaited)
+        .current_dir(&sweeps)
+        .output()
+        .expect("bash runs");
+    assert!(
+        ran.status.success(),
+        "chainS.sh: {}",
+        String::from_utf8_lossy(&ran.stderr)
+    );
+    let trained: Vec<usize> = std::fs::read_to_string(out.path().join("trained"))
+        .expect("the stand-in logged the runs it trained")
+        .lines()
+        .map(|i| i.parse().expect("an index"))
+        .collect();
+    let mut expected = vec![begun];
+    expected.extend(order[2..order.len() - 1].iter().copied());
+    assert_eq!(trained, expected, "chainS.sh's order {order:?}");
+}

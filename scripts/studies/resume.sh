@@ -17,9 +17,10 @@
 #    second running its studies one after another.
 #      chainR: the Reacher cells (docs/results/arms-reacher/run.sh), at nice 5;
 #      chainV, then chainB, then chainS: VIC, the TileSwapCursor baselines, board size, at nice 10;
-#      chainJ, once chainR is done: the board-size runs chainS has not reached (taken from the far
-#      end of its list, so that the two cores share them), then the LightsOutJaco cells
-#      (experiments/arms-jaco.toml), at nice 5.
+#      chainJ, once chainR is done: the board-size runs chainS has not reached (the 7×7 and 9×9
+#      taken from the far end of its list, so that the two cores share them, then the 5×5 and the
+#      spaced 5×5 the same way), then the LightsOutJaco cells (experiments/arms-jaco.toml), at nice 5.
+#    Each chain resumes the runs it had begun before it starts new ones (index_chain below).
 # Runs in progress resume from their checkpoints; runs lost with a machine start again.
 # Progress: $SEADS_SWEEPS/done.log, `seads sweep status <sweep>` by the study's frozen binary.
 set -euo pipefail
@@ -116,9 +117,11 @@ done
 EOF
 # A chain that trains (and evaluates) sweeps' runs index by index with frozen binaries, once the
 # chains named have ended; a finished run is skipped, so is one another chain holds (its lock is
-# taken: status "running"), one in progress resumes. Arguments: the chain, its comment lines, the
-# niceness, the chains to wait for (none: it starts at once), then one "commit sweep indices…"
-# segment per sweep, in order.
+# taken: status "running"). Within a sweep it goes twice through its indices: first it resumes
+# the runs that have begun (steps trained, not finished), then it takes the rest in order, so a
+# restarted chain finishes what it had begun before it starts anything new. Arguments: the chain,
+# its comment lines, the niceness, the chains to wait for (none: it starts at once), then one
+# "commit sweep indices…" segment per sweep, in order.
 index_chain() {
   local chain=$1 comment=$2 niceness=$3 waits=$4 wait="" w segment commit sweep indices
   shift 4
@@ -136,22 +139,27 @@ EOF
       read -r commit sweep indices <<< "$segment"
       cat <<EOF
 B="$SEADS_FROZEN/$commit/bin/seads"
-for i in $indices; do
-  st=\$(\$B sweep status $sweep --json | python3 -c "import sys, json; print(json.load(sys.stdin)['runs'][\$i]['status'])")
-  case \$st in done | copied | running) continue ;; esac
-  nice -n $niceness \$B sweep task $sweep --index \$i --cores 1 >> $sweep.log 2>&1
-  rc=\$?; echo "\$(date +%H:%M) $sweep index \$i exit \$rc" >> done.log
+for pass in begun all; do
+  for i in $indices; do
+    read -r st steps < <(\$B sweep status $sweep --json | python3 -c "import sys, json; r = json.load(sys.stdin)['runs'][\$i]; print(r['status'], r['env_steps'])")
+    case \$st in done | copied | running) continue ;; esac
+    [[ \$pass == begun && \$steps == 0 ]] && continue
+    nice -n $niceness \$B sweep task $sweep --index \$i --cores 1 >> $sweep.log 2>&1
+    rc=\$?; echo "\$(date +%H:%M) $sweep index \$i exit \$rc" >> done.log
+  done
 done
 EOF
     done
   } | write "$chain.sh"
 }
 index_chain chainS "# Board size (issue 48 item 4), frozen 948442b, after the baselines: 7×7 and 9×9 seeds 1-3, then
-# 5×5 seeds 1-3 (scripts/studies/resume.sh)." 10 "chainB chainV" "948442b board-size 1 2 6 7 11 12 0 5 10"
+# 5×5 seeds 1-3, then the spaced 5×5 seeds 1-3 (scripts/studies/resume.sh)." 10 "chainB chainV" \
+  "948442b board-size 1 2 6 7 11 12 0 5 10 4 9 14"
 index_chain chainJ "# On chainR's core once the Reacher cells are done: the board-size runs chainS has not reached,
-# from the far end of its list (issue 48 item 4, frozen 948442b), then the LightsOutJaco cells
+# the 7×7 and 9×9 from the far end of its list, then the 5×5 and the spaced 5×5 the same way (issue
+# 48 item 4, frozen 948442b), then the LightsOutJaco cells
 # (issue 48 item 2, frozen 73dac45): SEADS and no forward-model relabelling, seed by seed
-# (scripts/studies/resume.sh)." 5 chainR "948442b board-size 10 5 0 12 11 7 6 2 1" \
+# (scripts/studies/resume.sh)." 5 chainR "948442b board-size 12 11 7 6 2 1 10 5 0 14 9 4" \
   "73dac45 arms-jaco 0 1 2 3 4 5"
 [[ ${1:-} == --chains ]] && exit 0
 cd "$SEADS_SWEEPS"
