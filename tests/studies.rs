@@ -1,5 +1,8 @@
 //! The long studies' scripts: the chains `scripts/studies/resume.sh` writes and starts.
 
+use std::path::Path;
+use std::process::Command;
+
 use crate::{read, root};
 
 /// The commits `resume.sh` freezes (its `FROZEN=(…)` line).
@@ -13,6 +16,31 @@ fn frozen() -> Vec<String> {
         .split_whitespace()
         .map(str::to_owned)
         .collect()
+}
+
+/// Runs `command` to its end; fails the test, with its error output, when it does not succeed.
+fn run_ok(command: &mut Command, what: &str) {
+    let out = command
+        .output()
+        .unwrap_or_else(|e| panic!("{what} does not start: {e}"));
+    assert!(
+        out.status.success(),
+        "{what}: {}: {}",
+        out.status,
+        String::from_utf8_lossy(&out.stderr)
+    );
+}
+
+/// Writes the chains into `sweeps` (`resume.sh --chains`), naming binaries under `frozen`.
+fn write_chains(sweeps: &Path, frozen: &Path) {
+    run_ok(
+        Command::new("bash")
+            .arg(root().join("scripts/studies/resume.sh"))
+            .arg("--chains")
+            .env("SEADS_SWEEPS", sweeps)
+            .env("SEADS_FROZEN", frozen),
+        "resume.sh --chains",
+    );
 }
 
 /// The commit after each `prefix` in `text` (`<prefix><commit>/bin/seads`).
@@ -30,29 +58,16 @@ fn binaries<'a>(text: &'a str, prefix: &str) -> Vec<&'a str> {
 fn the_study_chains_parse_and_run_only_frozen_binaries() {
     let out = tempfile::tempdir().expect("a temporary folder");
     let fake_frozen = "/nonexistent-frozen-for-the-test";
-    let status = std::process::Command::new("bash")
-        .arg(root().join("scripts/studies/resume.sh"))
-        .arg("--chains")
-        .env("SEADS_SWEEPS", out.path())
-        .env("SEADS_FROZEN", fake_frozen)
-        .status()
-        .expect("bash runs");
-    assert!(status.success(), "resume.sh --chains: {status}");
+    write_chains(out.path(), Path::new(fake_frozen));
     let frozen = frozen();
     let mut chains = 0;
     for entry in std::fs::read_dir(out.path()).expect("the chains' folder") {
         let path = entry.expect("an entry").path();
         let name = path.file_name().unwrap().to_string_lossy().into_owned();
         let text = std::fs::read_to_string(&path).expect("a chain");
-        let parsed = std::process::Command::new("bash")
-            .arg("-n")
-            .arg(&path)
-            .output()
-            .expect("bash runs");
-        assert!(
-            parsed.status.success(),
-            "{name} does not parse: {}",
-            String::from_utf8_lossy(&parsed.stderr)
+        run_ok(
+            Command::new("bash").arg("-n").arg(&path),
+            &format!("{name} parses"),
         );
         // The chains name the binaries under $SEADS_FROZEN, `arms-run.sh` under its $F.
         let used = [
@@ -87,14 +102,7 @@ fn a_restarted_chain_resumes_its_begun_runs_before_new_ones() {
     let sweeps = out.path().join("sweeps");
     let frozen = out.path().join("frozen");
     std::fs::create_dir_all(&sweeps).expect("the sweeps' folder");
-    let status = std::process::Command::new("bash")
-        .arg(root().join("scripts/studies/resume.sh"))
-        .arg("--chains")
-        .env("SEADS_SWEEPS", &sweeps)
-        .env("SEADS_FROZEN", &frozen)
-        .status()
-        .expect("bash runs");
-    assert!(status.success(), "resume.sh --chains: {status}");
+    write_chains(&sweeps, &frozen);
     let chain = std::fs::read_to_string(sweeps.join("chainS.sh")).expect("chainS.sh");
     let order: Vec<usize> = chain
         .lines()
@@ -141,28 +149,19 @@ esac
 "#;
     let bin = fake.join("seads");
     std::fs::write(&bin, seads).expect("the stand-in");
-    let chmod = std::process::Command::new("chmod")
-        .arg("+x")
-        .arg(&bin)
-        .status()
-        .expect("chmod runs");
-    assert!(chmod.success());
+    run_ok(Command::new("chmod").arg("+x").arg(&bin), "chmod");
     // Without its wait for other chains, which a study running on this machine would make long.
     let unwaited: String = chain
         .lines()
         .filter(|l| !l.starts_with("while "))
         .map(|l| format!("{l}\n"))
         .collect();
-    let ran = std::process::Command::new("bash")
-        .arg("-c")
-        .arg(unwaited)
-        .current_dir(&sweeps)
-        .output()
-        .expect("bash runs");
-    assert!(
-        ran.status.success(),
-        "chainS.sh: {}",
-        String::from_utf8_lossy(&ran.stderr)
+    run_ok(
+        Command::new("bash")
+            .arg("-c")
+            .arg(unwaited)
+            .current_dir(&sweeps),
+        "chainS.sh",
     );
     let trained: Vec<usize> = std::fs::read_to_string(out.path().join("trained"))
         .expect("the stand-in logged the runs it trained")
