@@ -156,10 +156,9 @@ index_chain chainS "# Board size (issue 48 item 4), frozen 948442b, after the ba
 # 5×5 seeds 1-3, then the spaced 5×5 seeds 1-3 (scripts/studies/resume.sh)." 10 "chainB chainV" \
   "948442b board-size 1 2 6 7 11 12 0 5 10 4 9 14"
 index_chain chainJ "# On chainR's core once the Reacher cells are done: the board-size runs chainS has not reached,
-# the 7×7 and 9×9 from the far end of its list, then the 5×5 and the spaced 5×5 the same way (issue
-# 48 item 4, frozen 948442b), then the LightsOutJaco cells
-# (issue 48 item 2, frozen 73dac45): SEADS and no forward-model relabelling, seed by seed
-# (scripts/studies/resume.sh)." 5 chainR "948442b board-size 12 11 7 6 2 1 10 5 0 14 9 4" \
+# the 7×7 and 9×9 from the far end of its list, then the 5×5 and the spaced 5×5 the same way
+# (issue 48 item 4, frozen 948442b), then the LightsOutJaco cells (issue 48 item 2, frozen
+# 73dac45): SEADS and no forward-model relabelling, seed by seed (scripts/studies/resume.sh)." 5 chainR "948442b board-size 12 11 7 6 2 1 10 5 0 14 9 4" \
   "73dac45 arms-jaco 0 1 2 3 4 5"
 [[ ${1:-} == --chains ]] && exit 0
 cd "$SEADS_SWEEPS"
