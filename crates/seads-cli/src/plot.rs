@@ -33,7 +33,8 @@ pub struct PlotArgs {
     /// Initialisations per skill in `--animate`'s clips.
     #[arg(long, default_value_t = 2, value_parser = clap::value_parser!(u64).range(1..=20))]
     starts: u64,
-    /// Use the checkpoint of this epoch instead of the latest.
+    /// Use the checkpoint of this epoch instead of the latest (its evaluation is saved as
+    /// `evaluation-replan-epoch-NNNNNN.json` and reused; the figures of it name the epoch).
     #[arg(long)]
     checkpoint: Option<u64>,
     /// Boards per depth when an evaluation must be run first (saved evaluations are reused).
@@ -141,16 +142,18 @@ pub fn write_figures(
         };
         let agent = Agent::load_for(on_cpu, spec, &find_checkpoint(run, checkpoint)?)?;
         let k = seads_embodiment::SkillPolicy::num_skills(&agent.policy);
+        let at = checkpoint_title(&agent);
         both("coverage", &|p| coverage_figure(p, &metrics, k, &title))?;
-        let file = EvaluationKind::Replan.results_file(&STANDARD_DEPTHS, None);
-        match read_evaluation(&run.join(&file)).map_err(crate::study_error)? {
+        let file = saved_evaluation(run, &agent, EvaluationKind::Replan)?;
+        match read_evaluation(&file).map_err(crate::study_error)? {
             Some(record) if record.checkpoint.is_some_and(|c| c.epoch == agent.epoch) => {
                 let replan = [(true, record.results)];
-                both("success", &|p| success_figure(p, &replan, &title))?;
+                both("success", &|p| success_figure(p, &replan, &at))?;
             }
             Some(_) if !quiet => eprintln!(
-                "seads: {file} is not an evaluation of epoch {}: no success figure \
+                "seads: {} is not an evaluation of epoch {}: no success figure \
                  (`seads uarm evaluate` makes one)",
+                file.display(),
                 agent.epoch
             ),
             _ => {}
@@ -162,15 +165,16 @@ pub fn write_figures(
                 agent.config.env
             );
         }
-        skill_figures(&mut twin, &agent.policy, &title, both)?;
+        skill_figures(&mut twin, &agent.policy, &at, both)?;
         return Ok(written);
     }
     let mut agent = load_agent(run, checkpoint, seads_rl::ComputeDevice::Cpu)?;
     let k = seads_embodiment::SkillPolicy::num_skills(&agent.policy);
+    let at = checkpoint_title(&agent);
     both("coverage", &|p| coverage_figure(p, &metrics, k, &title))?;
     if agent.model.is_some() {
         let evaluations = evaluations(&mut agent, run, boards, limits, quiet)?;
-        both("success", &|p| success_figure(p, &evaluations, &title))?;
+        both("success", &|p| success_figure(p, &evaluations, &at))?;
     } else if !quiet {
         eprintln!(
             "seads: {} is a VIC run: its skill discriminator cannot plan, so there is no task-success figure",
@@ -184,13 +188,33 @@ pub fn write_figures(
             ..agent.config.env_config.clone()
         },
     )?;
-    skill_figures(env.as_mut(), &agent.policy, &title, both)?;
+    skill_figures(env.as_mut(), &agent.policy, &at, both)?;
     Ok(written)
 }
 
+/// The title of the figures of one checkpoint (success, skills): the coverage figure's, with
+/// the checkpoint's epoch.
+fn checkpoint_title(agent: &Agent) -> String {
+    let config = &agent.config;
+    format!(
+        "{} (seed {}, epoch {})",
+        config.env, config.seed, agent.epoch
+    )
+}
+
+/// Where an evaluation of `kind` on the standard depths of the agent's checkpoint is saved in
+/// `run`: the final evaluation's file for the run's latest checkpoint, an epoch-named one
+/// (`evaluation-replan-epoch-000500.json`) for an earlier checkpoint, as the evaluation names it.
+fn saved_evaluation(run: &Path, agent: &Agent, kind: EvaluationKind) -> Result<PathBuf> {
+    let (_, named) = seads_study::evaluation::checkpoint_of(run, &agent.checkpoint)
+        .map_err(crate::study_error)?;
+    Ok(run.join(kind.results_file(&STANDARD_DEPTHS, named)))
+}
+
 /// The run's evaluations of the agent's checkpoint with and without re-planning: the saved ones
-/// where they name that checkpoint (`evaluation-replan.json`, `evaluation-plan-once.json`),
-/// otherwise evaluated now (an evaluation of an earlier checkpoint, or one that does not say
+/// where they name that checkpoint ([`saved_evaluation`]: `evaluation-replan.json` and
+/// `evaluation-plan-once.json` for the latest checkpoint, `-epoch-NNNNNN` ones for an earlier
+/// one), otherwise evaluated now (an evaluation of another checkpoint, or one that does not say
 /// which it evaluated, is never shown for this one).
 fn evaluations(
     agent: &mut Agent,
@@ -200,9 +224,8 @@ fn evaluations(
     quiet: bool,
 ) -> Result<[(bool, Vec<DepthResult>); 2]> {
     let mut load = |replan: bool| -> Result<Vec<DepthResult>> {
-        let kind = EvaluationKind::planning(replan);
-        let saved = read_evaluation(&run.join(kind.results_file(&STANDARD_DEPTHS, None)))
-            .map_err(crate::study_error)?;
+        let file = saved_evaluation(run, agent, EvaluationKind::planning(replan))?;
+        let saved = read_evaluation(&file).map_err(crate::study_error)?;
         if let Some(record) = saved
             && record.checkpoint.is_some_and(|c| c.epoch == agent.epoch)
         {

@@ -2013,6 +2013,67 @@ fn budgets_and_seeds_beyond_a_toml_integer_are_refused_before_writing() {
     }
 }
 
+/// `seads plot --checkpoint` of an earlier checkpoint evaluates it once: the next plot reuses
+/// the evaluation saved under the epoch's name (it looked for the final evaluation's file and
+/// evaluated the checkpoint anew each time, minutes on an arm), and the figures of the checkpoint
+/// say its epoch. The run keeps one checkpoint; a copy of it under a lower epoch stands in for an
+/// earlier one.
+#[test]
+fn a_plot_of_an_earlier_checkpoint_reuses_its_evaluation_and_names_its_epoch() {
+    let dir = tempfile::tempdir().unwrap();
+    let run = dir.path().join("run");
+    copy_tiny_run(&run);
+    let latest = std::fs::read_to_string(run.join("checkpoints/latest")).unwrap();
+    let last: u64 = latest
+        .trim()
+        .strip_prefix("epoch-")
+        .unwrap()
+        .parse()
+        .unwrap();
+    let earlier = last - 1;
+    let status = std::process::Command::new("cp")
+        .arg("-r")
+        .arg(run.join(format!("checkpoints/epoch-{last:06}")))
+        .arg(run.join(format!("checkpoints/epoch-{earlier:06}")))
+        .status()
+        .unwrap();
+    assert!(status.success());
+    let epoch = earlier.to_string();
+    let plot = |out: &str| {
+        let figures = dir.path().join(out);
+        seads_ok(&[
+            "plot",
+            "--run",
+            s(&run),
+            "--out",
+            s(&figures),
+            "--checkpoint",
+            &epoch,
+            "--boards",
+            "1",
+            "--max-expanded",
+            "2000",
+        ]);
+        figures
+    };
+    plot("first");
+    let record: serde_json::Value = serde_json::from_str(
+        &std::fs::read_to_string(run.join(format!("evaluation-replan-epoch-{earlier:06}.json")))
+            .unwrap(),
+    )
+    .unwrap();
+    assert_eq!(record["checkpoint"]["epoch"], earlier, "{record}");
+    // A planted line stands in for the tasks the evaluation wrote: evaluating again rewrites them.
+    let tasks = run.join(format!("evaluation-replan-epoch-{earlier:06}-tasks.jsonl"));
+    std::fs::write(&tasks, "planted\n").unwrap();
+    let figures = plot("second");
+    assert_eq!(std::fs::read_to_string(&tasks).unwrap(), "planted\n");
+    for name in ["success", "trajectories", "pushes"] {
+        let svg = std::fs::read_to_string(figures.join(format!("{name}.svg"))).unwrap();
+        assert!(svg.contains(&format!("epoch {earlier})")), "{name}");
+    }
+}
+
 /// An evaluation with no board, or with more tasks than one evaluation may have, is refused
 /// before anything is trained or written, by `run` and `plot` as by `evaluate`.
 #[test]
