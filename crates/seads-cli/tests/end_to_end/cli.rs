@@ -1030,28 +1030,8 @@ fn a_resumed_robot_run_keeps_its_action_space() {
             .contains("uarm-lightsout-displacement")
     );
     // An earlier checkpoint evaluated on its own, beside the final evaluation (issue 32: it
-    // took the final evaluation's file). The run keeps one checkpoint; a copy of it under a
-    // lower epoch stands in for an earlier one.
-    let last: u64 = std::fs::read_dir(run.join("checkpoints"))
-        .unwrap()
-        .filter_map(|e| {
-            e.unwrap()
-                .file_name()
-                .to_str()?
-                .strip_prefix("epoch-")?
-                .parse()
-                .ok()
-        })
-        .max()
-        .unwrap();
-    let earlier = last - 1;
-    let status = std::process::Command::new("cp")
-        .arg("-r")
-        .arg(run.join(format!("checkpoints/epoch-{last:06}")))
-        .arg(run.join(format!("checkpoints/epoch-{earlier:06}")))
-        .status()
-        .unwrap();
-    assert!(status.success());
+    // took the final evaluation's file).
+    let (last, earlier) = add_an_earlier_checkpoint(&run);
     let final_evaluation = std::fs::read_to_string(run.join("evaluation-replan.json")).unwrap();
     let evaluate = |extra: &[&str]| {
         let mut args = vec![
@@ -2013,22 +1993,20 @@ fn budgets_and_seeds_beyond_a_toml_integer_are_refused_before_writing() {
     }
 }
 
-/// `seads plot --checkpoint` of an earlier checkpoint evaluates it once: the next plot reuses
-/// the evaluation saved under the epoch's name (it looked for the final evaluation's file and
-/// evaluated the checkpoint anew each time, minutes on an arm), and the figures of the checkpoint
-/// say its epoch. The run keeps one checkpoint; a copy of it under a lower epoch stands in for an
-/// earlier one.
-#[test]
-fn a_plot_of_an_earlier_checkpoint_reuses_its_evaluation_and_names_its_epoch() {
-    let dir = tempfile::tempdir().unwrap();
-    let run = dir.path().join("run");
-    copy_tiny_run(&run);
-    let latest = std::fs::read_to_string(run.join("checkpoints/latest")).unwrap();
-    let last: u64 = latest
-        .trim()
-        .strip_prefix("epoch-")
+/// Copies the run's last checkpoint under the epoch before it, which stands in for an earlier
+/// checkpoint (a run keeps only its last); returns the last epoch and the earlier one.
+fn add_an_earlier_checkpoint(run: &std::path::Path) -> (u64, u64) {
+    let last: u64 = std::fs::read_dir(run.join("checkpoints"))
         .unwrap()
-        .parse()
+        .filter_map(|e| {
+            e.unwrap()
+                .file_name()
+                .to_str()?
+                .strip_prefix("epoch-")?
+                .parse()
+                .ok()
+        })
+        .max()
         .unwrap();
     let earlier = last - 1;
     let status = std::process::Command::new("cp")
@@ -2038,6 +2016,19 @@ fn a_plot_of_an_earlier_checkpoint_reuses_its_evaluation_and_names_its_epoch() {
         .status()
         .unwrap();
     assert!(status.success());
+    (last, earlier)
+}
+
+/// `seads plot --checkpoint` of an earlier checkpoint evaluates it once: the next plot reuses
+/// the evaluation saved under the epoch's name (it looked for the final evaluation's file and
+/// evaluated the checkpoint anew each time, minutes on an arm), and the figures of the checkpoint
+/// say its epoch.
+#[test]
+fn a_plot_of_an_earlier_checkpoint_reuses_its_evaluation_and_names_its_epoch() {
+    let dir = tempfile::tempdir().unwrap();
+    let run = dir.path().join("run");
+    copy_tiny_run(&run);
+    let (_, earlier) = add_an_earlier_checkpoint(&run);
     let epoch = earlier.to_string();
     let plot = |out: &str| {
         let figures = dir.path().join(out);
