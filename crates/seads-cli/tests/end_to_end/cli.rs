@@ -1996,18 +1996,7 @@ fn budgets_and_seeds_beyond_a_toml_integer_are_refused_before_writing() {
 /// Copies the run's last checkpoint under the epoch before it, which stands in for an earlier
 /// checkpoint (a run keeps only its last); returns the last epoch and the earlier one.
 fn add_an_earlier_checkpoint(run: &std::path::Path) -> (u64, u64) {
-    let last: u64 = std::fs::read_dir(run.join("checkpoints"))
-        .unwrap()
-        .filter_map(|e| {
-            e.unwrap()
-                .file_name()
-                .to_str()?
-                .strip_prefix("epoch-")?
-                .parse()
-                .ok()
-        })
-        .max()
-        .unwrap();
+    let (last, _) = seads_rl::store::checkpoints(run).unwrap().pop().unwrap();
     let earlier = last - 1;
     let status = std::process::Command::new("cp")
         .arg("-r")
