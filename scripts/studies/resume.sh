@@ -16,7 +16,9 @@
 #    starts each that is not running, detached (setsid, nohup): two cores, one chain each, the
 #    second running its studies one after another.
 #      chainR: the Reacher cells (docs/results/arms-reacher/run.sh), at nice 5;
-#      chainV, then chainB, then chainS: VIC, the TileSwapCursor baselines, board size, at nice 10;
+#      chainV, then chainB, then chainS: VIC, the TileSwapCursor baselines, board size, then the
+#      LightsOutJaco cells chainJ has not reached (each seed's no forward-model relabelling run
+#      first, SEADS's first on chainJ, so that the cores train a seed's pair together), at nice 10;
 #      chainJ, once chainR is done: the board-size runs chainS has not reached (the 7×7 and 9×9
 #      taken from the far end of its list, so that the two cores share them, then the 5×5 and the
 #      spaced 5×5 the same way), then the LightsOutJaco cells (experiments/arms-jaco.toml), at nice 5.
@@ -153,8 +155,10 @@ EOF
   } | write "$chain.sh"
 }
 index_chain chainS "# Board size (issue 48 item 4), frozen 948442b, after the baselines: 7×7 and 9×9 seeds 1-3, then
-# 5×5 seeds 1-3, then the spaced 5×5 seeds 1-3 (scripts/studies/resume.sh)." 10 "chainB chainV" \
-  "948442b board-size 1 2 6 7 11 12 0 5 10 4 9 14"
+# 5×5 seeds 1-3, then the spaced 5×5 seeds 1-3; then the LightsOutJaco cells chainJ has not
+# reached, each seed's pair from the other end of the pair, so that both cores train Jaco
+# (issue 48 item 2, frozen 73dac45; scripts/studies/resume.sh)." 10 "chainB chainV" \
+  "948442b board-size 1 2 6 7 11 12 0 5 10 4 9 14" "73dac45 arms-jaco 1 0 3 2 5 4"
 index_chain chainJ "# On chainR's core once the Reacher cells are done: the board-size runs chainS has not reached,
 # the 7×7 and 9×9 from the far end of its list, then the 5×5 and the spaced 5×5 the same way
 # (issue 48 item 4, frozen 948442b), then the LightsOutJaco cells (issue 48 item 2, frozen
