@@ -18,10 +18,12 @@
 #      chainR: the Reacher cells (docs/results/arms-reacher/run.sh), at nice 5;
 #      chainV, then chainB, then chainS: VIC, the TileSwapCursor baselines, board size, then the
 #      LightsOutJaco cells chainJ has not reached (each seed's no forward-model relabelling run
-#      first, SEADS's first on chainJ, so that the cores train a seed's pair together), at nice 10;
+#      first, SEADS's first on chainJ, so that the cores train a seed's pair together), then the
+#      13×13 board's seeds 1-3 (chainJ takes them from the far end), at nice 10;
 #      chainJ, once chainR is done: the board-size runs chainS has not reached (the 7×7 and 9×9
 #      taken from the far end of its list, so that the two cores share them, then the 5×5 and the
-#      spaced 5×5 the same way), then the LightsOutJaco cells (experiments/arms-jaco.toml), at nice 5.
+#      spaced 5×5 the same way), then the LightsOutJaco cells (experiments/arms-jaco.toml), then
+#      the 13×13 board, at nice 5.
 #    Each chain resumes the runs it had begun before it starts new ones (index_chain below).
 # Runs in progress resume from their checkpoints; runs lost with a machine start again.
 # Progress: $SEADS_SWEEPS/done.log, `seads sweep status <sweep>` by the study's frozen binary.
@@ -157,13 +159,16 @@ EOF
 index_chain chainS "# Board size (issue 48 item 4), frozen 948442b, after the baselines: 7×7 and 9×9 seeds 1-3, then
 # 5×5 seeds 1-3, then the spaced 5×5 seeds 1-3; then the LightsOutJaco cells chainJ has not
 # reached, each seed's pair from the other end of the pair, so that both cores train Jaco
-# (issue 48 item 2, frozen 73dac45; scripts/studies/resume.sh)." 10 "chainB chainV" \
-  "948442b board-size 1 2 6 7 11 12 0 5 10 4 9 14" "73dac45 arms-jaco 1 0 3 2 5 4"
+# (issue 48 item 2, frozen 73dac45); then the 13×13 board, seeds 1-3 (issue 48 item 4, if
+# compute allows; scripts/studies/resume.sh)." 10 "chainB chainV" \
+  "948442b board-size 1 2 6 7 11 12 0 5 10 4 9 14" "73dac45 arms-jaco 1 0 3 2 5 4" \
+  "948442b board-size 3 8 13"
 index_chain chainJ "# On chainR's core once the Reacher cells are done: the board-size runs chainS has not reached,
 # the 7×7 and 9×9 from the far end of its list, then the 5×5 and the spaced 5×5 the same way
 # (issue 48 item 4, frozen 948442b), then the LightsOutJaco cells (issue 48 item 2, frozen
-# 73dac45): SEADS and no forward-model relabelling, seed by seed (scripts/studies/resume.sh)." 5 chainR "948442b board-size 12 11 7 6 2 1 10 5 0 14 9 4" \
-  "73dac45 arms-jaco 0 1 2 3 4 5"
+# 73dac45): SEADS and no forward-model relabelling, seed by seed; then the 13×13 board from the
+# far end, seeds 3-1 (scripts/studies/resume.sh)." 5 chainR "948442b board-size 12 11 7 6 2 1 10 5 0 14 9 4" \
+  "73dac45 arms-jaco 0 1 2 3 4 5" "948442b board-size 13 8 3"
 [[ ${1:-} == --chains ]] && exit 0
 cd "$SEADS_SWEEPS"
 for chain in chainR chainV chainB chainS chainJ; do
