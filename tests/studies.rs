@@ -104,18 +104,28 @@ fn a_restarted_chain_resumes_its_begun_runs_before_new_ones() {
     std::fs::create_dir_all(&sweeps).expect("the sweeps' folder");
     write_chains(&sweeps, &frozen);
     let chain = std::fs::read_to_string(sweeps.join("chainS.sh")).expect("chainS.sh");
-    let order: Vec<usize> = chain
-        .lines()
-        .find_map(|l| l.trim().strip_prefix("for i in "))
-        .and_then(|l| l.strip_suffix("; do"))
-        .expect("chainS.sh has a `for i in …; do` line")
-        .split_whitespace()
-        .map(|i| i.parse().expect("an index"))
+    // Its segments on the board-size sweep, in order: each `for i in …; do` line is followed by
+    // the line that reads the status of the sweep it trains.
+    let lines: Vec<&str> = chain.lines().collect();
+    let segments: Vec<Vec<usize>> = lines
+        .windows(2)
+        .filter(|w| w[1].contains("sweep status board-size "))
+        .filter_map(|w| w[0].trim().strip_prefix("for i in ")?.strip_suffix("; do"))
+        .map(|l| {
+            l.split_whitespace()
+                .map(|i| i.parse().expect("an index"))
+                .collect()
+        })
         .collect();
+    let (order, later) = segments
+        .split_first()
+        .expect("chainS.sh trains the board-size sweep");
+    let later: Vec<usize> = later.concat();
     assert!(order.len() >= 4, "chainS.sh trains {order:?}");
     // The sweep: the first index finished, the second held by another chain, the last begun.
     let (finished, held, begun) = (order[0], order[1], order[order.len() - 1]);
-    let runs: Vec<serde_json::Value> = (0..=*order.iter().max().unwrap())
+    let last = order.iter().chain(&later).max().copied().unwrap_or(0);
+    let runs: Vec<serde_json::Value> = (0..=last)
         .map(|i| {
             let status = match i {
                 _ if i == finished => "done",
@@ -168,7 +178,13 @@ esac
         .lines()
         .map(|i| i.parse().expect("an index"))
         .collect();
+    // The begun run first, then the segment's others but the finished and the held, then the
+    // later segments' runs on the same sweep (the stand-in knows no other sweep).
     let mut expected = vec![begun];
     expected.extend(order[2..order.len() - 1].iter().copied());
-    assert_eq!(trained, expected, "chainS.sh's order {order:?}");
+    expected.extend(later.iter().copied());
+    assert_eq!(
+        trained, expected,
+        "chainS.sh's order {order:?}, then {later:?}"
+    );
 }
