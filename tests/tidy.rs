@@ -138,7 +138,8 @@ fn crate_dependencies_point_one_way_and_only_five_crates_link_libtorch() {
     let graph = normal_graph(&meta);
     let expected: &[(&str, &[&str])] = &[
         ("seads-games", &[]),
-        ("seads-nn", &[]),
+        ("seads-weights", &[]),
+        ("seads-nn", &["seads-weights"]),
         ("seads-embodiment", &["seads-games"]),
         ("seads-skillmodel", &["seads-games", "seads-nn"]),
         (
@@ -152,7 +153,10 @@ fn crate_dependencies_point_one_way_and_only_five_crates_link_libtorch() {
             ],
         ),
         ("seads-planner", &["seads-embodiment", "seads-games"]),
-        ("seads-infer", &["seads-embodiment", "seads-games"]),
+        (
+            "seads-infer",
+            &["seads-embodiment", "seads-games", "seads-weights"],
+        ),
         ("seads-uarm", &["seads-embodiment", "seads-games"]),
         (
             "seads-py",
@@ -275,6 +279,7 @@ fn light_crates_pull_in_neither_libtorch_nor_rapier() {
         ),
         (&["-p", "seads-planner"], &["tch", "torch-sys", "rapier3d"]),
         (&["-p", "seads-infer"], &["tch", "torch-sys", "rapier3d"]),
+        (&["-p", "seads-weights"], &["tch", "torch-sys", "rapier3d"]),
         (&["-p", "seads-uarm"], &["tch", "torch-sys", "rapier3d"]),
         (
             &["-p", "seads-embodiment", "--no-default-features"],

@@ -106,6 +106,7 @@ pub fn env_bench(args: BenchArgs) -> Result<()> {
     if args.threads == 0 || args.steps == 0 {
         return Err(BadInput(anyhow::anyhow!("--steps and --threads must be at least 1")).into());
     }
+    crate::check_threads("--threads", args.threads)?;
     let config = EnvConfig {
         manipulator: args.manipulator.into_iter().collect(),
         ..EnvConfig::default()

@@ -143,6 +143,25 @@ pub fn usable_device(device: seads_rl::ComputeDevice) -> anyhow::Result<seads_rl
     Ok(device)
 }
 
+/// The boolean environment variable `name`: `1`, `true`, `yes` and `on` (in any case) are true;
+/// `0`, `false`, `no`, `off`, an empty value and an unset variable are false. Any other value is
+/// bad input naming the variable, since the user set it without a flag to point to.
+pub fn env_flag(name: &str) -> anyhow::Result<bool> {
+    let Some(value) = std::env::var_os(name) else {
+        return Ok(false);
+    };
+    let text = value.to_string_lossy();
+    match text.trim().to_ascii_lowercase().as_str() {
+        "1" | "true" | "yes" | "on" => Ok(true),
+        "" | "0" | "false" | "no" | "off" => Ok(false),
+        _ => Err(bad_input(anyhow::anyhow!(
+            "environment variable {name}={text:?} is not a boolean: use 1 or 0, true or false, \
+             yes or no, on or off"
+        ))
+        .into()),
+    }
+}
+
 /// Any error as bad input (exit 2).
 pub fn bad_input(e: impl Into<anyhow::Error>) -> BadInput {
     BadInput(e.into())

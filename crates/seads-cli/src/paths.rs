@@ -75,6 +75,36 @@ pub fn refuse_unsafe_output(output: &Path, inputs: &[&Path]) -> Result<()> {
     refuse_overwriting_input(output, inputs)
 }
 
+/// Checks an output file before any work is done for it: [`refuse_unsafe_output`], a name that
+/// ends in one of `extensions` (the formats the command writes), and a folder for it that exists.
+/// Each failure is the user's input to fix, said in one line that names the path.
+pub fn check_output_file(output: &Path, inputs: &[&Path], extensions: &[&str]) -> Result<()> {
+    refuse_unsafe_output(output, inputs)?;
+    let known = output
+        .extension()
+        .and_then(|e| e.to_str())
+        .is_some_and(|e| extensions.iter().any(|x| x.eq_ignore_ascii_case(e)));
+    if !known {
+        return Err(invalid(format!(
+            "{}: the output must be a .{} file",
+            output.display(),
+            extensions.join(", .")
+        )));
+    }
+    let parent = output
+        .parent()
+        .filter(|p| !p.as_os_str().is_empty())
+        .unwrap_or(Path::new("."));
+    if !parent.is_dir() {
+        return Err(invalid(format!(
+            "{}: the folder {} does not exist",
+            output.display(),
+            parent.display()
+        )));
+    }
+    Ok(())
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -13,7 +13,7 @@ use seads_rl::{Agent, find_checkpoint, read_metrics};
 
 use crate::envs::build_env;
 use crate::plan::{load_agent, run_evaluation};
-use seads_planner::{EvaluationKind, Protocol, STANDARD_DEPTHS};
+use seads_planner::{EvaluationRecord, Protocol};
 use seads_study::evaluation::read_evaluation;
 use seads_study::figures::{coverage_figure, skill_figures, success_figure};
 
@@ -37,10 +37,12 @@ pub struct PlotArgs {
     /// `evaluation-replan-epoch-NNNNNN.json` and reused; the figures of it name the epoch).
     #[arg(long)]
     checkpoint: Option<u64>,
-    /// Boards per depth when an evaluation must be run first (saved evaluations are reused).
+    /// Boards per depth of the evaluation the success figure shows. A saved evaluation of
+    /// exactly this protocol (boards and search limits) is reused; otherwise one is run and
+    /// saved (a robot run's is shown only if `seads uarm` saved it).
     #[arg(long, default_value_t = 20)]
     boards: usize,
-    /// The search limits of such an evaluation.
+    /// The search limits of that evaluation.
     #[command(flatten)]
     search: crate::plan::SearchArgs,
 }
@@ -74,16 +76,7 @@ pub fn plot(args: PlotArgs) -> Result<()> {
 
 /// `seads plot --animate GIF`: a clip per skill, from `starts` coverage initialisations.
 fn animate(run: &Path, checkpoint: Option<u64>, starts: u64, gif: &Path) -> Result<()> {
-    if !gif
-        .extension()
-        .is_some_and(|e| e.eq_ignore_ascii_case("gif"))
-    {
-        return Err(crate::BadInput(anyhow::anyhow!(
-            "--animate {}: the animation is a .gif file",
-            gif.display()
-        ))
-        .into());
-    }
+    crate::paths::check_output_file(gif, &[run], &["gif"])?;
     let config = seads_rl::load_config(run)?;
     let (env, agent) = match crate::uarm::twin_for_figures(run, &config)? {
         Some(twin) => {
@@ -109,8 +102,19 @@ fn animate(run: &Path, checkpoint: Option<u64>, starts: u64, gif: &Path) -> Resu
     };
     let frames =
         seads_study::animation::skill_clips(env, &agent.policy, starts, seads_rl::COVERAGE_SEED)?;
-    seads_study::animation::write_gif(&frames, 150, 150, gif)?;
-    outln!("wrote {} ({} frames)", gif.display(), frames.len());
+    let shown = seads_study::animation::write_gif(&frames, 150, 150, gif)?;
+    if shown < frames.len() {
+        // Never a cut without a word: the clips of the last skills are not in the file.
+        outln!(
+            "wrote {} ({shown} of {} frames: an animation holds at most {}; the last skills' \
+             clips are left out, fewer --starts show every skill)",
+            gif.display(),
+            frames.len(),
+            seads_study::animation::MAX_FRAMES
+        );
+    } else {
+        outln!("wrote {} ({shown} frames)", gif.display());
+    }
     Ok(())
 }
 
@@ -144,17 +148,21 @@ pub fn write_figures(
         let k = seads_embodiment::SkillPolicy::num_skills(&agent.policy);
         let at = checkpoint_title(&agent);
         both("coverage", &|p| coverage_figure(p, &metrics, k, &title))?;
-        let file = saved_evaluation(run, &agent, EvaluationKind::Replan)?;
+        let protocol = Protocol::planning(true, boards, limits);
+        let file = saved_evaluation(run, &agent, &protocol)?;
         match read_evaluation(&file).map_err(crate::study_error)? {
-            Some(record) if record.checkpoint.is_some_and(|c| c.epoch == agent.epoch) => {
+            Some(record) if shows(&record, &agent, &protocol) => {
                 let replan = [(true, record.results)];
+                let at = with_protocol(&at, &protocol);
                 both("success", &|p| success_figure(p, &replan, &at))?;
             }
-            Some(_) if !quiet => eprintln!(
-                "seads: {} is not an evaluation of epoch {}: no success figure \
-                 (`seads uarm evaluate` makes one)",
+            _ if !quiet => eprintln!(
+                "seads: {} holds no evaluation of epoch {} with this protocol ({}): no success \
+                 figure (`seads uarm evaluate` makes one; --boards and the search options choose \
+                 the protocol)",
                 file.display(),
-                agent.epoch
+                agent.epoch,
+                protocol.label()
             ),
             _ => {}
         }
@@ -174,7 +182,8 @@ pub fn write_figures(
     both("coverage", &|p| coverage_figure(p, &metrics, k, &title))?;
     if agent.model.is_some() {
         let evaluations = evaluations(&mut agent, run, boards, limits, quiet)?;
-        both("success", &|p| success_figure(p, &evaluations, &at))?;
+        let shown = with_protocol(&at, &Protocol::planning(true, boards, limits));
+        both("success", &|p| success_figure(p, &evaluations, &shown))?;
     } else if !quiet {
         eprintln!(
             "seads: {} is a VIC run: its skill discriminator cannot plan, so there is no task-success figure",
@@ -202,20 +211,35 @@ fn checkpoint_title(agent: &Agent) -> String {
     )
 }
 
-/// Where an evaluation of `kind` on the standard depths of the agent's checkpoint is saved in
-/// `run`: the final evaluation's file for the run's latest checkpoint, an epoch-named one
-/// (`evaluation-replan-epoch-000500.json`) for an earlier checkpoint, as the evaluation names it.
-fn saved_evaluation(run: &Path, agent: &Agent, kind: EvaluationKind) -> Result<PathBuf> {
+/// Where an evaluation with `protocol` of the agent's checkpoint is saved in `run`: the
+/// protocol's file for the run's latest checkpoint (`evaluation-replan.json` for the standard
+/// protocol), an epoch-named one (`evaluation-replan-epoch-000500.json`) for an earlier
+/// checkpoint, as the evaluation names it.
+fn saved_evaluation(run: &Path, agent: &Agent, protocol: &Protocol) -> Result<PathBuf> {
     let (_, named) = seads_study::evaluation::checkpoint_of(run, &agent.checkpoint)
         .map_err(crate::study_error)?;
-    Ok(run.join(kind.results_file(&STANDARD_DEPTHS, named)))
+    Ok(run.join(protocol.results_file(named)))
 }
 
-/// The run's evaluations of the agent's checkpoint with and without re-planning: the saved ones
-/// where they name that checkpoint ([`saved_evaluation`]: `evaluation-replan.json` and
-/// `evaluation-plan-once.json` for the latest checkpoint, `-epoch-NNNNNN` ones for an earlier
-/// one), otherwise evaluated now (an evaluation of another checkpoint, or one that does not say
-/// which it evaluated, is never shown for this one).
+/// Whether a saved evaluation is the one a figure of the agent's checkpoint under `protocol`
+/// shows: of that checkpoint, and under exactly that protocol (one made with other boards or
+/// limits, or one that does not say, never stands in for it).
+fn shows(record: &EvaluationRecord, agent: &Agent, protocol: &Protocol) -> bool {
+    record.checkpoint.is_some_and(|c| c.epoch == agent.epoch) && record.made_with(protocol)
+}
+
+/// A figure's title with the evaluation's protocol where it is not the standard one.
+fn with_protocol(title: &str, protocol: &Protocol) -> String {
+    if protocol.departures().is_empty() {
+        title.to_owned()
+    } else {
+        format!("{title}; {}", protocol.label())
+    }
+}
+
+/// The run's evaluations of the agent's checkpoint with and without re-planning, each with
+/// `boards` boards per depth under `limits`: the saved ones where they are of that checkpoint and
+/// that protocol ([`saved_evaluation`], [`shows`]), otherwise evaluated now.
 fn evaluations(
     agent: &mut Agent,
     run: &Path,
@@ -224,14 +248,14 @@ fn evaluations(
     quiet: bool,
 ) -> Result<[(bool, Vec<DepthResult>); 2]> {
     let mut load = |replan: bool| -> Result<Vec<DepthResult>> {
-        let file = saved_evaluation(run, agent, EvaluationKind::planning(replan))?;
+        let protocol = Protocol::planning(replan, boards, limits);
+        let file = saved_evaluation(run, agent, &protocol)?;
         let saved = read_evaluation(&file).map_err(crate::study_error)?;
         if let Some(record) = saved
-            && record.checkpoint.is_some_and(|c| c.epoch == agent.epoch)
+            && shows(&record, agent, &protocol)
         {
             return Ok(record.results);
         }
-        let protocol = Protocol::planning(replan, boards, limits);
         Ok(run_evaluation(agent, run, &protocol, quiet)?.results)
     };
     Ok([(true, load(true)?), (false, load(false)?)])

@@ -36,6 +36,27 @@ pub struct ReportArgs {
 pub fn report(args: ReportArgs) -> Result<()> {
     let inputs: Vec<&std::path::Path> = args.inputs.iter().map(PathBuf::as_path).collect();
     crate::paths::refuse_overwriting_input(&args.out, &inputs)?;
+    // A repository the user names must be one: a report would otherwise say "not checked" for
+    // every commit, as if no repository had been asked for.
+    if let Some(repository) = &args.repository {
+        match seads_study::report::is_repository(repository) {
+            Some(true) => {}
+            Some(false) => {
+                return Err(crate::bad_input(anyhow::anyhow!(
+                    "--repository {} is not a git repository",
+                    repository.display()
+                ))
+                .into());
+            }
+            None => {
+                return Err(crate::bad_input(anyhow::anyhow!(
+                    "--repository {}: git could not be run to look up commits",
+                    repository.display()
+                ))
+                .into());
+            }
+        }
+    }
     let options = ReportOptions {
         inputs: args.inputs.clone(),
         reference: args.reference.clone(),

@@ -577,6 +577,8 @@ fn evaluate(
         .finished_before(run, &checkpoint)
         .map_err(crate::study_error)?;
     let tasks = 5 * boards as u64;
+    crate::plan::warn_damaged_journal(run, before.damaged);
+    let before = before.finished;
     if before > 0 {
         eprintln!(
             "resuming a robot evaluation: {before} of {tasks} tasks finished before{}",

@@ -31,7 +31,7 @@ enum BoardSource {
 /// let config = EnvConfig { max_solution_depth: 3, random_solution_depth: false, ..EnvConfig::default() };
 /// let mut board = BoardState::new(GameKind::named("lightsout")?, 5, &config)?;
 /// board.seed(7);
-/// board.reset();
+/// board.reset()?;
 /// // An environment seeded alike starts from the same board.
 /// let mut env = make_env("lightsout-cursor", &config)?;
 /// env.seed(7);
@@ -125,8 +125,10 @@ impl BoardState {
         &mut self.rng
     }
 
-    /// Draws a new board from the reset distribution.
-    pub fn reset(&mut self) {
+    /// Draws a new board from the reset distribution. A game that draws its deep boards by a
+    /// bounded search (the 15-puzzle) may find none of the depth asked for: an error that says
+    /// so, and the board stays as it was.
+    pub fn reset(&mut self) -> Result<(), EnvError> {
         let depth = if self.random_depth {
             loop {
                 let depth = self.rng.random_range(1..=self.max_depth);
@@ -137,15 +139,20 @@ impl BoardState {
         } else {
             self.max_depth
         };
-        self.board = match &self.source {
-            BoardSource::Dataset(data) => data
-                .sample(depth, self.split, &mut self.rng)
-                .expect("checked in new()"),
-            BoardSource::Sampled => self
-                .game
-                .sample_at_depth(depth, self.split, &mut self.rng)
-                .expect("checked in new()"),
+        let drawn = match &self.source {
+            BoardSource::Dataset(data) => data.sample(depth, self.split, &mut self.rng),
+            BoardSource::Sampled => self.game.sample_at_depth(depth, self.split, &mut self.rng),
         };
+        let game = self.game.kind();
+        let size = self.game.size();
+        self.board = drawn.ok_or_else(|| {
+            EnvError::InvalidConfig(format!(
+                "no {game} {size}×{size} board of solution depth {depth} in the {} split was \
+                 found within the sampler's bound: choose a smaller max_solution_depth",
+                self.split
+            ))
+        })?;
+        Ok(())
     }
 
     /// Puts the board into `board` (for evaluation and replay).
@@ -236,7 +243,7 @@ mod tests {
         assert!(refused.to_string().contains("depth 49"), "{refused}");
         let mut board = BoardState::new(lightsout(), 7, &config(has)).unwrap();
         board.seed(3);
-        board.reset();
+        board.reset().unwrap();
         assert_eq!(board.board(), all);
     }
 }

@@ -164,7 +164,7 @@ impl<M: Manipulator> Embodied<M> {
         board: BoardState,
         layout: Layout,
         step_limit: Option<usize>,
-    ) -> Self {
+    ) -> Result<Self, EnvError> {
         let game = board.game();
         let (action_low, action_high) = manipulator.action_bounds();
         let (state_low, state_high) = manipulator.state_bounds();
@@ -193,15 +193,16 @@ impl<M: Manipulator> Embodied<M> {
             steps: 0,
         };
         env.seed(0);
-        env.draw_initial_state();
-        env
+        env.draw_initial_state()?;
+        Ok(env)
     }
 
     /// A new board and manipulator state from the random streams, and a fresh step counter.
-    fn draw_initial_state(&mut self) {
-        self.board.reset();
+    fn draw_initial_state(&mut self) -> Result<(), EnvError> {
+        self.board.reset()?;
         self.manipulator.reset(&mut self.rng);
         self.steps = 0;
+        Ok(())
     }
 
     /// The manipulator.
@@ -221,8 +222,7 @@ impl<M: Manipulator> Environment for Embodied<M> {
     }
 
     fn reset(&mut self) -> Result<(), EnvError> {
-        self.draw_initial_state();
-        Ok(())
+        self.draw_initial_state()
     }
 
     fn step(&mut self, action: &[f32]) -> Result<StepOutcome, EnvError> {

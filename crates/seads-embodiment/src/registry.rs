@@ -155,7 +155,7 @@ pub fn make_env(name: &str, config: &EnvConfig) -> Result<Box<dyn Environment>, 
     let layout = layout(entry, game.as_ref(), config)?;
     let board = BoardState::new(entry.game, game.size(), config)?;
     let name = entry.name.as_str();
-    Ok(match entry.embodiment {
+    match entry.embodiment {
         Embodiment::Cursor => {
             let NoOptions {} = config.manipulator_options(name)?;
             build(name, Cursor::default(), board, layout, config)
@@ -174,7 +174,7 @@ pub fn make_env(name: &str, config: &EnvConfig) -> Result<Box<dyn Environment>, 
             let substeps = options.physics_substeps.get();
             build(name, Jaco::new(jaco, substeps), board, layout, config)
         }
-    })
+    }
 }
 
 fn build<M: Manipulator>(
@@ -183,14 +183,14 @@ fn build<M: Manipulator>(
     board: BoardState,
     layout: Layout,
     config: &EnvConfig,
-) -> Box<dyn Environment> {
-    Box::new(Embodied::new(
+) -> Result<Box<dyn Environment>, EnvError> {
+    Ok(Box::new(Embodied::new(
         name,
         manipulator,
         board,
         layout,
         config.step_limit,
-    ))
+    )?))
 }
 
 /// The board layout an entry gets under `config`: fields tiling the board, or the pivots

@@ -143,6 +143,37 @@ pub enum GameError {
         /// Board size.
         size: usize,
     },
+    /// A solver that stopped at its bound of search nodes without a solution.
+    #[error(
+        "the {game} solver stopped after {nodes} search nodes without a solution (a board this \
+         far from the goal needs a larger bound)"
+    )]
+    SearchLimit {
+        /// Game name.
+        game: &'static str,
+        /// The nodes it expanded.
+        nodes: u64,
+    },
+    /// A solver stopped by another thread (Ctrl-C in Python).
+    #[error("the {game} solver was interrupted")]
+    Interrupted {
+        /// Game name.
+        game: &'static str,
+    },
+    /// A solution depth beyond the farthest board of the game.
+    #[error(
+        "depth {depth} is beyond every {game} board of size {size}: the farthest is {max} moves from the goal"
+    )]
+    DepthBeyondGame {
+        /// Game name.
+        game: &'static str,
+        /// Board size.
+        size: usize,
+        /// The depth asked for.
+        depth: usize,
+        /// The largest solution depth of any board.
+        max: usize,
+    },
     /// No registered game has this name.
     #[error("unknown game {name:?} (valid: {valid})")]
     UnknownGame {
@@ -152,6 +183,12 @@ pub enum GameError {
         valid: String,
     },
 }
+
+/// Search nodes a game's searching solver (the 15-puzzle's IDA*) may expand to solve one board
+/// by default ([`BoardGame::solve`]; [`BoardGame::solve_within`] sets another bound): tens of
+/// seconds, enough for 15-puzzle boards up to about 60 moves; the hardest take 80 moves and far
+/// more nodes.
+pub const SOLVE_NODES: u64 = 4_000_000_000;
 
 /// Where on the board a move is made.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -278,6 +315,19 @@ pub trait BoardGame: Send + Sync {
     /// goal.
     fn solve(&self, _board: SymbolicState) -> Option<Result<Vec<MoveId>, GameError>> {
         None
+    }
+
+    /// [`solve`](Self::solve), by a solver that searches (the 15-puzzle's IDA*) bounded by
+    /// `max_nodes` search nodes (past them, [`GameError::SearchLimit`]) and stopped by another
+    /// thread raising `stop` ([`GameError::Interrupted`]). A game whose solver does not search
+    /// solves as `solve` does.
+    fn solve_within(
+        &self,
+        board: SymbolicState,
+        _max_nodes: u64,
+        _stop: &std::sync::atomic::AtomicBool,
+    ) -> Option<Result<Vec<MoveId>, GameError>> {
+        self.solve(board)
     }
 
     /// The solution depth of `board` (the length of a shortest solution) by the game's own

@@ -73,10 +73,29 @@ pub struct SplitReport {
 }
 
 impl SplitReport {
-    /// The split of `game` at `size` up to `max_depth` (at least 1).
+    /// The split of `game` at `size` up to `max_depth` (at least 1), which must not lie beyond
+    /// the game's farthest board: the enumeration stops there, and the table is allocated only
+    /// once the depth is known to exist.
+    ///
+    /// ```
+    /// use seads_games::{GameError, GameKind, SplitReport};
+    /// let lightsout = GameKind::named("lightsout").unwrap();
+    /// assert_eq!(SplitReport::of(lightsout, 3, 9)?.train.len(), 9);
+    /// let beyond = SplitReport::of(lightsout, 3, usize::MAX).unwrap_err();
+    /// assert!(matches!(beyond, GameError::DepthBeyondGame { max: 9, .. }), "{beyond}");
+    /// # Ok::<(), GameError>(())
+    /// ```
     pub fn of(game: GameKind, size: usize, max_depth: usize) -> Result<Self, GameError> {
         let g = listed(game, size)?;
         let data = BoardDataset::build(g.enumerable().expect("checked by listed"), max_depth)?;
+        if max_depth > data.max_depth() {
+            return Err(GameError::DepthBeyondGame {
+                game: game.name(),
+                size,
+                depth: max_depth,
+                max: data.max_depth(),
+            });
+        }
         let count = |s| (1..=max_depth).map(|d| data.boards(d, s).len()).collect();
         Ok(Self {
             train: count(Split::Train),

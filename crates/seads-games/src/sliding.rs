@@ -3,6 +3,7 @@
 //! nothing. Unlike LightsOut's and TileSwap's, its moves thus depend on the state.
 
 use std::sync::OnceLock;
+use std::sync::atomic::{AtomicBool, Ordering};
 
 use rand::seq::SliceRandom;
 use rand::{RngExt, seq::IndexedRandom as _};
@@ -10,7 +11,7 @@ use rand::{RngExt, seq::IndexedRandom as _};
 use crate::perm::{FACTORIAL, is_one_hot_permutation, one_hot, rank, tiles_of, unrank};
 use crate::{
     BoardGame, DepthTable, Enumerable, FieldMark, GameEntry, GameError, GameKind, MAX_DRAWS,
-    MoveId, MoveSite, Split, SymbolicState, split_of,
+    MoveId, MoveSite, SOLVE_NODES, Split, SymbolicState, split_of,
 };
 
 /// The sliding puzzle in the registry.
@@ -24,6 +25,11 @@ pub(crate) static ENTRY: GameEntry = GameEntry {
 
 /// Largest board side: 16 cells of 16 tiles fill a 256-bit [`SymbolicState`].
 const MAX_CELLS: usize = 16;
+
+/// Search nodes the 15-puzzle's sampler may spend on drawing one board deeper than the listed
+/// depths: past them a reset says that no board of that depth was found, instead of drawing
+/// for minutes (the random walks rarely stay optimal past about 45 moves).
+pub const SAMPLE_NODES: u64 = 400_000_000;
 
 /// Depths up to which the 15-puzzle's boards of one depth are listed, to draw among them and to
 /// tell whether a split lacks them (depth 12 has 7,808 boards); deeper layers hold many boards in
@@ -225,7 +231,8 @@ impl BoardGame for SlidingPuzzle {
     }
     /// A board of exactly `depth` in `split`: drawn among the listed boards of that depth up to
     /// depth 12 (`LISTED_DEPTHS`); deeper, a random walk of `depth` slides that never undoes the
-    /// last one, kept when the solver finds it that deep and it lies in `split`.
+    /// last one, kept when the solver finds it that deep and it lies in `split`. The 15-puzzle's
+    /// solver is bounded by [`SAMPLE_NODES`] over all draws: `None` once they are spent.
     fn sample_at_depth(
         &self,
         depth: usize,
@@ -242,6 +249,8 @@ impl BoardGame for SlidingPuzzle {
                 .choose(rng)
                 .copied();
         }
+        let never = AtomicBool::new(false);
+        let mut budget = Budget::new(SAMPLE_NODES, &never);
         for _ in 0..MAX_DRAWS {
             let mut board = self.goal();
             let mut last_gap = usize::MAX;
@@ -254,9 +263,16 @@ impl BoardGame for SlidingPuzzle {
                 board = self.apply(board, mv);
                 last_gap = gap;
             }
-            if split_of(&self.values(board)) == split
-                && self.solution_depth(board).and_then(Result::ok) == Some(depth)
-            {
+            if split_of(&self.values(board)) != split {
+                continue;
+            }
+            let found = if self.n == 3 {
+                self.solution_depth(board).and_then(Result::ok)
+            } else {
+                // The budget left is spent over the draws; once it is gone, no board is found.
+                Some(ida_star(self.n, &self.tiles(board).0[..self.cells()], &mut budget)?.len())
+            };
+            if found == Some(depth) {
                 return Some(board);
             }
         }
@@ -276,8 +292,17 @@ impl BoardGame for SlidingPuzzle {
         Some(self.class(&a.0[..cells]) == self.class(&b.0[..cells]))
     }
     /// The 8-puzzle from its complete depth table, the 15-puzzle by IDA* with the Manhattan
-    /// distance (fast to a depth of about 40; the hardest boards take 80 moves and much longer).
+    /// distance (fast to a depth of about 40; the hardest boards take 80 moves and much longer),
+    /// within [`SOLVE_NODES`] search nodes.
     fn solve(&self, board: SymbolicState) -> Option<Result<Vec<MoveId>, GameError>> {
+        self.solve_within(board, SOLVE_NODES, &AtomicBool::new(false))
+    }
+    fn solve_within(
+        &self,
+        board: SymbolicState,
+        max_nodes: u64,
+        stop: &AtomicBool,
+    ) -> Option<Result<Vec<MoveId>, GameError>> {
         let unsolvable = GameError::Unsolvable { game: "sliding" };
         if !self.is_valid(board) || self.can_reach(board, self.goal()) != Some(true) {
             return Some(Err(unsolvable));
@@ -285,7 +310,17 @@ impl BoardGame for SlidingPuzzle {
         Some(if self.n == 3 {
             eight_puzzle_table().solve(self, board)
         } else {
-            Ok(ida_star(self.n, &self.tiles(board).0[..self.cells()]))
+            let mut budget = Budget::new(max_nodes, stop);
+            ida_star(self.n, &self.tiles(board).0[..self.cells()], &mut budget).ok_or(
+                if stop.load(Ordering::Relaxed) {
+                    GameError::Interrupted { game: "sliding" }
+                } else {
+                    GameError::SearchLimit {
+                        game: "sliding",
+                        nodes: max_nodes,
+                    }
+                },
+            )
         })
     }
     fn solution_depth(&self, board: SymbolicState) -> Option<Result<usize, GameError>> {
@@ -327,9 +362,44 @@ fn eight_puzzle_table() -> &'static DepthTable {
     })
 }
 
+/// What an IDA* search may still do: the nodes left to expand, and a flag another thread raises
+/// to stop it (looked at on the first node and every [`Budget::CHECK_EVERY`] nodes after it).
+struct Budget<'a> {
+    left: u64,
+    taken: u64,
+    stop: &'a AtomicBool,
+}
+
+impl<'a> Budget<'a> {
+    const CHECK_EVERY: u64 = 1 << 16;
+
+    fn new(nodes: u64, stop: &'a AtomicBool) -> Self {
+        Self {
+            left: nodes,
+            taken: 0,
+            stop,
+        }
+    }
+
+    /// Takes one node off the budget; `false` once none is left or the search was stopped.
+    fn take(&mut self) -> bool {
+        if self.left == 0 {
+            return false;
+        }
+        if self.taken.is_multiple_of(Self::CHECK_EVERY) && self.stop.load(Ordering::Relaxed) {
+            self.left = 0;
+            return false;
+        }
+        self.left -= 1;
+        self.taken += 1;
+        true
+    }
+}
+
 /// A shortest solution of a solvable board (`tiles` per cell) by iterative-deepening A* with
-/// the Manhattan distance of every tile from its goal cell, an admissible bound.
-fn ida_star(n: usize, tiles: &[u8]) -> Vec<MoveId> {
+/// the Manhattan distance of every tile from its goal cell, an admissible bound; `None` once
+/// `budget` is spent (each node it expands is taken off it) or stopped.
+fn ida_star(n: usize, tiles: &[u8], budget: &mut Budget<'_>) -> Option<Vec<MoveId>> {
     let cells = n * n;
     // Tile t's goal cell is t − 1; the gap's is the last.
     let home = |t: u8| if t == 0 { cells - 1 } else { t as usize - 1 };
@@ -355,17 +425,21 @@ fn ida_star(n: usize, tiles: &[u8]) -> Vec<MoveId> {
             bound,
             &mut path,
             &distance,
+            budget,
         ) {
-            Found::Yes => return path,
+            Found::Yes => return Some(path),
             Found::No(next) => bound = next,
+            Found::Spent => return None,
         }
     }
 }
 
-/// What one IDA* pass found: a solution, or the least cost past its bound.
+/// What one IDA* pass found: a solution, the least cost past its bound, or nothing before its
+/// node budget ran out.
 enum Found {
     Yes,
     No(usize),
+    Spent,
 }
 
 /// One depth-first pass of IDA* under `bound`: `path` holds the pushes made so far, `from` the
@@ -380,7 +454,11 @@ fn search(
     bound: usize,
     path: &mut Vec<MoveId>,
     distance: &dyn Fn(u8, usize) -> usize,
+    budget: &mut Budget<'_>,
 ) -> Found {
+    if !budget.take() {
+        return Found::Spent;
+    }
     let f = path.len() + h;
     if f > bound {
         return Found::No(f);
@@ -402,9 +480,10 @@ fn search(
         tiles[gap] = tile;
         tiles[p] = 0;
         path.push(p);
-        match search(n, tiles, p, gap, h_after, bound, path, distance) {
+        match search(n, tiles, p, gap, h_after, bound, path, distance, budget) {
             Found::Yes => return Found::Yes,
             Found::No(t) => least = least.min(t),
+            Found::Spent => return Found::Spent,
         }
         path.pop();
         tiles[p] = tile;
@@ -484,7 +563,8 @@ mod tests {
             for &index in e.layer(d).iter().step_by(e.layer(d).len().div_ceil(6)) {
                 let board = g.board_at(index);
                 let tiles = g.values(board);
-                let moves = ida_star(3, &tiles);
+                let never = AtomicBool::new(false);
+                let moves = ida_star(3, &tiles, &mut Budget::new(u64::MAX, &never)).unwrap();
                 assert_eq!(moves.len(), d, "board {}", g.format(board));
                 assert!(g.is_goal(g.apply_all(board, &moves)));
             }
@@ -512,6 +592,28 @@ mod tests {
         let moves = g.solve(board).unwrap().unwrap();
         assert!(g.is_goal(g.apply_all(board, &moves)));
         assert!(moves.len() <= 60);
+        // Within a bound of search nodes (issue 82: a deep board was searched for without an
+        // end): a bound too small for the board is said, one large enough solves it alike.
+        // A board of depth 12 takes at least 13 nodes: 12 are too few.
+        let board = g.layer(12)[0];
+        let moves = g.solve(board).unwrap().unwrap();
+        let go = AtomicBool::new(false);
+        let stopped = g.solve_within(board, 12, &go).unwrap().unwrap_err();
+        assert!(
+            matches!(stopped, GameError::SearchLimit { nodes: 12, .. }),
+            "{stopped}"
+        );
+        assert_eq!(
+            g.solve_within(board, u64::MAX, &go).unwrap().unwrap(),
+            moves
+        );
+        // A raised flag stops the search at its next look (another thread raises it: Ctrl-C).
+        let stop = AtomicBool::new(true);
+        let interrupted = g.solve_within(board, u64::MAX, &stop).unwrap().unwrap_err();
+        assert!(
+            matches!(interrupted, GameError::Interrupted { .. }),
+            "{interrupted}"
+        );
     }
 
     /// Boards drawn at a depth have exactly that depth and lie in the split, past the listed
@@ -531,6 +633,10 @@ mod tests {
                 assert_eq!(g.solution_depth(board).unwrap().unwrap(), depth);
             }
         }
+        // A depth whose boards the random walks do not reach within the sampler's bound of
+        // search nodes: no board, found out in bounded time (issue 82: depth 55 drew for 102 s,
+        // then a reset panicked).
+        assert!(g.sample_at_depth(200, Split::Test, &mut rng).is_none());
         // Depth 1 has two boards (the gap left or up); at most both splits hold them.
         let listed: usize = [Split::Train, Split::Test]
             .iter()

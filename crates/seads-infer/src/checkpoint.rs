@@ -3,7 +3,7 @@
 use std::path::{Path, PathBuf};
 
 use ndarray::{Array1, Array2};
-use safetensors::{Dtype, SafeTensors};
+use seads_weights::Weights;
 
 use crate::InferError;
 use crate::mlp::{Dense, Mlp};
@@ -45,64 +45,35 @@ pub fn checkpoint_dir(run: &Path, epoch: Option<u64>) -> Result<PathBuf, InferEr
         .ok_or_else(|| InferError::Missing(format!("{}: no checkpoint", run.display())))
 }
 
-/// The float32 tensors of one safetensors file, by name.
+/// The float32 tensors of one safetensors file, by name, read and checked by
+/// [`seads_weights::Weights`], the reader the binary loads its networks through too.
 pub struct Tensors {
-    path: PathBuf,
-    bytes: Vec<u8>,
+    weights: Weights,
 }
 
 impl Tensors {
     /// Reads `path`.
     pub fn read(path: &Path) -> Result<Self, InferError> {
-        let bytes = std::fs::read(path).map_err(|e| InferError::Io {
-            what: format!("reading {}", path.display()),
-            source: e,
-        })?;
-        SafeTensors::deserialize(&bytes).map_err(|e| InferError::Damaged {
-            path: path.display().to_string(),
-            reason: format!("{e:?}"),
-        })?;
         Ok(Self {
-            path: path.to_owned(),
-            bytes,
+            weights: Weights::read(path)?,
         })
     }
 
     fn damaged(&self, reason: String) -> InferError {
         InferError::Damaged {
-            path: self.path.display().to_string(),
+            path: self.weights.path().display().to_string(),
             reason,
         }
     }
 
     /// Whether a tensor called `name` is there.
     pub fn has(&self, name: &str) -> bool {
-        SafeTensors::deserialize(&self.bytes).is_ok_and(|t| t.tensor(name).is_ok())
+        self.weights.has(name)
     }
 
-    /// The float32 tensor `name` as a flat vector and its shape.
+    /// The float32 tensor `name` as a flat vector and its shape (finite values only).
     pub fn get(&self, name: &str) -> Result<(Vec<f32>, Vec<usize>), InferError> {
-        let tensors =
-            SafeTensors::deserialize(&self.bytes).map_err(|e| self.damaged(format!("{e:?}")))?;
-        let view = tensors
-            .tensor(name)
-            .map_err(|_| self.damaged(format!("no tensor {name}")))?;
-        if view.dtype() != Dtype::F32 {
-            return Err(self.damaged(format!("{name} is {:?}, not F32", view.dtype())));
-        }
-        let values: Vec<f32> = view
-            .data()
-            .chunks_exact(4)
-            .map(|b| f32::from_le_bytes([b[0], b[1], b[2], b[3]]))
-            .collect();
-        let shape = view.shape().to_vec();
-        if values.len() != shape.iter().product::<usize>() {
-            return Err(self.damaged(format!("{name}: {} values for {shape:?}", values.len())));
-        }
-        if let Some(bad) = values.iter().find(|v| !v.is_finite()) {
-            return Err(self.damaged(format!("{name} holds {bad}")));
-        }
-        Ok((values, shape))
+        Ok(self.weights.get(name)?)
     }
 
     /// The linear layer `{prefix}.weight`, `{prefix}.bias`.

@@ -81,6 +81,24 @@ pub enum InferError {
     },
 }
 
+impl From<seads_weights::WeightsError> for InferError {
+    /// A weights file that cannot be read, or is damaged, as the agent's error of that kind.
+    fn from(e: seads_weights::WeightsError) -> Self {
+        match e {
+            seads_weights::WeightsError::Io { path, source } => InferError::Io {
+                what: format!("reading {path}"),
+                source,
+            },
+            seads_weights::WeightsError::Damaged { path, reason } => {
+                InferError::Damaged { path, reason }
+            }
+        }
+    }
+}
+
+/// The settings file a robot run keeps beside its config (`seads_uarm::RobotSettings::FILE`).
+const ROBOT_SETTINGS: &str = "robot.toml";
+
 /// The file of the forward model in a checkpoint.
 pub const MODEL_FILE: &str = "forward_model.safetensors";
 /// The file of the actor in a checkpoint.
@@ -95,6 +113,11 @@ pub struct Agent {
     pub model: ForwardModel,
     /// The environment it was trained on.
     pub env: String,
+    /// That environment's options as the run set them (`[env_config]`: board size, spacing,
+    /// the manipulator's options, …).
+    pub env_config: EnvConfig,
+    /// That environment's dimensions, as the agent was loaded for.
+    pub spec: EnvSpec,
     /// The checkpoint's epoch.
     pub epoch: u64,
 }
@@ -111,15 +134,24 @@ struct SavedConfig {
 
 impl Agent {
     /// The agent of the run in `run` at the checkpoint of `epoch`, or the latest; its
-    /// environment from the registry (the Cursor and Reacher environments; a Jaco or robot run
-    /// needs [`Agent::load_for`] with its environment's spec).
+    /// environment from the registry with the run's own options (`[env_config]`: a 7×7 run's
+    /// agent plays 7×7 boards), so the Cursor, Reacher and Jaco environments; a robot run needs
+    /// [`Agent::load_for`] with its environment's spec.
     pub fn load(run: &Path, epoch: Option<u64>) -> Result<Self, InferError> {
         let dir = checkpoint_dir(run, epoch)?;
         let config = saved_config(&dir)?;
         let env =
             make_env(&config.env, &config.env_config).map_err(|e| InferError::Environment {
                 env: config.env.clone(),
-                reason: e.to_string(),
+                // A robot run (its settings file beside its config) acts on the arm or its
+                // twin, which the registry does not build (`seads uarm evaluate` does).
+                reason: if run.join(ROBOT_SETTINGS).is_file() {
+                    "a robot run: its skills act on the uArm or its twin, which `seads uarm \
+                     evaluate` builds; Python has no robot environment"
+                        .to_owned()
+                } else {
+                    e.to_string()
+                },
             })?;
         Self::load_for(run, epoch, env.spec())
     }
@@ -176,6 +208,8 @@ impl Agent {
             policy,
             model,
             env: config.env,
+            env_config: config.env_config,
+            spec: spec.clone(),
             epoch,
         })
     }
@@ -206,4 +240,29 @@ fn saved_config(dir: &Path) -> Result<SavedConfig, InferError> {
             path: path.display().to_string(),
             reason: e.message().to_owned(),
         })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A robot run's agent is named as such (issue 82: "unknown environment
+    /// uarm-lightsout-absolute"); a run of an environment that is not there keeps the
+    /// registry's word.
+    #[test]
+    fn a_robot_run_is_named_as_such() {
+        let dir = tempfile::tempdir().unwrap();
+        let checkpoint = dir.path().join("checkpoints/epoch-000001");
+        std::fs::create_dir_all(&checkpoint).unwrap();
+        std::fs::write(
+            checkpoint.join("config.toml"),
+            "env = \"uarm-lightsout-absolute\"\n",
+        )
+        .unwrap();
+        let unknown = Agent::load(dir.path(), None).unwrap_err().to_string();
+        assert!(unknown.contains("unknown environment"), "{unknown}");
+        std::fs::write(dir.path().join("robot.toml"), "").unwrap();
+        let robot = Agent::load(dir.path(), None).unwrap_err().to_string();
+        assert!(robot.contains("a robot run"), "{robot}");
+    }
 }

@@ -142,6 +142,15 @@ impl Policy {
                 );
             }
         }
+        // Finite observations can still carry a layer past float32's range (±3e38): an action
+        // that is not a number is never handed out as one.
+        if out.iter().any(|v| !v.is_finite()) {
+            return Err(InferError::Input(
+                "these observations drive the policy's layers beyond float32's range: no finite \
+                 action"
+                    .into(),
+            ));
+        }
         Ok(out)
     }
 }

@@ -9,6 +9,7 @@ pub mod process;
 mod stacked;
 
 pub use device::{ComputeDevice, DeviceError};
+pub use seads_weights::WeightsError;
 pub use stacked::{StackedAdam, StackedLinear, StackedMlp, StackedParameters, upload};
 
 use rand::{Rng, RngExt};
@@ -133,6 +134,40 @@ impl Module for Mlp {
     fn forward(&self, x: &Tensor) -> Tensor {
         self.head().forward(&self.features(x))
     }
+}
+
+/// Loads the network weights of the safetensors file `path` (written by `VarStore::save`) into
+/// `vs`, through [`seads_weights::Weights`], the one reader of checkpoints (the Python package's
+/// agent reads them with it too): the file must hold exactly the variables of `vs`, each of
+/// exactly its shape, float32 and finite; otherwise nothing is written and the error says why.
+/// tch's own `VarStore::load` would take a `[1, 32]` weight for `[32, 32]` (the copy
+/// broadcasts) or a float64 one (the variable changes its type, and the first product fails).
+/// The values are copied into the variables in place, so views of them (the flat buffer of
+/// [`flatten_parameters`]) see the loaded values.
+pub fn load_var_store(
+    vs: &mut nn::VarStore,
+    path: &std::path::Path,
+) -> Result<(), seads_weights::WeightsError> {
+    let weights = seads_weights::Weights::read(path)?;
+    let variables = vs.variables();
+    weights.exactly(variables.keys().map(String::as_str))?;
+    let mut checked = Vec::with_capacity(variables.len());
+    for (name, variable) in variables {
+        let size = variable.size();
+        let shape: Vec<usize> = size.iter().map(|&d| d as usize).collect();
+        let values = weights.tensor(&name, &shape)?;
+        checked.push((variable, values, size));
+    }
+    // Every tensor is checked before any is written: a refused file leaves the network as it was.
+    tch::no_grad(|| {
+        for (mut variable, values, size) in checked {
+            let source = Tensor::from_slice(&values)
+                .reshape(size.as_slice())
+                .to_device(variable.device());
+            variable.copy_(&source);
+        }
+    });
+    Ok(())
 }
 
 /// Moves every trainable variable of `vs` into one flat buffer, in name order, and returns it:

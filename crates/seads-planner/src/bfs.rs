@@ -1,6 +1,8 @@
 //! Breadth-first search over skill sequences on bit-packed symbolic states (SPEC §4.2).
 
 use std::hash::Hash;
+use std::sync::Arc;
+use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::{Duration, Instant};
 
 use rayon::prelude::*;
@@ -45,6 +47,15 @@ impl std::str::FromStr for PlanChoice {
 }
 
 impl PlanChoice {
+    /// The name records and the command line use.
+    pub fn name(self) -> &'static str {
+        match self {
+            Self::MostLikely => "most-likely",
+            Self::FirstFound => "first-found",
+            Self::MostLikelyWary => "most-likely-wary",
+        }
+    }
+
     /// The choice that evaluation records without one were made with.
     pub fn paper() -> Self {
         Self::FirstFound
@@ -77,9 +88,54 @@ impl std::str::FromStr for Search {
 }
 
 impl Search {
+    /// The name records and the command line use.
+    pub fn name(self) -> &'static str {
+        match self {
+            Self::Breadth => "breadth",
+            Self::BothEnds => "both-ends",
+        }
+    }
+
     /// Whether this is the default, breadth-first search (records leave it out).
     pub fn is_breadth(&self) -> bool {
         *self == Self::Breadth
+    }
+}
+
+/// A flag that another thread raises to stop searches early (Ctrl-C in Python, whose signal
+/// handlers run on the thread that waits for the search): a search that sees it raised ends with
+/// [`PlanError::Interrupted`]. It is no part of a configuration's value: configurations that
+/// differ only in it are equal, and it is never written.
+#[derive(Debug, Clone, Default)]
+pub struct Interrupt(Arc<AtomicBool>);
+
+impl Interrupt {
+    /// A flag not raised.
+    pub fn new() -> Self {
+        Self::default()
+    }
+
+    /// Raises the flag: every search that holds it stops at its next check.
+    pub fn raise(&self) {
+        self.0.store(true, Ordering::Relaxed);
+    }
+
+    /// Whether the flag was raised.
+    pub fn is_raised(&self) -> bool {
+        self.0.load(Ordering::Relaxed)
+    }
+
+    /// The flag itself, for a search outside this crate that checks one (the 15-puzzle's
+    /// solver).
+    pub fn flag(&self) -> &AtomicBool {
+        &self.0
+    }
+}
+
+impl PartialEq for Interrupt {
+    /// Always: a stop handle is not part of what a configuration says.
+    fn eq(&self, _: &Self) -> bool {
+        true
     }
 }
 
@@ -105,6 +161,9 @@ pub struct PlannerConfig {
     /// How to search ([`find_plan`](crate::find_plan); [`bfs_plan`] is breadth-first whatever
     /// this says).
     pub search: Search,
+    /// Raised by another thread to stop the search (never written).
+    #[serde(skip)]
+    pub interrupt: Interrupt,
 }
 
 impl PlannerConfig {
@@ -128,6 +187,7 @@ impl Default for PlannerConfig {
             batch_size: 1024,
             plan: PlanChoice::MostLikely,
             search: Search::Breadth,
+            interrupt: Interrupt::default(),
         }
     }
 }
@@ -183,6 +243,9 @@ pub enum PlanError {
         /// States expanded.
         expanded: usize,
     },
+    /// Another thread raised the search's [`Interrupt`].
+    #[error("planning was interrupted")]
+    Interrupted,
 }
 
 /// A symbolic state packed into a hash key as small as the state allows.
@@ -454,6 +517,9 @@ fn search<K: Key>(
                     return Err(PlanError::Timeout {
                         seconds: began.elapsed().as_secs_f64(),
                     });
+                }
+                if config.interrupt.is_raised() {
+                    return Err(PlanError::Interrupted);
                 }
             }
         }

@@ -411,17 +411,19 @@ mod tests {
             action_noise: Some(0.05),
             ..record.protocol.clone().unwrap()
         };
+        // Named by how the protocol departs from the standard one (no state bound, a clock,
+        // the first plan found), then the noise and the checkpoint.
         assert_eq!(
             record.protocol.as_ref().unwrap().results_file(Some(7)),
-            "evaluation-replan-epoch-000007.json"
+            "evaluation-replan-unbounded-timeout-10s-first-found-epoch-000007.json"
         );
         assert_eq!(
             noisy.results_file(Some(7)),
-            "evaluation-replan-noise-0.05-epoch-000007.json"
+            "evaluation-replan-unbounded-timeout-10s-first-found-noise-0.05-epoch-000007.json"
         );
         assert_eq!(
             noisy.tasks_file(None),
-            "evaluation-replan-noise-0.05-tasks.jsonl"
+            "evaluation-replan-unbounded-timeout-10s-first-found-noise-0.05-tasks.jsonl"
         );
         assert!(!record.made_with(&noisy));
         let back = EvaluationRecord::from_json(&record.to_json()).unwrap();

@@ -34,7 +34,7 @@ mod meet;
 mod memo;
 mod protocol;
 
-pub use bfs::{Plan, PlanChoice, PlanError, PlannerConfig, Search, bfs_plan};
+pub use bfs::{Interrupt, Plan, PlanChoice, PlanError, PlannerConfig, Search, bfs_plan};
 pub use evaluate::{
     CheckpointId, DepthResult, Evaluation, EvaluationRecord, EvaluationSummary, Evaluator,
     TaskRecord, TaskSummary, evaluate, evaluate_resuming, summarise,
@@ -43,8 +43,8 @@ pub use execute::{Deviation, SolveConfig, SolveOutcome, solve};
 pub use meet::meet_plan;
 pub use memo::Memo;
 pub use protocol::{
-    DEFAULT_MAX_EXPANDED, EVALUATION_SEEDS, EvaluationKind, Protocol, STANDARD_DEPTHS,
-    SearchLimits, TASK_STREAM_SEED, TaskSet,
+    DEFAULT_MAX_EXPANDED, EVALUATION_SEEDS, EvaluationKind, Protocol, STANDARD_BOARDS,
+    STANDARD_DEPTHS, SearchLimits, TASK_STREAM_SEED, TaskSet,
 };
 
 /// A plan from `start` to `goal` by the search `config.search` names.

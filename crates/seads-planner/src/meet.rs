@@ -137,6 +137,9 @@ impl Limits<'_> {
                 seconds: self.began.elapsed().as_secs_f64(),
             });
         }
+        if self.config.interrupt.is_raised() {
+            return Err(PlanError::Interrupted);
+        }
         Ok(())
     }
 }

@@ -43,6 +43,9 @@ pub const TASK_STREAM_SEED: u64 = 4343;
 /// The paper's solution depths.
 pub const STANDARD_DEPTHS: [usize; 5] = [1, 2, 3, 4, 5];
 
+/// Boards per solution depth of the standard protocol: the authors' 20 seeds.
+pub const STANDARD_BOARDS: usize = EVALUATION_SEEDS.len();
+
 /// The tasks of an evaluation: `boards` boards of each solution depth from `split`.
 #[derive(Debug, Clone, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -122,7 +125,7 @@ impl TaskSet {
         };
         let mut board = BoardState::new(game, size, &config)?;
         board.seed(seed);
-        board.reset();
+        board.reset()?;
         Ok(board.board())
     }
 
@@ -293,11 +296,73 @@ impl Protocol {
         }
     }
 
-    /// The stem of this evaluation's files: the kind's ([`EvaluationKind::stem`]), with
-    /// `-noise-0.05` for an evaluation under action noise, so that it never takes the name of
-    /// the one without.
+    /// How this protocol departs from the standard one: [`STANDARD_BOARDS`] test boards per
+    /// depth with the authors' seeds and, for planning, searches under
+    /// [`SearchLimits::default`] (2²² expanded states, no clock, the most likely plan,
+    /// breadth-first, the planner's memory). One item per departure, as the files' names
+    /// write it: `boards-2`, `train-boards`, `task-seed-7`, `expanded-1000` (or `unbounded`),
+    /// `timeout-0.5s`, `first-found`, `both-ends`, `memory-16384mib`. Empty for the standard
+    /// protocol.
+    pub fn departures(&self) -> Vec<String> {
+        let mut items = Vec::new();
+        let tasks = &self.tasks;
+        if tasks.boards != STANDARD_BOARDS {
+            items.push(format!("boards-{}", tasks.boards));
+        }
+        if tasks.split != Split::Test {
+            items.push("train-boards".to_owned());
+        }
+        if let Some(seed) = tasks.seed {
+            items.push(format!("task-seed-{seed}"));
+        }
+        if let Some(limits) = &self.limits {
+            let standard = SearchLimits::default();
+            if limits.max_expanded != standard.max_expanded {
+                items.push(match limits.max_expanded {
+                    Some(states) => format!("expanded-{states}"),
+                    None => "unbounded".to_owned(),
+                });
+            }
+            if let Some(seconds) = limits.timeout_s {
+                items.push(format!("timeout-{seconds}s"));
+            }
+            if limits.plan != standard.plan {
+                items.push(limits.plan.name().to_owned());
+            }
+            if limits.search != standard.search {
+                items.push(limits.search.name().to_owned());
+            }
+            if let Some(mib) = limits.memory_limit_mib {
+                items.push(format!("memory-{mib}mib"));
+            }
+        }
+        items
+    }
+
+    /// The protocol in a few words for tables and figures: `standard`, or its
+    /// [departures](Self::departures) (`boards-2, expanded-1`).
+    pub fn label(&self) -> String {
+        let items = self.departures();
+        if items.is_empty() {
+            "standard".to_owned()
+        } else {
+            items.join(", ")
+        }
+    }
+
+    /// The stem of this evaluation's files: the kind's ([`EvaluationKind::stem`]), then how the
+    /// protocol departs from the standard one (`-boards-2-expanded-1`: [`departures`]), then
+    /// `-noise-0.05` for an evaluation under action noise. Every part of the protocol is in the
+    /// name, so an evaluation under other boards, limits or noise never takes the file of
+    /// another; the standard protocol keeps the plain names that plots and reports read first.
+    ///
+    /// [`departures`]: Self::departures
     pub fn stem(&self, epoch: Option<u64>) -> String {
         let mut stem = self.kind.stem(&self.tasks.depths, None);
+        for item in self.departures() {
+            stem.push('-');
+            stem += &item;
+        }
         if let Some(std) = self.action_noise {
             stem += &format!("-noise-{std}");
         }
@@ -394,6 +459,80 @@ mod tests {
             replan.tasks_file(&STANDARD_DEPTHS, None),
             "evaluation-replan-tasks.jsonl"
         );
+    }
+
+    /// Every part of a protocol that departs from the standard one is in its files' names, in
+    /// one order, so that an evaluation under other boards or limits never takes the standard
+    /// one's file (issue 82: `--max-expanded 1 --timeout 0.5` overwrote
+    /// `evaluation-replan-depths-1-3.json`); the standard protocol keeps the plain names.
+    #[test]
+    fn files_name_every_departure_from_the_standard_protocol() {
+        let standard = Protocol::planning(true, STANDARD_BOARDS, SearchLimits::default());
+        assert_eq!(standard.results_file(None), "evaluation-replan.json");
+        assert!(standard.departures().is_empty());
+        assert_eq!(standard.label(), "standard");
+        let limits = SearchLimits {
+            max_expanded: Some(1),
+            timeout_s: Some(0.5),
+            ..SearchLimits::default()
+        };
+        let mut other = Protocol::planning(true, 5, limits);
+        other.tasks.depths = vec![1, 2, 3];
+        assert_eq!(
+            other.results_file(None),
+            "evaluation-replan-depths-1-3-boards-5-expanded-1-timeout-0.5s.json"
+        );
+        assert_eq!(other.label(), "boards-5, expanded-1, timeout-0.5s");
+        let deep = Protocol::planning(
+            false,
+            STANDARD_BOARDS,
+            SearchLimits {
+                max_expanded: None,
+                plan: PlanChoice::FirstFound,
+                search: Search::BothEnds,
+                memory_limit_mib: Some(16384),
+                ..SearchLimits::default()
+            },
+        );
+        assert_eq!(
+            deep.tasks_file(Some(7)),
+            "evaluation-plan-once-unbounded-first-found-both-ends-memory-16384mib-epoch-000007-tasks.jsonl"
+        );
+        let mut seeded = Protocol {
+            action_noise: Some(0.05),
+            ..Protocol::planning(true, STANDARD_BOARDS, SearchLimits::default())
+        };
+        seeded.tasks.seed = Some(7);
+        seeded.tasks.split = Split::Train;
+        assert_eq!(
+            seeded.stem(None),
+            "evaluation-replan-train-boards-task-seed-7-noise-0.05"
+        );
+        // A policy acting alone has no search limits: only its tasks can depart.
+        let policy = Protocol {
+            kind: EvaluationKind::Policy,
+            tasks: TaskSet::standard(STANDARD_BOARDS),
+            limits: None,
+            action_noise: None,
+        };
+        assert_eq!(policy.results_file(None), "evaluation-policy.json");
+        // Two protocols that differ anywhere have different files.
+        let mut names = std::collections::BTreeSet::new();
+        for boards in [1, 20] {
+            for max_expanded in [None, Some(1), Some(DEFAULT_MAX_EXPANDED)] {
+                for timeout_s in [None, Some(0.5)] {
+                    for plan in [PlanChoice::MostLikely, PlanChoice::FirstFound] {
+                        let limits = SearchLimits {
+                            max_expanded,
+                            timeout_s,
+                            plan,
+                            ..SearchLimits::default()
+                        };
+                        assert!(names.insert(Protocol::planning(true, boards, limits).stem(None)));
+                    }
+                }
+            }
+        }
     }
 
     /// Records name a search from both ends and a memory bound, and those from before either

@@ -111,6 +111,25 @@ fn limits_end_the_search_with_a_reason() {
         bfs_plan(&mut GameSuccessor::new(lo), deep, lo.goal(), &hasty),
         Err(PlanError::Timeout { .. })
     ));
+    // A raised interrupt (another thread's: Ctrl-C in Python) stops searches of both kinds;
+    // it is no part of the configuration's value.
+    let interrupted = PlannerConfig::default();
+    assert_eq!(interrupted, PlannerConfig::default());
+    interrupted.interrupt.raise();
+    for search in [
+        seads_planner::Search::Breadth,
+        seads_planner::Search::BothEnds,
+    ] {
+        let config = PlannerConfig {
+            search,
+            ..interrupted.clone()
+        };
+        assert_eq!(
+            seads_planner::find_plan(&mut GameSuccessor::new(lo), deep, lo.goal(), &config),
+            Err(PlanError::Interrupted),
+            "{search:?}"
+        );
+    }
 }
 
 #[test]

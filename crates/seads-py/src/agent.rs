@@ -8,22 +8,36 @@ use pyo3::prelude::*;
 use pyo3::types::PyDict;
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
-use seads_embodiment::{
-    EnvConfig, Environment, Filmed, Push, SkillPolicy, execute_skill, make_env,
-};
+use seads_embodiment::{Environment, Filmed, Push, SkillPolicy, execute_skill};
+use std::sync::Mutex;
+
 use seads_games::{BoardGame, Successor, SymbolicState};
+use seads_infer::ForwardModel;
 use seads_planner::{PlanChoice, PlannerConfig, Search, SolveConfig, find_plan};
 
 use crate::env::Env;
 use crate::{Values, value_error};
 
-/// A trained agent: its skill policy and forward model.
+/// A trained agent: its skill policy and forward model. Every method borrows it shared, so
+/// Python threads may use one agent at once; the forward model, which plans, is taken by one
+/// search at a time, always with the GIL released (a thread waiting for it never holds the GIL
+/// that the thread holding it needs).
 #[pyclass(module = "seads._seads")]
 pub struct Agent {
+    /// The checkpoint (its forward model is the one in `model`).
     inner: seads_infer::Agent,
+    model: Mutex<ForwardModel>,
     game: Box<dyn BoardGame + Send + Sync>,
     obs_dim: usize,
     action_dim: usize,
+}
+
+/// The forward model, whichever thread used it last (a panic there leaves it whole: it is
+/// only read and its buffers rewritten).
+fn lock(model: &Mutex<ForwardModel>) -> std::sync::MutexGuard<'_, ForwardModel> {
+    model
+        .lock()
+        .unwrap_or_else(std::sync::PoisonError::into_inner)
 }
 
 /// The planner's settings from the Python arguments.
@@ -63,14 +77,44 @@ fn env_core<'py>(env: &Bound<'py, PyAny>) -> PyResult<Bound<'py, Env>> {
 impl Agent {
     /// The environment of `core` if it is in skill mode and of this agent's kind.
     fn own_env<'a>(&self, core: &'a mut Env) -> PyResult<&'a mut Box<dyn Environment>> {
+        let options = core.config().clone();
         let environment = core.skill_env().ok_or_else(|| {
             value_error("env: an environment in task mode; the agent needs skill mode")
         })?;
-        if environment.spec().name != self.inner.env {
+        // The whole world must be the run's: its name and dimensions (a 7×7 board is no 5×5
+        // one), and the options that shape it beyond them (spacing, the manipulator's).
+        let spec = environment.spec();
+        let trained = &self.inner;
+        let differs = if spec.name != trained.env {
+            Some(format!("a {} environment", spec.name))
+        } else if spec != &trained.spec {
+            Some(format!(
+                "{} with a {n}×{n} board of {} fields and {} observations",
+                spec.name,
+                spec.symbolic_len,
+                spec.obs_dim,
+                n = spec.board_size
+            ))
+        } else if options.spacing != trained.env_config.spacing
+            || options.manipulator != trained.env_config.manipulator
+        {
+            Some(format!(
+                "{} with spacing {:?} and manipulator options {:?}",
+                spec.name,
+                options.spacing,
+                serde_json::Value::Object(options.manipulator.clone()).to_string()
+            ))
+        } else {
+            None
+        };
+        if let Some(differs) = differs {
             return Err(value_error(format!(
-                "env: a {} environment; the agent was trained on {}",
-                environment.spec().name,
-                self.inner.env
+                "env: {differs}; the agent was trained on {} ({n}×{n} board, spacing {:?}, \
+                 manipulator options {:?})",
+                trained.env,
+                trained.env_config.spacing,
+                serde_json::Value::Object(trained.env_config.manipulator.clone()).to_string(),
+                n = trained.spec.board_size
             )));
         }
         Ok(environment)
@@ -98,12 +142,13 @@ impl Agent {
         let inner = py
             .detach(|| seads_infer::Agent::load(&run_dir, checkpoint))
             .map_err(value_error)?;
-        let env = make_env(&inner.env, &EnvConfig::default()).map_err(value_error)?;
-        let spec = env.spec();
+        // The game of the run's own environment (its board size, from `[env_config]`).
+        let spec = &inner.spec;
         let game = spec.game.build(spec.board_size).map_err(value_error)?;
         Ok(Self {
             obs_dim: spec.obs_dim,
             action_dim: spec.action_dim,
+            model: Mutex::new(inner.model.clone()),
             inner,
             game,
         })
@@ -124,7 +169,7 @@ impl Agent {
     /// The number of skills K.
     #[getter]
     fn num_skills(&self) -> usize {
-        self.inner.model.num_skills()
+        self.inner.policy.num_skills()
     }
 
     /// `act(obs, skill, deterministic=True, seed=None)`: actions for observations (one, or
@@ -134,12 +179,35 @@ impl Agent {
     fn act<'py>(
         &self,
         py: Python<'py>,
-        obs: PyReadonlyArrayDyn<'py, f32>,
+        obs: &Bound<'py, PyAny>,
         skill: &Bound<'py, PyAny>,
         deterministic: bool,
         seed: Option<u64>,
     ) -> PyResult<Bound<'py, PyAny>> {
-        let shape = obs.shape().to_vec();
+        // float32 as it is; float64 (NumPy's default) converted, where every value fits.
+        let (shape, values): (Vec<usize>, Vec<f32>) =
+            if let Ok(obs) = obs.extract::<PyReadonlyArrayDyn<'py, f32>>() {
+                (
+                    obs.shape().to_vec(),
+                    obs.as_array().iter().copied().collect(),
+                )
+            } else if let Ok(obs) = obs.extract::<PyReadonlyArrayDyn<'py, f64>>() {
+                let values = obs.as_array().iter().map(|&v| v as f32).collect::<Vec<_>>();
+                if let Some(v) = obs
+                    .as_array()
+                    .iter()
+                    .find(|v| v.is_finite() && (**v as f32).is_infinite())
+                {
+                    return Err(value_error(format!(
+                        "an observation of {v} lies beyond float32's range"
+                    )));
+                }
+                (obs.shape().to_vec(), values)
+            } else {
+                return Err(value_error(
+                    "observations: a NumPy array of float32 (or float64) values",
+                ));
+            };
         let rows = match shape[..] {
             [n] if n == self.obs_dim => 1,
             [rows, n] if n == self.obs_dim => rows,
@@ -162,7 +230,6 @@ impl Agent {
                 skills.len()
             )));
         }
-        let values: Vec<f32> = obs.as_array().iter().copied().collect();
         let policy = &self.inner.policy;
         let actions = match (deterministic, seed) {
             (true, _) => policy.actions::<ChaCha8Rng>(&values, &skills, None),
@@ -187,13 +254,13 @@ impl Agent {
     /// `successors(board)`: the board the forward model predicts after each skill (K rows of
     /// the board's values).
     fn successors<'py>(
-        &mut self,
+        &self,
         py: Python<'py>,
         board: Values,
     ) -> PyResult<Bound<'py, PyArray2<u8>>> {
         let z = self.board(&board)?;
         let mut next = Vec::new();
-        self.inner.model.successors(&[z], &mut next);
+        py.detach(|| lock(&self.model).successors(&[z], &mut next));
         let rows: Vec<Vec<u8>> = next.iter().map(|&b| self.game.values(b)).collect();
         PyArray2::from_vec2(py, &rows).map_err(value_error)
     }
@@ -204,7 +271,7 @@ impl Agent {
     #[pyo3(signature = (board, goal=None, max_depth=20, max_expanded=Some(seads_planner::DEFAULT_MAX_EXPANDED), search="breadth", choice="most-likely"))]
     #[allow(clippy::too_many_arguments)]
     fn plan(
-        &mut self,
+        &self,
         py: Python<'_>,
         board: Values,
         goal: Option<Values>,
@@ -222,10 +289,13 @@ impl Agent {
             return Ok(Vec::new());
         }
         let config = planner(max_depth, max_expanded, search, choice)?;
-        let model = &mut self.inner.model;
-        py.detach(|| find_plan(model, start, goal, &config))
-            .map(|plan| plan.skills)
-            .map_err(value_error)
+        crate::interruptible(
+            py,
+            || find_plan(&mut *lock(&self.model), start, goal, &config),
+            || config.interrupt.raise(),
+        )?
+        .map(|plan| plan.skills)
+        .map_err(value_error)
     }
 
     /// `solve(env, board=None, replan=True, max_expanded=4194304, search="breadth",
@@ -239,7 +309,7 @@ impl Agent {
     #[pyo3(signature = (env, board=None, replan=true, max_expanded=Some(seads_planner::DEFAULT_MAX_EXPANDED), search="breadth", choice="most-likely", render=false, size=256))]
     #[allow(clippy::too_many_arguments)]
     fn solve<'py>(
-        &mut self,
+        &self,
         py: Python<'py>,
         env: &Bound<'py, PyAny>,
         board: Option<Values>,
@@ -266,20 +336,38 @@ impl Agent {
         if let Some(start) = start {
             environment.set_board(start).map_err(value_error)?;
         }
-        let (policy, model) = (&self.inner.policy, &mut self.inner.model);
-        let (outcome, scenes) = if render {
+        let policy = &self.inner.policy;
+        if render {
             crate::render::check_size(size)?;
-            // A copy (same state, same random streams) is filmed and then takes the
-            // environment's place: the environment ends as an unfilmed solve leaves it.
-            let mut filmed = Filmed::new(environment.box_clone());
-            let outcome = seads_planner::solve(&mut filmed, policy, model, goal, &config);
-            let scenes = filmed.take_frames();
-            *environment = filmed.into_inner();
-            (outcome, scenes)
-        } else {
-            let outcome = seads_planner::solve(environment.as_mut(), policy, model, goal, &config);
-            (outcome, Vec::new())
-        };
+        }
+        // The search and the skills run with the GIL released (other Python threads go on),
+        // and Ctrl-C stops the search.
+        let (outcome, scenes) = crate::interruptible(
+            py,
+            || {
+                let mut model = lock(&self.model);
+                if render {
+                    // A copy (same state, same random streams) is filmed and then takes the
+                    // environment's place: the environment ends as an unfilmed solve leaves it.
+                    let mut filmed = Filmed::new(environment.box_clone());
+                    let outcome =
+                        seads_planner::solve(&mut filmed, policy, &mut *model, goal, &config);
+                    let scenes = filmed.take_frames();
+                    *environment = filmed.into_inner();
+                    (outcome, scenes)
+                } else {
+                    let outcome = seads_planner::solve(
+                        environment.as_mut(),
+                        policy,
+                        &mut *model,
+                        goal,
+                        &config,
+                    );
+                    (outcome, Vec::new())
+                }
+            },
+            || config.planner.interrupt.raise(),
+        )?;
         let outcome = outcome.map_err(value_error)?;
         let result = PyDict::new(py);
         if render {
@@ -332,10 +420,14 @@ impl Agent {
         let core = env_core(env)?;
         let mut core = core.borrow_mut();
         let environment = self.own_env(&mut core)?;
-        let mut filmed = Filmed::new(environment.box_clone());
-        let run = execute_skill(&mut filmed, &self.inner.policy, skill);
-        let scenes = filmed.take_frames();
-        *environment = filmed.into_inner();
+        let policy = &self.inner.policy;
+        let (run, scenes) = py.detach(|| {
+            let mut filmed = Filmed::new(environment.box_clone());
+            let run = execute_skill(&mut filmed, policy, skill);
+            let scenes = filmed.take_frames();
+            *environment = filmed.into_inner();
+            (run, scenes)
+        });
         let run = run.map_err(value_error)?;
         let frames = scenes
             .iter()

@@ -130,11 +130,18 @@ impl Core {
 #[pyclass(module = "seads._seads")]
 pub struct Env {
     core: Core,
+    /// The options it was built with.
+    config: EnvConfig,
     /// The board game, for the board's values (built once, not per step).
     game: Box<dyn BoardGame>,
 }
 
 impl Env {
+    /// The options the environment was built with.
+    pub(crate) fn config(&self) -> &EnvConfig {
+        &self.config
+    }
+
     /// The environment in skill mode, for executing skills (`None` in task mode).
     pub(crate) fn skill_env(&mut self) -> Option<&mut Box<dyn Environment>> {
         match &mut self.core {
@@ -155,7 +162,7 @@ impl Env {
         let config = parse_options(options)?;
         let core = Core::new(name, &config, task).map_err(value_error)?;
         let game = core.game().map_err(value_error)?;
-        Ok(Self { core, game })
+        Ok(Self { core, game, config })
     }
 
     /// The environment's specification as a dict (name, game, board_size, obs_dim, action_dim,

@@ -2,11 +2,13 @@
 //! NumPy boards in and out: a board is its values, row-major (LightsOut: 0/1 per field;
 //! TileSwap and the sliding puzzle: the tile on each field, 0 the sliding puzzle's gap).
 
+use std::sync::atomic::{AtomicBool, Ordering};
+
 use numpy::{PyArray1, PyArray2};
 use pyo3::prelude::*;
 use seads_games::{
-    BoardDataset, BoardGame, Enumerable, GameKind, GameSuccessor, Split, SymbolicState, enumerate,
-    split_of,
+    BoardDataset, BoardGame, Enumerable, GameKind, GameSuccessor, SOLVE_NODES, Split,
+    SymbolicState, enumerate, split_of,
 };
 use seads_planner::{PlannerConfig, bfs_plan};
 
@@ -112,23 +114,27 @@ impl Game {
         Ok(self.game().is_goal(self.board(board)?))
     }
 
-    /// An optimal (shortest) move sequence that solves `board`; a `ValueError` if none does.
-    fn solve(&self, board: Values) -> PyResult<Vec<usize>> {
+    /// An optimal (shortest) move sequence that solves `board`; a `ValueError` if none does,
+    /// or if the solver's search (the 15-puzzle's) stops at its bound of nodes. Ctrl-C stops it.
+    fn solve(&self, py: Python<'_>, board: Values) -> PyResult<Vec<usize>> {
         let board = self.board(board)?;
-        match self.game().solve(board) {
+        let game = self.game();
+        let stop = AtomicBool::new(false);
+        let solved = crate::interruptible(
+            py,
+            || game.solve_within(board, SOLVE_NODES, &stop),
+            || stop.store(true, Ordering::Relaxed),
+        )?;
+        match solved {
             Some(moves) => moves.map_err(value_error),
             None => Err(value_error("this game has no solver")),
         }
     }
 
     /// The board's solution depth (length of an optimal solution); a `ValueError` if it has
-    /// none.
-    fn depth(&self, board: Values) -> PyResult<usize> {
-        let board = self.board(board)?;
-        match self.game().solution_depth(board) {
-            Some(depth) => depth.map_err(value_error),
-            None => Err(value_error("this game has no solver")),
-        }
+    /// none. Ctrl-C stops a search.
+    fn depth(&self, py: Python<'_>, board: Values) -> PyResult<usize> {
+        Ok(self.solve(py, board)?.len())
     }
 
     /// Number of boards per solution depth 0, 1, … (up to `max_depth` when given), by
@@ -218,10 +224,14 @@ pub fn plan(
         ..PlannerConfig::default()
     };
     let rules = game.game();
-    py.detach(|| {
-        let mut successor = GameSuccessor::new(rules);
-        bfs_plan(&mut successor, start, goal, &config)
-    })
+    crate::interruptible(
+        py,
+        || {
+            let mut successor = GameSuccessor::new(rules);
+            bfs_plan(&mut successor, start, goal, &config)
+        },
+        || config.interrupt.raise(),
+    )?
     .map(|plan| plan.skills)
     .map_err(value_error)
 }

@@ -9,7 +9,10 @@
 //!
 //! Architecture invariant: no libtorch, never a second one beside PyTorch's in a process.
 
-use pyo3::exceptions::PyValueError;
+use std::sync::{Condvar, Mutex};
+use std::time::Duration;
+
+use pyo3::exceptions::{PyRuntimeError, PyValueError};
 use pyo3::prelude::*;
 
 mod agent;
@@ -17,6 +20,60 @@ mod env;
 mod games;
 mod render;
 mod vector;
+
+/// Runs `work` on a helper thread with the GIL released, while this thread, where Python runs
+/// its signal handlers, looks for a signal every 50 ms: on one (Ctrl-C: `KeyboardInterrupt`),
+/// `stop` is called so that the work ends early, the helper is waited for, and the signal's
+/// exception raised. So a long search can be stopped, and other Python threads go on meanwhile.
+/// A panic of the work is a `RuntimeError`, never a crash of the interpreter.
+pub(crate) fn interruptible<T: Send>(
+    py: Python<'_>,
+    work: impl FnOnce() -> T + Send,
+    stop: impl Fn(),
+) -> PyResult<T> {
+    let finished = (Mutex::new(false), Condvar::new());
+    std::thread::scope(|scope| {
+        let signal = &finished;
+        let helper = scope.spawn(move || {
+            let out = work();
+            *signal.0.lock().unwrap_or_else(|e| e.into_inner()) = true;
+            signal.1.notify_all();
+            out
+        });
+        let mut interrupted = None;
+        loop {
+            let done = py.detach(|| {
+                let guard = signal.0.lock().unwrap_or_else(|e| e.into_inner());
+                let (guard, _) = signal
+                    .1
+                    .wait_timeout_while(guard, Duration::from_millis(50), |done| !*done)
+                    .unwrap_or_else(|e| e.into_inner());
+                *guard
+            });
+            if done || helper.is_finished() {
+                break;
+            }
+            if interrupted.is_none()
+                && let Err(e) = py.check_signals()
+            {
+                stop();
+                interrupted = Some(e);
+            }
+        }
+        let joined = py.detach(|| helper.join());
+        if let Some(e) = interrupted {
+            return Err(e);
+        }
+        joined.map_err(|panic| {
+            let why = panic
+                .downcast_ref::<&str>()
+                .map(|s| (*s).to_owned())
+                .or_else(|| panic.downcast_ref::<String>().cloned())
+                .unwrap_or_default();
+            PyRuntimeError::new_err(format!("the computation failed: {why}"))
+        })
+    })
+}
 
 /// Any error of the Rust libraries as a Python `ValueError` with its message.
 fn value_error(e: impl std::fmt::Display) -> PyErr {

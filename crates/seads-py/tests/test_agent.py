@@ -127,6 +127,74 @@ def test_bad_input_raises_value_errors(agent, tmp_path):
         agent.solve(object())
 
 
+def test_the_agent_takes_its_environment_from_its_run(agent, tmp_path):
+    """Issue 82: ``Agent.load`` built its game from the default options, not the run's, so a run
+    of 7×7 boards loaded as a 5×5 agent, and a 5×5 agent planned on a 7×7 environment for half a
+    minute. With its config set to 7×7 boards, the 5×5 networks of this run no longer fit and the
+    load says so; the 5×5 agent refuses a 7×7 environment at once."""
+    seven = tmp_path / "seven"
+    shutil.copytree(RUN, seven)
+    for config in [seven / "config.toml", *seven.glob("checkpoints/*/config.toml")]:
+        text = config.read_text()
+        assert "[env_config]\n" in text
+        config.write_text(text.replace("[env_config]\n", "[env_config]\nboard_size = 7\n"))
+    with pytest.raises(ValueError, match="environment of 49 fields"):
+        seads.Agent.load(str(seven))
+    env = gymnasium.make("seads/LightsOutCursor-v0", board_size=7)
+    with pytest.raises(ValueError, match="7×7 board"):
+        agent.solve(env)
+    with pytest.raises(ValueError, match="7×7 board"):
+        agent.clip(env, 3)
+
+
+def test_observations_are_converted_and_actions_are_finite(agent):
+    """Issue 82: float64 observations raised a TypeError, and finite observations of ±3e38 gave
+    NaN actions without a word."""
+    obs = np.linspace(-1, 1, 28)
+    assert obs.dtype == np.float64
+    assert np.array_equal(agent.act(obs, 3), agent.act(obs.astype(np.float32), 3))
+    with pytest.raises(ValueError, match="float32's range"):
+        agent.act(np.array([3e38, -3e38] * 14, dtype=np.float32), 0)
+    with pytest.raises(ValueError, match="float32's range"):
+        agent.act(np.full(28, 1e39), 0)
+    with pytest.raises(ValueError, match="float32"):
+        agent.act(np.zeros(28, dtype=np.int64), 0)
+
+
+def test_one_agent_serves_several_threads(agent):
+    """Issue 82: an agent used from two threads raised "Already mutably borrowed", even for its
+    epoch, while another thread planned. Threads plan, solve and read it at once, with the
+    answers of one thread alone."""
+    import threading
+
+    tasks = [t for t in TASKS if t["plan_found"]][:4]
+    alone = [agent.plan(board(t), max_expanded=MAX_EXPANDED) for t in tasks]
+    errors, plans = [], []
+
+    def plan_all():
+        try:
+            for _ in range(3):
+                plans.append([agent.plan(board(t), max_expanded=MAX_EXPANDED) for t in tasks])
+        except Exception as e:  # noqa: BLE001 - any error is the test's failure
+            errors.append(e)
+
+    def read_all():
+        try:
+            for _ in range(300):
+                assert agent.epoch == 510
+                agent.successors(board(tasks[0]))
+        except Exception as e:  # noqa: BLE001
+            errors.append(e)
+
+    threads = [threading.Thread(target=f) for f in (plan_all, plan_all, read_all)]
+    for t in threads:
+        t.start()
+    for t in threads:
+        t.join()
+    assert errors == []
+    assert plans == [alone] * 6
+
+
 def test_a_rendered_solution_is_the_same_solution_filmed(agent):
     """``solve(render=True)`` plays exactly the unfilmed solution (same skills, steps and end
     state) and returns a frame before the first step and one after each: the first is the

@@ -374,6 +374,10 @@ impl TrainConfig {
         if self.eval_every == 0 || self.checkpoint_every == 0 {
             return bad("eval_every and checkpoint_every must be at least 1".into());
         }
+        // A run of no step would write no checkpoint and never finish.
+        if self.env_steps == 0 {
+            return bad("env_steps must be at least 1".into());
+        }
         self.check_other_sections()
     }
 

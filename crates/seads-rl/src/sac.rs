@@ -545,7 +545,7 @@ impl Sac {
         let files = checkpoint_files(prefix);
         for (file, vs) in files.iter().zip(self.stores_mut()).take(count) {
             let path = dir.join(file);
-            vs.load(&path).map_err(|e| RlError::unreadable(&path, e))?;
+            seads_nn::load_var_store(vs, &path).map_err(|e| RlError::unreadable(&path, e))?;
         }
         Ok(())
     }

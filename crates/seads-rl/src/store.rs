@@ -63,13 +63,24 @@ pub(crate) const ORIGIN: &str = "origin.json";
 struct Origin {
     env: String,
     algorithm: crate::Algorithm,
+    /// Whether the checkpoint keeps the state its environments carry from episode to episode
+    /// (`environment.json`: the robot's twin); left out where it does not, and in checkpoints
+    /// written before it was recorded.
+    #[serde(default, skip_serializing_if = "is_false")]
+    carried_state: bool,
 }
 
-/// Writes the origin of a checkpoint of a run with `config` into its folder `dir`.
+fn is_false(value: &bool) -> bool {
+    !*value
+}
+
+/// Writes the origin of a checkpoint of a run with `config` into its folder `dir`, after the
+/// learner's files (whether it kept its environments' carried state is read from them).
 pub(crate) fn write_origin(dir: &Path, config: &crate::TrainConfig) -> Result<(), RlError> {
     let origin = Origin {
         env: config.env.clone(),
         algorithm: config.algorithm,
+        carried_state: dir.join(crate::checkpoint::ENVIRONMENT_FILE).is_file(),
     };
     let path = dir.join(ORIGIN);
     let text = serde_json::to_string(&origin).map_err(|e| RlError::io(&path, e))?;
@@ -98,6 +109,15 @@ pub(crate) fn check_config(checkpoint: &Path, config: &crate::TrainConfig) -> Re
             checkpoint.display()
         ))),
     }
+}
+
+/// Whether the origin of `checkpoint` says that it was written with the state its environments
+/// carry (so a checkpoint without that file is damaged, not old).
+pub(crate) fn keeps_carried_state(checkpoint: &Path) -> bool {
+    fs::read_to_string(checkpoint.join(ORIGIN))
+        .ok()
+        .and_then(|text| serde_json::from_str::<Origin>(&text).ok())
+        .is_some_and(|origin| origin.carried_state)
 }
 
 /// Refuses a checkpoint written by a run of another environment or algorithm than `config`'s,

@@ -456,13 +456,24 @@ impl Trainer {
     }
 
     /// Restores what [`Trainer::save_carried`] wrote. A checkpoint without the file (from
-    /// before it, or of environments that carry nothing) leaves the environments as they are.
+    /// before it, or of environments that carry nothing) leaves the environments as they are;
+    /// one whose origin says it was written with the file is damaged (passed over on resume).
     fn load_carried(&mut self, dir: &Path) -> Result<(), RlError> {
         let path = dir.join(checkpoint::ENVIRONMENT_FILE);
         self.carried_missing = false;
         let text = match std::fs::read_to_string(&path) {
             Ok(text) => text,
             Err(e) if e.kind() == std::io::ErrorKind::NotFound => {
+                if crate::store::keeps_carried_state(dir) {
+                    return Err(RlError::Checkpoint {
+                        path: dir.display().to_string(),
+                        reason: format!(
+                            "{} is missing, though the checkpoint was written with the state its \
+                             environments carry (origin.json)",
+                            checkpoint::ENVIRONMENT_FILE
+                        ),
+                    });
+                }
                 self.carried_missing = self.carried_states().iter().any(Option::is_some);
                 return Ok(());
             }

@@ -682,18 +682,18 @@ impl Trainable {
     }
 
     fn load(&mut self, dir: &Path, optimiser: bool) -> Result<(), SkillModelError> {
-        let corrupt = |path: &Path, e: tch::TchError| SkillModelError::Checkpoint {
+        let corrupt = |path: &Path, e: seads_nn::WeightsError| SkillModelError::Checkpoint {
             path: path.display().to_string(),
-            reason: e.to_string(),
+            reason: match e {
+                seads_nn::WeightsError::Damaged { reason, .. } => reason,
+                seads_nn::WeightsError::Io { source, .. } => source.to_string(),
+            },
         };
         let path = dir.join(format!("{}.safetensors", self.name));
-        self.vs.load(&path).map_err(|e| corrupt(&path, e))?;
+        seads_nn::load_var_store(&mut self.vs, &path).map_err(|e| corrupt(&path, e))?;
         if optimiser {
             let path = dir.join(format!("{}_adam.safetensors", self.name));
-            self.opt
-                .state_mut()
-                .load(&path)
-                .map_err(|e| corrupt(&path, e))?;
+            seads_nn::load_var_store(self.opt.state_mut(), &path).map_err(|e| corrupt(&path, e))?;
         }
         Ok(())
     }

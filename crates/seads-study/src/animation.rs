@@ -57,13 +57,15 @@ const SIZE: (u32, u32) = (480, 520);
 pub const MAX_FRAMES: usize = 2000;
 
 /// Writes `frames` (a scene and its caption each) as an animated GIF to `out`, each shown
-/// `delay_ms` and the last one `hold_ms`, atomically (a temporary file beside it, then renamed).
+/// `delay_ms` and the last one `hold_ms`, atomically (a temporary file beside it, then renamed;
+/// removed again if anything fails). Returns how many of the frames it holds: at most
+/// [`MAX_FRAMES`], the first ones.
 pub fn write_gif(
     frames: &[(Scene, String)],
     delay_ms: u32,
     hold_ms: u32,
     out: &Path,
-) -> Result<()> {
+) -> Result<usize> {
     if frames.is_empty() {
         return Err(StudyError::invalid("an animation needs at least one frame"));
     }
@@ -95,8 +97,11 @@ pub fn write_gif(
         return Err(e);
     }
     let sync = std::fs::File::open(&tmp).and_then(|f| f.sync_all());
-    sync.and_then(|()| std::fs::rename(&tmp, out))
-        .map_err(|e| StudyError::file(format!("writing {}", out.display()), e))
+    if let Err(e) = sync.and_then(|()| std::fs::rename(&tmp, out)) {
+        let _ = std::fs::remove_file(&tmp);
+        return Err(StudyError::file(format!("writing {}", out.display()), e));
+    }
+    Ok(frames.len().min(MAX_FRAMES))
 }
 
 fn draw_frame<DB: DrawingBackend>(
@@ -110,4 +115,41 @@ where
     area.fill(&WHITE).map_err(plot_err)?;
     draw_scene(area, scene, caption, 16, true)?;
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Three frames of a LightsOutCursor board after a reset.
+    fn frames() -> Vec<(Scene, String)> {
+        let mut env = seads_embodiment::make_env("lightsout-cursor", &Default::default()).unwrap();
+        env.seed(1);
+        env.reset().unwrap();
+        vec![(env.scene(), "a caption".to_owned()); 3]
+    }
+
+    /// A GIF whose last step fails (the rename into place: a folder with a file in it stands
+    /// where the GIF goes) leaves no temporary file behind (issue 82 found `*.gif.tmp-PID` files
+    /// left); one that can be written holds every frame, and says how many.
+    #[test]
+    fn a_failed_write_leaves_no_temporary_file() {
+        let dir = tempfile::tempdir().unwrap();
+        let blocked = dir.path().join("blocked.gif");
+        std::fs::create_dir(&blocked).unwrap();
+        std::fs::write(blocked.join("keep"), "").unwrap();
+        assert!(write_gif(&frames(), 150, 150, &blocked).is_err());
+        let names = || -> Vec<String> {
+            let mut names: Vec<String> = std::fs::read_dir(dir.path())
+                .unwrap()
+                .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+                .collect();
+            names.sort();
+            names
+        };
+        assert_eq!(names(), ["blocked.gif"]);
+        let out = dir.path().join("x.gif");
+        assert_eq!(write_gif(&frames(), 150, 150, &out).unwrap(), 3);
+        assert_eq!(names(), ["blocked.gif", "x.gif"]);
+    }
 }

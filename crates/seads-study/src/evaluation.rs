@@ -27,7 +27,9 @@ pub fn checkpoint_of(run: &Path, checkpoint: &Path) -> Result<(CheckpointId, Opt
 }
 
 /// Writes an evaluation's record (and its tasks' lines, if any) into the run directory, under
-/// the names its protocol and checkpoint give.
+/// the names its protocol and checkpoint give. An evaluation of another protocol found under
+/// these names (written by a binary that named files by fewer parts of the protocol) is first
+/// moved to the names its own protocol gives, never replaced.
 pub fn save_evaluation(
     run: &Path,
     record: &EvaluationRecord,
@@ -38,6 +40,7 @@ pub fn save_evaluation(
         .protocol
         .as_ref()
         .ok_or_else(|| StudyError::failed("an evaluation is saved with its protocol"))?;
+    keep_another_protocols(run, protocol, named_epoch)?;
     seads_rl::store::write_atomic(
         &run.join(protocol.results_file(named_epoch)),
         record.to_json().as_bytes(),
@@ -47,6 +50,62 @@ pub fn save_evaluation(
             &run.join(protocol.tasks_file(named_epoch)),
             lines.as_bytes(),
         )?;
+    }
+    Ok(())
+}
+
+/// Moves an evaluation of another protocol than `protocol` out of the way of `protocol`'s files
+/// (of the checkpoint `named_epoch`), to the names its own protocol gives; one whose protocol is
+/// not recorded goes to `…-protocol-unknown.json`. Where those names are taken too, nothing is
+/// moved and the evaluation is refused, so that no record is lost.
+pub(crate) fn keep_another_protocols(
+    run: &Path,
+    protocol: &Protocol,
+    named_epoch: Option<u64>,
+) -> Result<()> {
+    let results = run.join(protocol.results_file(named_epoch));
+    let Ok(Some(found)) = read_evaluation(&results) else {
+        // Nothing there, or not an evaluation: nothing to keep.
+        return Ok(());
+    };
+    if found.protocol.as_ref() == Some(protocol) {
+        return Ok(());
+    }
+    let (to_results, to_tasks) = match &found.protocol {
+        Some(other) => (
+            other.results_file(named_epoch),
+            other.tasks_file(named_epoch),
+        ),
+        None => {
+            let stem = protocol.stem(named_epoch);
+            (
+                format!("{stem}-protocol-unknown.json"),
+                format!("{stem}-protocol-unknown-tasks.jsonl"),
+            )
+        }
+    };
+    let moves = [
+        (results, run.join(to_results)),
+        (
+            run.join(protocol.tasks_file(named_epoch)),
+            run.join(to_tasks),
+        ),
+    ];
+    for (_, to) in &moves {
+        if to.exists() {
+            return Err(StudyError::invalid(format!(
+                "{} holds an evaluation of another protocol, and {} is taken too: move one of \
+                 them away first",
+                moves[0].0.display(),
+                to.display()
+            )));
+        }
+    }
+    for (from, to) in moves {
+        if from.exists() {
+            std::fs::rename(&from, &to)
+                .doing(|| format!("moving {} to {}", from.display(), to.display()))?;
+        }
     }
     Ok(())
 }
@@ -213,6 +272,9 @@ pub fn run_evaluation(
 ) -> Result<EvaluationRecord> {
     let game = crate::run_game(&agent.config)?;
     let (checkpoint, named) = checkpoint_of(run, &agent.checkpoint)?;
+    // Before any work: an evaluation of another protocol in the way is moved to its own name,
+    // or the evaluation is refused with nothing solved.
+    keep_another_protocols(run, protocol, named)?;
     let mut journal = Place::new(run, protocol, &checkpoint, named, &[]).open()?;
     let mut now = BTreeMap::new();
     let finished = journal.summaries();
@@ -251,9 +313,10 @@ pub fn run_evaluation(
     Ok(record)
 }
 
-/// How many tasks of `protocol` a stopped evaluation of the agent's checkpoint in `run` has
-/// finished: [`run_evaluation`] counts them instead of solving them again.
-pub fn finished_before(agent: &Agent, run: &Path, protocol: &Protocol) -> Result<usize> {
+/// What a stopped evaluation of `protocol` of the agent's checkpoint in `run` left: the tasks it
+/// finished, which [`run_evaluation`] counts instead of solving them again, and its damaged
+/// journal lines, whose tasks it solves again.
+pub fn finished_before(agent: &Agent, run: &Path, protocol: &Protocol) -> Result<crate::Resumed> {
     let (checkpoint, named) = checkpoint_of(run, &agent.checkpoint)?;
     Place::new(run, protocol, &checkpoint, named, &[]).finished_before()
 }

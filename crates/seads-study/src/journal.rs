@@ -56,18 +56,33 @@ impl Place {
         Self { partial, header }
     }
 
-    /// How many tasks a stopped evaluation wrote under this header.
-    pub(crate) fn finished_before(&self) -> Result<usize> {
-        Ok(finished_tasks(&self.partial, &self.header)?.0.len())
+    /// What a stopped evaluation wrote under this header: its finished tasks, and its damaged
+    /// lines, whose tasks are solved again.
+    pub(crate) fn finished_before(&self) -> Result<Resumed> {
+        let earlier = finished_tasks(&self.partial, &self.header)?;
+        Ok(Resumed {
+            finished: earlier.tasks.len(),
+            damaged: earlier.damaged,
+        })
     }
 
     /// Opens the journal: reads the tasks a stopped evaluation under the same header wrote, or
-    /// starts a new journal with the header.
+    /// starts a new journal with the header. A journal with damaged lines is written again
+    /// without them, so that the tasks appended now follow whole lines only.
     pub(crate) fn open(self) -> Result<Journal> {
-        let (earlier, earlier_by) = finished_tasks(&self.partial, &self.header)?;
-        if earlier.is_empty() {
+        let Earlier {
+            tasks: earlier,
+            by: earlier_by,
+            damaged,
+            kept,
+        } = finished_tasks(&self.partial, &self.header)?;
+        if earlier.is_empty() || damaged > 0 {
             let mut text = self.header.to_string();
             text.push('\n');
+            for line in &kept {
+                text += line;
+                text.push('\n');
+            }
             seads_rl::store::write_atomic(&self.partial, text.as_bytes())?;
         }
         Ok(Journal {
@@ -142,54 +157,95 @@ impl Journal {
 /// The key of a journal line that names the binary that solved the task.
 const BY: &str = "by";
 
-/// Finished tasks by depth and seed, and the binaries their lines name (`None` if a line names
-/// none).
-type Earlier = (BTreeMap<(usize, u64), Finished>, Option<Vec<Evaluator>>);
+/// What a stopped evaluation left in its journal.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Resumed {
+    /// Tasks it finished, counted instead of solved again.
+    pub finished: usize,
+    /// Lines that could not be read back (garbled by a fault of the disk or a hand), left out:
+    /// their tasks are solved again.
+    pub damaged: usize,
+}
+
+/// What a journal holds under the expected header.
+struct Earlier {
+    /// Finished tasks by depth and seed.
+    tasks: BTreeMap<(usize, u64), Finished>,
+    /// The binaries their lines name, in the order they first appear (`None` if a line names
+    /// none).
+    by: Option<Vec<Evaluator>>,
+    /// Lines that could not be read back as a task.
+    damaged: usize,
+    /// The whole task lines as written, without the damaged ones.
+    kept: Vec<String>,
+}
+
+impl Earlier {
+    fn none() -> Self {
+        Self {
+            tasks: BTreeMap::new(),
+            by: Some(Vec::new()),
+            damaged: 0,
+            kept: Vec::new(),
+        }
+    }
+}
 
 /// The tasks an earlier, stopped evaluation wrote into `partial` under `header`, by depth and
 /// seed, with their lines (without what only the journal keeps: the search time and the
-/// binary), and the binaries those lines name, in the order they first appear (`None` if a
-/// line names none). No tasks where there is no such file, or it was written under another
-/// header (another protocol or checkpoint) or cannot be read back whole: the evaluation then
-/// starts afresh and rewrites it.
+/// binary), and the binaries those lines name. No tasks where there is no such file, or it was
+/// written under another header (another protocol or checkpoint): the evaluation then starts
+/// afresh and rewrites it. A line that is not a task (damaged) is counted and left out, and so
+/// is a torn last line (a crash during an append); every other task stands.
 fn finished_tasks(partial: &Path, header: &serde_json::Value) -> Result<Earlier> {
-    let none = || Ok((BTreeMap::new(), Some(Vec::new())));
     if !partial.exists() {
-        return none();
+        return Ok(Earlier::none());
     }
-    let Ok((lines, _torn)) = seads_rl::store::read_json_lines::<serde_json::Value>(partial) else {
-        return none();
-    };
-    if lines.first() != Some(header) {
-        return none();
+    let text = std::fs::read(partial).doing(|| format!("reading {}", partial.display()))?;
+    let text = String::from_utf8_lossy(&text);
+    // Whole lines only: what follows the last newline is a torn append.
+    let whole = text.rfind('\n').map_or("", |end| &text[..end]);
+    let mut lines = whole.lines().filter(|l| !l.trim().is_empty());
+    let first = lines
+        .next()
+        .and_then(|l| serde_json::from_str::<serde_json::Value>(l).ok());
+    if first.as_ref() != Some(header) {
+        return Ok(Earlier::none());
     }
-    let (mut tasks, mut by) = (BTreeMap::new(), Some(Vec::new()));
-    for line in lines.into_iter().skip(1) {
-        let key = (line["depth"].as_u64(), line["seed"].as_u64());
-        let (Some(depth), Some(seed)) = key else {
-            return none();
+    let mut earlier = Earlier::none();
+    for text in lines {
+        let Some((key, finished, named)) = task_of(text) else {
+            earlier.damaged += 1;
+            continue;
         };
-        let Ok(summary) = serde_json::from_value::<TaskSummary>(line.clone()) else {
-            return none();
-        };
-        let mut line = line;
-        if let Some(fields) = line.as_object_mut() {
-            fields.remove("planning_s");
-            match fields.remove(BY) {
-                Some(named) => {
-                    let Ok(evaluator) = serde_json::from_value::<Evaluator>(named) else {
-                        return none();
-                    };
-                    if let Some(by) = by.as_mut()
-                        && !by.contains(&evaluator)
-                    {
-                        by.push(evaluator);
-                    }
+        match named {
+            Some(evaluator) => {
+                if let Some(by) = earlier.by.as_mut()
+                    && !by.contains(&evaluator)
+                {
+                    by.push(evaluator);
                 }
-                None => by = None,
             }
+            None => earlier.by = None,
         }
-        tasks.insert((depth as usize, seed), (summary, line));
+        earlier.tasks.insert(key, finished);
+        earlier.kept.push(text.to_owned());
     }
-    Ok((tasks, by))
+    Ok(earlier)
+}
+
+/// A journal line as a task: its depth and seed, what it adds and its line without what only
+/// the journal keeps, and the binary it names; `None` for a line that is not one.
+fn task_of(text: &str) -> Option<((usize, u64), Finished, Option<Evaluator>)> {
+    let mut line: serde_json::Value = serde_json::from_str(text).ok()?;
+    let depth = usize::try_from(line["depth"].as_u64()?).ok()?;
+    let seed = line["seed"].as_u64()?;
+    let summary = serde_json::from_value::<TaskSummary>(line.clone()).ok()?;
+    let fields = line.as_object_mut()?;
+    fields.remove("planning_s");
+    let named = match fields.remove(BY) {
+        Some(named) => Some(serde_json::from_value::<Evaluator>(named).ok()?),
+        None => None,
+    };
+    Some(((depth, seed), (summary, line), named))
 }

@@ -53,6 +53,7 @@ pub mod robot;
 pub mod sweep;
 
 pub use error::{BoxError, Context, Result, StudyError};
+pub use journal::Resumed;
 
 /// The number of skills K of a run: its `num_skills`, else the moves of its environment's game
 /// (for a robot run, whose environment is not in the registry, the tablet's LightsOut 5×5).

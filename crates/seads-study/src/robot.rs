@@ -51,8 +51,9 @@ impl RobotEvaluation {
         [("twin", self.twin_seed.into())]
     }
 
-    /// How many tasks a stopped evaluation of `checkpoint` in `run` finished.
-    pub fn finished_before(&self, run: &Path, checkpoint: &Path) -> Result<usize> {
+    /// What a stopped evaluation of `checkpoint` in `run` left: the tasks it finished, and its
+    /// damaged journal lines.
+    pub fn finished_before(&self, run: &Path, checkpoint: &Path) -> Result<crate::Resumed> {
         let (id, named) = checkpoint_of(run, checkpoint)?;
         Place::new(run, &self.protocol(), &id, named, &self.header()).finished_before()
     }
@@ -95,6 +96,7 @@ impl RobotEvaluation {
             planner: self.limits.planner(),
             ..SolveConfig::default()
         };
+        crate::evaluation::keep_another_protocols(run, &protocol, named)?;
         let mut journal = Place::new(run, &protocol, &id, named, &self.header()).open()?;
         let mut results: BTreeMap<usize, DepthResult> = BTreeMap::new();
         let mut lines = String::new();

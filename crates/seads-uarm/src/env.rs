@@ -424,7 +424,7 @@ impl Environment for UarmEnv {
         }
         let mut hw = self.lock();
         let before = hw.board.board();
-        hw.board.reset();
+        hw.board.reset()?;
         let board = hw.board.board();
         let rng = hw.board.rng();
         let cursor = [rng.random::<f64>(), rng.random::<f64>()];

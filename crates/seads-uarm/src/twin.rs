@@ -260,8 +260,13 @@ impl Twin {
     pub fn restore(&self, state: &TwinState) -> Result<(), UarmError> {
         let mut w = self.lock();
         let bad = |what: &str| Err(UarmError::Config(format!("the twin's saved state: {what}")));
-        if !state.pen.iter().all(|v| v.is_finite()) {
-            return bad("the pen's position is not finite");
+        // Within the arm's reach on every axis (issue 82: a pen at 1e308 mm was taken).
+        let reach = crate::calibration::REACH_MM;
+        if !state.pen.iter().all(|v| v.is_finite() && v.abs() <= reach) {
+            return bad(&format!(
+                "the pen's position {:?} lies beyond the arm's reach ({reach} mm on each axis)",
+                state.pen
+            ));
         }
         if !w.game.is_valid(state.board) {
             return bad("not a LightsOut 5×5 board");
@@ -506,5 +511,33 @@ impl Tablet for SimTablet {
         w.late = false;
         w.timed = w.seq;
         Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A saved pen beyond the arm's reach, or not finite, is refused and leaves the twin as it
+    /// was (issue 82: a pen at [1e308, -1e308, 1e308] was taken); one within reach is restored.
+    #[test]
+    fn a_saved_pen_beyond_the_arms_reach_is_refused() {
+        let twin = Twin::new(1);
+        let before = twin.state();
+        for pen in [
+            [1e308, -1e308, 1e308],
+            [f64::NAN, 0.0, 0.0],
+            [0.0, 0.0, crate::calibration::REACH_MM + 1.0],
+        ] {
+            let mut state = before.clone();
+            state.pen = pen;
+            let err = twin.restore(&state).unwrap_err().to_string();
+            assert!(err.contains("reach"), "{pen:?}: {err}");
+            assert_eq!(twin.state().pen, before.pen);
+        }
+        let mut state = before.clone();
+        state.pen = [200.0, -50.0, 30.0];
+        twin.restore(&state).unwrap();
+        assert_eq!(twin.state().pen, [200.0, -50.0, 30.0]);
     }
 }

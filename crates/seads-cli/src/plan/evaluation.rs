@@ -24,14 +24,16 @@ pub fn run_evaluation(
     // A resumed evaluation starts from the tasks its stopped run finished.
     let before = seads_study::evaluation::finished_before(agent, run, protocol)
         .map_err(crate::study_error)?;
-    if before > 0 {
+    if before.finished > 0 {
         eprintln!(
-            "seads: {}: resuming an evaluation: {before} of {} tasks finished before",
+            "seads: {}: resuming an evaluation: {} of {} tasks finished before",
             run.display(),
+            before.finished,
             protocol.tasks.len()
         );
     }
-    bar.set_position(before as u64);
+    crate::plan::warn_damaged_journal(run, before.damaged);
+    bar.set_position(before.finished as u64);
     let record = seads_study::evaluation::run_evaluation(agent, run, protocol, |task| {
         bar.set_message(format!("depth {}", task.depth));
         bar.inc(1);

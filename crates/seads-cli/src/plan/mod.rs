@@ -20,6 +20,18 @@ pub use solve::{SolveArgs, solve_board};
 
 use crate::BadInput;
 
+/// Says on standard error that a stopped evaluation's journal in `run` had `damaged` lines that
+/// could not be read back, so that their tasks are solved again (nothing if none).
+pub fn warn_damaged_journal(run: &Path, damaged: usize) {
+    if damaged > 0 {
+        eprintln!(
+            "seads: {}: {damaged} damaged line(s) in the journal of a stopped evaluation were left \
+             out; their tasks are solved again",
+            run.display()
+        );
+    }
+}
+
 /// How far each search may go: by default 2²² expanded states and no clock, so that the same
 /// agent solves the same boards on any machine, loaded or not.
 #[derive(Debug, Clone, Args)]
@@ -84,6 +96,17 @@ pub fn check_boards(boards: usize) -> Result<()> {
 /// foreign directory into a clear error.
 pub fn load_agent(run: &Path, checkpoint: Option<u64>, device: ComputeDevice) -> Result<Agent> {
     let mut config = crate::run_config(run)?;
+    // A robot run's skills act on the arm or its twin, which only `seads uarm` builds (issue 82:
+    // "unknown environment uarm-lightsout-absolute").
+    if seads_uarm::ActionSpace::of_env(&config.env).is_some() {
+        bail!(BadInput(anyhow::anyhow!(
+            "{} is a robot run ({}): its skills act on the uArm or its twin; evaluate it with \
+             `seads uarm evaluate --run {}`",
+            run.display(),
+            config.env,
+            run.display()
+        )));
+    }
     config.device = crate::usable_device(device)?;
     crate::kernels::use_kernels(config.portable_numerics)?;
     if config.algorithm != seads_rl::Algorithm::Seads {

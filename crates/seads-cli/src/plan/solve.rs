@@ -46,6 +46,11 @@ pub struct SolveArgs {
 
 /// `seads solve`.
 pub fn solve_board(args: SolveArgs) -> Result<()> {
+    // The output is checked before the work: never written into the run, onto a special file,
+    // or into a folder that is not there after the whole solve.
+    if let Some(out) = &args.render {
+        crate::paths::check_output_file(out, &[&args.run], &["png", "svg", "gif"])?;
+    }
     // The planner's parts run on rayon's threads, each on one libtorch thread.
     seads_rl::set_threads(1);
     let mut agent = load_agent(&args.run, args.checkpoint, args.device)?;
@@ -71,7 +76,16 @@ pub fn solve_board(args: SolveArgs) -> Result<()> {
         let outcome = solve(&mut filmed, policy, model, game.goal(), &config)?;
         let captions = captions(&agent.config.env, &outcome, filmed.frames().len());
         let frames: Vec<_> = filmed.take_frames().into_iter().zip(captions).collect();
-        seads_study::animation::write_gif(&frames, 150, 1500, out)?;
+        let shown = seads_study::animation::write_gif(&frames, 150, 1500, out)?;
+        if shown < frames.len() {
+            eprintln!(
+                "seads: {} holds the first {shown} of the solution's {} frames (an animation holds \
+                 at most {})",
+                out.display(),
+                frames.len(),
+                seads_study::animation::MAX_FRAMES
+            );
+        }
         return report(&args, &game.format(board), &agent.checkpoint, &outcome);
     }
     let outcome = solve(env.as_mut(), policy, model, game.goal(), &config)?;

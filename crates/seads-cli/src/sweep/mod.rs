@@ -97,8 +97,9 @@ pub struct RunArgs {
     population: Option<u64>,
     /// Train even though this binary was built from a working tree with uncommitted changes
     /// (refused by default, so that a study's runs come from committed code; such runs say
-    /// `dirty: true` in their provenance and the report marks them).
-    #[arg(long, env = "SEADS_ALLOW_DIRTY")]
+    /// `dirty: true` in their provenance and the report marks them). The environment variable
+    /// SEADS_ALLOW_DIRTY=1 (or true, yes, on) does the same.
+    #[arg(long)]
     allow_dirty: bool,
     /// No progress bar.
     #[arg(long)]
@@ -126,8 +127,8 @@ pub struct TaskArgs {
     #[arg(long, value_name = "SECONDS", default_value_t = state::PATIENCE.as_secs())]
     wait: u64,
     /// Train even though this binary was built from a working tree with uncommitted changes
-    /// (refused by default; see `seads sweep run --allow-dirty`).
-    #[arg(long, env = "SEADS_ALLOW_DIRTY")]
+    /// (refused by default; see `seads sweep run --allow-dirty`; or SEADS_ALLOW_DIRTY=1).
+    #[arg(long)]
     allow_dirty: bool,
     /// Started by `seads sweep run`: die with the parent, and if another task holds the run,
     /// exit with status 3 (taken elsewhere) after two seconds.
@@ -173,8 +174,8 @@ pub struct SlurmArgs {
     #[arg(long)]
     submit: bool,
     /// Let the tasks train with a binary built from a working tree with uncommitted changes
-    /// (refused by default; see `seads sweep run --allow-dirty`).
-    #[arg(long, env = "SEADS_ALLOW_DIRTY")]
+    /// (refused by default; see `seads sweep run --allow-dirty`; or SEADS_ALLOW_DIRTY=1).
+    #[arg(long)]
     allow_dirty: bool,
 }
 
@@ -194,7 +195,7 @@ pub fn run(command: SweepCommand) -> Result<()> {
         SweepCommand::Plan(args) => plan(args),
         SweepCommand::Run(args) => {
             crate::build()
-                .allows_study(args.allow_dirty)
+                .allows_study(allow_dirty(args.allow_dirty)?)
                 .map_err(crate::study_error)?;
             let cores = match args.cores {
                 Some(c) => thread_count("--cores", c)?,
@@ -222,7 +223,7 @@ pub fn run(command: SweepCommand) -> Result<()> {
         }
         SweepCommand::Task(args) => {
             crate::build()
-                .allows_study(args.allow_dirty)
+                .allows_study(allow_dirty(args.allow_dirty)?)
                 .map_err(crate::study_error)?;
             // `seads sweep run` looked at the run an instant ago and found it free: if another
             // task holds it now, it took it meanwhile, and the child leaves it to that one.
@@ -318,7 +319,7 @@ fn slurm(args: SlurmArgs) -> Result<()> {
         seads,
         device: args.device,
         populations,
-        allow_dirty: args.allow_dirty,
+        allow_dirty: allow_dirty(args.allow_dirty)?,
     };
     let (array, report) =
         slurm::write_scripts(&dir, &sweep, &options).map_err(crate::study_error)?;
@@ -346,6 +347,19 @@ fn status(args: StatusArgs) -> Result<()> {
         outln!("{}", overview.table());
     }
     Ok(())
+}
+
+/// The environment variable that allows a study to train with a binary built from a working tree
+/// with uncommitted changes, as `--allow-dirty` does.
+const ALLOW_DIRTY_VAR: &str = "SEADS_ALLOW_DIRTY";
+
+/// Whether a study may train with a dirty binary: `--allow-dirty` (`flag`), or
+/// [`ALLOW_DIRTY_VAR`] set to a true value; a value that is no boolean is bad input naming the
+/// variable.
+fn allow_dirty(flag: bool) -> Result<bool> {
+    // The variable is checked even beside the flag: a bad value is never silently ignored.
+    let variable = crate::env_flag(ALLOW_DIRTY_VAR)?;
+    Ok(flag || variable)
 }
 
 /// Whether `e` says that another task holds a run.

@@ -6,6 +6,9 @@ use std::path::{Path, PathBuf};
 
 use crate::common::*;
 
+/// The policy evaluation of `seads evaluate --boards 2`: named by its protocol's boards.
+const POLICY_TWO: &str = "evaluation-policy-boards-2.json";
+
 /// A tiny baseline run of `algorithm` (sac or hac): 30 epochs of 8 steps, evaluations and
 /// checkpoints every 10 epochs.
 fn tiny_config(dir: &Path, algorithm: &str) -> PathBuf {
@@ -205,8 +208,7 @@ fn trains_resumes_evaluates_and_is_reported(algorithm: &str) {
     let v = json(&["evaluate", "--run", s(&run), "--boards", "2", "--json"]);
     assert_eq!(v["success_rate"].as_object().unwrap().len(), 5, "{v}");
     let saved: serde_json::Value =
-        serde_json::from_str(&std::fs::read_to_string(run.join("evaluation-policy.json")).unwrap())
-            .unwrap();
+        serde_json::from_str(&std::fs::read_to_string(run.join(POLICY_TWO)).unwrap()).unwrap();
     // The record names the checkpoint it evaluated and its protocol.
     assert_eq!(saved["checkpoint"]["epoch"], 40, "{saved}");
     assert_eq!(saved["checkpoint"]["env_steps"], 320, "{saved}");
@@ -214,7 +216,8 @@ fn trains_resumes_evaluates_and_is_reported(algorithm: &str) {
     assert_eq!(saved["protocol"]["tasks"]["boards"], 2, "{saved}");
     let results = saved["results"].as_array().unwrap();
     assert!(results.iter().all(|d| d["tasks"] == 2));
-    let tasks = std::fs::read_to_string(run.join("evaluation-policy-tasks.jsonl")).unwrap();
+    let tasks =
+        std::fs::read_to_string(run.join("evaluation-policy-boards-2-tasks.jsonl")).unwrap();
     assert_eq!(tasks.lines().count(), 10, "one line per task");
 
     check_bad_input(
@@ -235,7 +238,7 @@ fn trains_resumes_evaluates_and_is_reported(algorithm: &str) {
     let report = dir.path().join("report");
     seads_ok(&["report", s(&run), "--out", s(&report)]);
     let md = std::fs::read_to_string(report.join("report.md")).unwrap();
-    assert!(md.contains("| run | policy | 1 |"), "{md}");
+    assert!(md.contains("| run | policy | boards-2 | 1 |"), "{md}");
     assert!(report.join("success-lightsout-cursor.png").is_file());
 }
 
@@ -334,16 +337,17 @@ overrides = { algorithm = "hac", hac = { replay_capacity = 100, eval_boards = 1,
             .all(|r| r["env_steps"].as_u64().unwrap() >= 240),
         "{status}"
     );
-    assert!(sac.join("evaluation-policy.json").is_file());
+    // Named by the manifest's protocol: 1 board per depth.
+    assert!(sac.join("evaluation-policy-boards-1.json").is_file());
     let hac = sweep.join("runs/lightsout-cursor/hac/seed-1");
-    assert!(hac.join("evaluation-policy.json").is_file());
+    assert!(hac.join("evaluation-policy-boards-1.json").is_file());
     let report = dir.path().join("report");
     seads_ok(&["report", s(&sweep), "--out", s(&report)]);
     let md = std::fs::read_to_string(report.join("report.md")).unwrap();
     for row in [
-        "| seads | re-planning | 1 |",
-        "| sac | policy | 1 |",
-        "| hac | policy | 1 |",
+        "| seads | re-planning | boards-1, expanded-500, timeout-600s | 1 |",
+        "| sac | policy | boards-1 | 1 |",
+        "| hac | policy | boards-1 | 1 |",
     ] {
         assert!(md.contains(row), "{row}: {md}");
     }

@@ -47,6 +47,44 @@ fn split_json() {
     assert_eq!(v["train"], serde_json::json!([7, 31]));
 }
 
+/// A depth beyond the game's farthest board is one line of bad input, found before the table is
+/// allocated (issue 82: `--max-depth 18446744073709551615` panicked with "capacity overflow" and
+/// `--max-depth 100000000` grew to 4.5 GB without a word); the farthest depth itself is fine.
+#[test]
+fn a_split_beyond_the_farthest_board_is_refused() {
+    for depth in ["18446744073709551615", "100000000", "10"] {
+        check_bad_input(
+            &[
+                "games",
+                "split",
+                "--game",
+                "lightsout",
+                "--size",
+                "3",
+                "--max-depth",
+                depth,
+            ],
+            "the farthest is 9 moves from the goal",
+        );
+    }
+    let v = json(&[
+        "games",
+        "split",
+        "--game",
+        "lightsout",
+        "--size",
+        "3",
+        "--max-depth",
+        "9",
+        "--json",
+    ]);
+    let boards: u64 = ["train", "test"]
+        .iter()
+        .flat_map(|s| v[s].as_array().unwrap().iter().map(|n| n.as_u64().unwrap()))
+        .sum();
+    assert_eq!(boards, 511, "every 3×3 board but the goal");
+}
+
 #[test]
 fn solve_json_and_table() {
     let board = "1,1,0,0,0,1,0,0,0,0,0,0,1,0,0,0,1,1,1,0,0,0,1,0,0";
@@ -254,6 +292,20 @@ fn env_bench_reports_steps_per_second() {
         &["env-bench", "--env", "lightsout-cursor", "--threads", "0"],
         "at least 1",
     );
+    // Threads beyond the machine are refused before any is spawned (issue 82: 10⁸ grew to
+    // 12.7 GB).
+    for huge in ["100000000", "18446744073709551615"] {
+        check_bad_input(
+            &[
+                "env-bench",
+                "--env",
+                "lightsout-reacher3",
+                "--threads",
+                huge,
+            ],
+            "more than this machine can run",
+        );
+    }
     // A manipulator's options are its own: the Cursor has none, the Jaco's must fit its type.
     check_bad_input(
         &[
@@ -452,13 +504,60 @@ fn train_rejects_bad_input() {
     );
 }
 
+/// A budget of no step is refused before a directory is made (issue 82: such a run had no
+/// checkpoint and never finished), and `seads run` on an existing run refuses an environment or
+/// seed that is not the run's instead of silently resuming the run it found there.
+#[test]
+fn run_and_train_refuse_what_they_would_ignore() {
+    let dir = tempfile::tempdir().unwrap();
+    let config = tiny_config(dir.path());
+    let new = dir.path().join("new");
+    check_bad_input(
+        &[
+            "train",
+            "--config",
+            s(&config),
+            "--env-steps",
+            "0",
+            "--out",
+            s(&new),
+        ],
+        "env_steps must be at least 1",
+    );
+    check_bad_input(
+        &["run", "--out", s(&new), "--env-steps", "0"],
+        "env_steps must be at least 1",
+    );
+    assert!(!new.exists(), "no run directory made");
+    let run = dir.path().join("run");
+    copy_tiny_run(&run);
+    let before = data_snapshot(&run);
+    check_bad_input(
+        &["run", "--out", s(&run), "--env", "tileswap-cursor"],
+        "is a run of env lightsout-cursor, not tileswap-cursor",
+    );
+    check_bad_input(
+        &["run", "--out", s(&run), "--seed", "7"],
+        "is a run of seed 1, not 7",
+    );
+    check_bad_input(
+        &["run", "--out", s(&run), "--env-steps", "10"],
+        "a budget can only be raised",
+    );
+    assert_eq!(data_snapshot(&run), before, "the run is untouched");
+}
+
 /// A copy of the shared tiny run at `to`, for a test that writes into it.
 fn copy_tiny_run(to: &std::path::Path) {
     copy_dir(&tiny_run().join("run"), to);
 }
 
+/// The stem of the files [`evaluate_two_boards_of_depths_1_2`] writes: named by every part of
+/// its protocol that departs from the standard one.
+const TWO_BOARDS: &str = "evaluation-replan-depths-1-2-boards-2-expanded-2000";
+
 /// `seads evaluate --json` of `run` with re-planning on 2 boards of depths 1 and 2 (searches
-/// bounded by 2,000 states); it writes `evaluation-replan-depths-1-2*` into the run.
+/// bounded by 2,000 states); it writes [`TWO_BOARDS`]`*` into the run.
 fn evaluate_two_boards_of_depths_1_2(run: &str) -> serde_json::Value {
     serde_json::from_slice(&evaluate_two_boards_of_depths_1_2_output(run).stdout).unwrap()
 }
@@ -564,6 +663,49 @@ fn solve_evaluate_and_plot_a_trained_run() {
     assert!(clips >= k * 2 * 4, "{clips} frames");
     assert!(String::from_utf8_lossy(&out.stdout).contains(&format!("({clips} frames)")));
     check_bad_input(&["plot", "--run", run, "--animate", "skills.png"], ".gif");
+    // An output that cannot be written is refused before the work, in one line naming it (issue
+    // 82: `--render /dev/null` and `--render nodir/x.gif` failed only after the whole solve, and
+    // `--render` wrote into the agent's run): a special file, a folder that is not there, the run
+    // itself, a format that is not drawn.
+    let missing = dir.path().join("nodir/x.gif");
+    let inside = std::path::Path::new(run).join("solution.gif");
+    let text = dir.path().join("solution.txt");
+    for (out, why) in [
+        ("/dev/null", "a special file"),
+        (s(&missing), "does not exist"),
+        (s(&inside), "lies inside"),
+        (s(&text), "the output must be a ."),
+    ] {
+        check_bad_input(
+            &["solve", "--run", run, "--board", board, "--render", out],
+            why,
+        );
+        check_bad_input(&["plot", "--run", run, "--animate", out], why);
+    }
+    assert!(!inside.exists() && !missing.exists());
+    // More clips than an animation holds: the frames it holds are said, never cut silently.
+    let many = dir.path().join("many.gif");
+    let out = seads_ok(&[
+        "plot",
+        "--run",
+        run,
+        "--animate",
+        s(&many),
+        "--starts",
+        "20",
+    ]);
+    let said = String::from_utf8_lossy(&out.stdout);
+    let mut decoder = gif::DecodeOptions::new()
+        .read_info(std::fs::File::open(&many).unwrap())
+        .unwrap();
+    let mut held = 0;
+    while decoder.read_next_frame().unwrap().is_some() {
+        held += 1;
+    }
+    assert!(
+        said.contains(&format!("({held} of ")) && said.contains("left out"),
+        "{held}: {said}"
+    );
     check_bad_input(&["plot", "--run", run], "--out");
     assert!(
         !std::fs::read_dir(dir.path())
@@ -599,8 +741,7 @@ fn solve_evaluate_and_plot_a_trained_run() {
     // One line per task, with what every skill did against the model's prediction: with
     // re-planning, each deviation of a solved task cost one more search.
     let tasks =
-        std::fs::read_to_string(tiny_run().join("run/evaluation-replan-depths-1-2-tasks.jsonl"))
-            .unwrap();
+        std::fs::read_to_string(tiny_run().join(format!("run/{TWO_BOARDS}-tasks.jsonl"))).unwrap();
     let tasks: Vec<serde_json::Value> = tasks
         .lines()
         .map(|l| serde_json::from_str(l).unwrap())
@@ -958,16 +1099,29 @@ fn uarm_twin_calibrates_and_trains() {
         std::fs::read_to_string(run.join("robot.toml")).unwrap(),
         "action_space = \"absolute\"\nreset_board = false\nobserve = \"pen\"\n"
     );
-    // A robot run has figures and a report too: what its directory holds.
+    // A robot run has figures and a report too: what its directory holds. Its success figure
+    // shows the evaluation of the protocol asked for (issue 82): the standard one was not made,
+    // so there is none, and said so.
     let figures = dir.path().join("figures");
-    seads_ok(&["plot", "--run", s(&run), "--out", s(&figures)]);
+    let out = seads_ok(&["plot", "--run", s(&run), "--out", s(&figures)]);
+    let said = String::from_utf8_lossy(&out.stderr);
+    assert!(said.contains("no evaluation of epoch"), "{said}");
+    assert!(!figures.join("success.png").exists());
     // Success as `uarm train` measured it; the skills as the twin executes them.
+    let limits = ["--boards", "1", "--max-expanded", "2000"];
+    seads_ok(
+        &[
+            &["plot", "--run", s(&run), "--out", s(&figures)][..],
+            &limits,
+        ]
+        .concat(),
+    );
     for f in ["coverage", "success", "trajectories", "pushes"] {
         assert!(figures.join(format!("{f}.png")).is_file(), "{f}");
     }
+    const RESULTS: &str = "evaluation-replan-boards-1-expanded-2000.json";
     let evaluation: serde_json::Value =
-        serde_json::from_str(&std::fs::read_to_string(run.join("evaluation-replan.json")).unwrap())
-            .unwrap();
+        serde_json::from_str(&std::fs::read_to_string(run.join(RESULTS)).unwrap()).unwrap();
     let tasks: u64 = evaluation["results"]
         .as_array()
         .unwrap()
@@ -985,10 +1139,23 @@ fn uarm_twin_calibrates_and_trains() {
         "robot.toml",
         "metrics.jsonl",
         "provenance.jsonl",
-        "evaluation-replan.json",
+        RESULTS,
     ] {
         assert!(report.join("runs/run").join(f).is_file(), "{f}");
     }
+    // Planning commands name a robot run as such (issue 82: "unknown environment").
+    let board = "1,1,1,1,0,1,1,1,0,0,1,1,0,0,0,1,0,1,0,1,1,0,1,1,1";
+    for args in [
+        vec!["solve", "--run", s(&run), "--board", board],
+        vec!["evaluate", "--run", s(&run), "--boards", "1"],
+    ] {
+        check_bad_input(&args, "is a robot run (uarm-lightsout-absolute)");
+    }
+    // The report takes the run's one evaluation of another protocol, and names it.
+    assert!(
+        md.contains("| re-planning | boards-1, expanded-2000 | 1 |"),
+        "{md}"
+    );
 }
 
 /// A resumed robot run acts as it was trained: resuming a displacement run without
@@ -1032,7 +1199,8 @@ fn a_resumed_robot_run_keeps_its_action_space() {
     // An earlier checkpoint evaluated on its own, beside the final evaluation (issue 32: it
     // took the final evaluation's file).
     let (last, earlier) = add_an_earlier_checkpoint(&run);
-    let final_evaluation = std::fs::read_to_string(run.join("evaluation-replan.json")).unwrap();
+    const RESULTS: &str = "evaluation-replan-boards-1-expanded-2000.json";
+    let final_evaluation = std::fs::read_to_string(run.join(RESULTS)).unwrap();
     let evaluate = |extra: &[&str]| {
         let mut args = vec![
             "uarm",
@@ -1053,13 +1221,15 @@ fn a_resumed_robot_run_keeps_its_action_space() {
     let args = evaluate(&["--checkpoint", &earlier.to_string()]);
     seads_ok(&args.iter().map(String::as_str).collect::<Vec<_>>());
     let record: serde_json::Value = serde_json::from_str(
-        &std::fs::read_to_string(run.join(format!("evaluation-replan-epoch-{earlier:06}.json")))
-            .unwrap(),
+        &std::fs::read_to_string(run.join(format!(
+            "evaluation-replan-boards-1-expanded-2000-epoch-{earlier:06}.json"
+        )))
+        .unwrap(),
     )
     .unwrap();
     assert_eq!(record["checkpoint"]["epoch"], earlier, "{record}");
     assert_eq!(
-        std::fs::read_to_string(run.join("evaluation-replan.json")).unwrap(),
+        std::fs::read_to_string(run.join(RESULTS)).unwrap(),
         final_evaluation,
         "the final evaluation is untouched"
     );
@@ -1355,11 +1525,13 @@ fn a_robot_evaluation_is_the_same_whole_resumed_or_after_training() {
     args.extend(limits);
     args.extend(["--out", s(&run), "--quiet"]);
     seads_ok(&args);
-    const TASKS: &str = "evaluation-replan-tasks.jsonl";
+    // The files of this protocol (2 boards, 2,000 states).
+    const TASKS: &str = "evaluation-replan-boards-2-expanded-2000-tasks.jsonl";
+    const RESULTS: &str = "evaluation-replan-boards-2-expanded-2000.json";
     let tasks = |run: &std::path::Path| std::fs::read_to_string(run.join(TASKS)).unwrap();
     // The results without the search times, which differ between machines.
     let results = |run: &std::path::Path| {
-        let text = std::fs::read_to_string(run.join("evaluation-replan.json")).unwrap();
+        let text = std::fs::read_to_string(run.join(RESULTS)).unwrap();
         let mut v: serde_json::Value = serde_json::from_str(&text).unwrap();
         for r in v["results"].as_array_mut().unwrap() {
             r.as_object_mut().unwrap().remove("planning_s");
@@ -1386,7 +1558,7 @@ fn a_robot_evaluation_is_the_same_whole_resumed_or_after_training() {
         let to = dir.path().join(name);
         copy_dir(&run, &to);
         std::fs::remove_file(to.join(TASKS)).unwrap();
-        std::fs::remove_file(to.join("evaluation-replan.json")).unwrap();
+        std::fs::remove_file(to.join(RESULTS)).unwrap();
         to
     };
     let again = copy("again");
@@ -1594,6 +1766,32 @@ fn a_full_stdout_is_an_error_message_not_a_panic() {
     assert_eq!(stderr.trim().lines().count(), 1, "{stderr}");
 }
 
+/// A repository the user names must exist and be one (issue 82: `--repository /nonexistent`
+/// said "not checked" and exited 0); nothing is written.
+#[test]
+fn a_report_refuses_a_repository_that_is_not_one() {
+    let dir = tempfile::tempdir().unwrap();
+    let run = dir.path().join("run");
+    copy_tiny_run(&run);
+    let plain = dir.path().join("plain");
+    std::fs::create_dir(&plain).unwrap();
+    let out = dir.path().join("report");
+    for repository in [dir.path().join("nonexistent"), plain] {
+        check_bad_input(
+            &[
+                "report",
+                s(&run),
+                "--out",
+                s(&out),
+                "--repository",
+                s(&repository),
+            ],
+            "is not a git repository",
+        );
+        assert!(!out.exists(), "nothing written");
+    }
+}
+
 /// Reports never hide damage (issue 32): a run whose metrics start with a garbage line, or whose
 /// evaluation file is garbage, or whose configuration cannot be read, is listed as damaged with
 /// why and left out of the tables, not counted as "not started" or dropped without a word.
@@ -1687,6 +1885,48 @@ fn a_checkpoint_of_other_shapes_is_one_line_of_bad_input() {
     );
 }
 
+/// A checkpoint whose network file has one damaged tensor (a shape that merely broadcasts, a
+/// scalar, NaN, an infinity, float64) is refused by every command that loads it, in one line of
+/// bad input naming the file and the tensor (issue 82: the binary loaded the broadcasting shapes
+/// and NaN without a word and executed skills with them, and panicked on float64).
+#[test]
+fn a_checkpoint_with_a_damaged_tensor_is_refused() {
+    let dir = tempfile::tempdir().unwrap();
+    for file in ["forward_model.safetensors", "sac_actor.safetensors"] {
+        for damage in [
+            TensorDamage::Broadcast,
+            TensorDamage::Scalar,
+            TensorDamage::NotANumber,
+            TensorDamage::Infinite,
+            TensorDamage::Float64,
+        ] {
+            let run = dir.path().join(format!("{file}-{damage:?}"));
+            copy_tiny_run(&run);
+            let latest = std::fs::read_to_string(run.join("checkpoints/latest")).unwrap();
+            let path = run.join("checkpoints").join(latest.trim()).join(file);
+            let tensor = damage_tensor(&path, damage);
+            let board = "1,1,1,1,0,1,1,1,0,0,1,1,0,0,0,1,0,1,0,1,1,0,1,1,1";
+            for args in [
+                vec!["evaluate", "--run", s(&run), "--boards", "1", "--quiet"],
+                vec!["solve", "--run", s(&run), "--board", board],
+            ] {
+                let out = seads(&args);
+                let stderr = String::from_utf8_lossy(&out.stderr);
+                assert_eq!(
+                    out.status.code(),
+                    Some(2),
+                    "{file} {damage:?} {args:?}: {stderr}"
+                );
+                assert_eq!(stderr.lines().count(), 1, "{stderr}");
+                assert!(
+                    stderr.contains(file) && stderr.contains(&tensor),
+                    "{file} {damage:?}: {stderr}"
+                );
+            }
+        }
+    }
+}
+
 /// What a process did with a command line: its exit code, or `None` if it was still working
 /// after `patience` (then it is killed), and its stderr.
 fn run_for(args: &[String], patience: std::time::Duration) -> (Option<i32>, String) {
@@ -1767,6 +2007,95 @@ proptest::proptest! {
     }
 }
 
+/// Evaluations are keyed by their whole protocol (issue 82): one with other limits never
+/// replaces another's file, a file of another protocol found under an evaluation's name (as an
+/// older binary named them) is moved to its own name rather than overwritten, and a plot shows
+/// only an evaluation of the protocol it is asked for, never one with other limits.
+#[test]
+fn an_evaluation_of_another_protocol_never_replaces_or_stands_in_for_another() {
+    let dir = tempfile::tempdir().unwrap();
+    let run = dir.path().join("run");
+    copy_tiny_run(&run);
+    let evaluate = |extra: &[&str]| {
+        let base = [
+            "evaluate",
+            "--run",
+            s(&run),
+            "--boards",
+            "1",
+            "--replan",
+            "--quiet",
+        ];
+        seads_ok(&[&base[..], extra].concat());
+    };
+    const ROOMY: &str = "evaluation-replan-boards-1-expanded-2000";
+    const CRIPPLED: &str = "evaluation-replan-boards-1-expanded-1-timeout-0.5s";
+    evaluate(&["--max-expanded", "2000"]);
+    let roomy = std::fs::read(run.join(format!("{ROOMY}.json"))).unwrap();
+    evaluate(&["--max-expanded", "1", "--timeout", "0.5"]);
+    assert_eq!(
+        std::fs::read(run.join(format!("{ROOMY}.json"))).unwrap(),
+        roomy,
+        "untouched"
+    );
+    let crippled: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(run.join(format!("{CRIPPLED}.json"))).unwrap())
+            .unwrap();
+    assert_eq!(crippled["protocol"]["limits"]["max_expanded"], 1);
+    // A plot with the roomy limits shows the roomy evaluation, and one with the crippled limits
+    // the crippled one: each reuses its own, neither is evaluated again.
+    for limits in [
+        &["--max-expanded", "2000"][..],
+        &["--max-expanded", "1", "--timeout", "0.5"],
+    ] {
+        let out = dir.path().join("figures");
+        let args = ["plot", "--run", s(&run), "--out", s(&out), "--boards", "1"];
+        seads_ok(&[&args[..], limits].concat());
+    }
+    assert_eq!(
+        std::fs::read(run.join(format!("{ROOMY}.json"))).unwrap(),
+        roomy
+    );
+    // The crippled record found where the roomy one goes (as an older binary, which named files
+    // by fewer parts of the protocol, left it): it moves to its own name, tasks and all.
+    let older = dir.path().join("older");
+    copy_tiny_run(&older);
+    let crippled_text = std::fs::read(run.join(format!("{CRIPPLED}.json"))).unwrap();
+    let crippled_tasks = std::fs::read(run.join(format!("{CRIPPLED}-tasks.jsonl"))).unwrap();
+    std::fs::write(older.join(format!("{ROOMY}.json")), &crippled_text).unwrap();
+    std::fs::write(older.join(format!("{ROOMY}-tasks.jsonl")), &crippled_tasks).unwrap();
+    let base = [
+        "evaluate",
+        "--run",
+        s(&older),
+        "--boards",
+        "1",
+        "--replan",
+        "--quiet",
+    ];
+    seads_ok(&[&base[..], &["--max-expanded", "2000"]].concat());
+    assert_eq!(
+        std::fs::read(older.join(format!("{CRIPPLED}.json"))).unwrap(),
+        crippled_text
+    );
+    assert_eq!(
+        std::fs::read(older.join(format!("{CRIPPLED}-tasks.jsonl"))).unwrap(),
+        crippled_tasks
+    );
+    let now: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(older.join(format!("{ROOMY}.json"))).unwrap())
+            .unwrap();
+    assert_eq!(now["protocol"]["limits"]["max_expanded"], 2000, "{now}");
+    // Where the moved record's own name is taken too, nothing is moved or lost: bad input.
+    std::fs::write(older.join(format!("{ROOMY}.json")), &crippled_text).unwrap();
+    let before = data_snapshot(&older);
+    check_bad_input(
+        &[&base[..], &["--max-expanded", "2000"]].concat(),
+        "holds an evaluation of another protocol",
+    );
+    assert_eq!(data_snapshot(&older), before);
+}
+
 /// `seads evaluate --search both-ends --memory-limit GIB` records both in its protocol and solves
 /// as many of the tiny agent's boards as breadth-first search does; an unknown search is bad
 /// input.
@@ -1775,20 +2104,23 @@ fn an_evaluation_records_its_search_and_memory_bound() {
     let dir = tempfile::tempdir().unwrap();
     let run = dir.path().join("run");
     copy_tiny_run(&run);
-    let evaluate = |extra: &[&str]| -> serde_json::Value {
+    let evaluate = |extra: &[&str], file: &str| -> serde_json::Value {
         let mut args = vec!["evaluate", "--run", s(&run), "--boards", "3", "--replan"];
         args.extend(["--max-expanded", "20000", "--json"]);
         args.extend(extra);
         seads_ok(&args);
-        serde_json::from_slice(&std::fs::read(run.join("evaluation-replan.json")).unwrap()).unwrap()
+        serde_json::from_slice(&std::fs::read(run.join(file)).unwrap()).unwrap()
     };
-    let breadth = evaluate(&[]);
+    let breadth = evaluate(&[], "evaluation-replan-boards-3-expanded-20000.json");
     let limits = &breadth["protocol"]["limits"];
     assert!(
         limits.get("search").is_none() && limits.get("memory_limit_mib").is_none(),
         "{limits}"
     );
-    let both = evaluate(&["--search", "both-ends", "--memory-limit", "16"]);
+    let both = evaluate(
+        &["--search", "both-ends", "--memory-limit", "16"],
+        "evaluation-replan-boards-3-expanded-20000-both-ends-memory-16384mib.json",
+    );
     let limits = &both["protocol"]["limits"];
     assert_eq!(limits["search"], "both-ends", "{limits}");
     assert_eq!(limits["memory_limit_mib"], 16384, "{limits}");
@@ -1847,8 +2179,8 @@ fn an_evaluation_under_action_noise_has_files_of_its_own_and_repeats() {
     };
     call("");
     call("0.05");
-    let plain = run.join("evaluation-replan-depths-1-2.json");
-    let noisy = run.join("evaluation-replan-depths-1-2-noise-0.05.json");
+    let plain = run.join("evaluation-replan-depths-1-2-boards-2-expanded-500.json");
+    let noisy = run.join("evaluation-replan-depths-1-2-boards-2-expanded-500-noise-0.05.json");
     let record: serde_json::Value =
         serde_json::from_slice(&std::fs::read(&noisy).unwrap()).unwrap();
     assert_eq!(record["protocol"]["action_noise"], 0.05, "{record}");
@@ -1862,7 +2194,8 @@ fn an_evaluation_under_action_noise_has_files_of_its_own_and_repeats() {
             .map(|l| serde_json::from_str(l).unwrap())
             .collect()
     };
-    let noisy_tasks = run.join("evaluation-replan-depths-1-2-noise-0.05-tasks.jsonl");
+    let noisy_tasks =
+        run.join("evaluation-replan-depths-1-2-boards-2-expanded-500-noise-0.05-tasks.jsonl");
     let first = tasks(&noisy_tasks);
     call("0.05");
     assert_eq!(tasks(&noisy_tasks), first, "the same seeds, the same noise");
@@ -2037,14 +2370,14 @@ fn a_plot_of_an_earlier_checkpoint_reuses_its_evaluation_and_names_its_epoch() {
         figures
     };
     plot("first");
-    let record: serde_json::Value = serde_json::from_str(
-        &std::fs::read_to_string(run.join(format!("evaluation-replan-epoch-{earlier:06}.json")))
-            .unwrap(),
-    )
-    .unwrap();
+    // Named by the protocol (1 board, 2,000 states) and the epoch.
+    let stem = format!("evaluation-replan-boards-1-expanded-2000-epoch-{earlier:06}");
+    let record: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(run.join(format!("{stem}.json"))).unwrap())
+            .unwrap();
     assert_eq!(record["checkpoint"]["epoch"], earlier, "{record}");
     // A planted line stands in for the tasks the evaluation wrote: evaluating again rewrites them.
-    let tasks = run.join(format!("evaluation-replan-epoch-{earlier:06}-tasks.jsonl"));
+    let tasks = run.join(format!("{stem}-tasks.jsonl"));
     std::fs::write(&tasks, "planted\n").unwrap();
     let figures = plot("second");
     assert_eq!(std::fs::read_to_string(&tasks).unwrap(), "planted\n");
@@ -2480,9 +2813,10 @@ fn the_golden_runs_first_100_epochs_repeat_line_for_line() {
 fn a_stopped_evaluation_resumes_from_its_finished_tasks() {
     let dir = tempfile::tempdir().unwrap();
     let evaluate = |run: &std::path::Path| evaluate_two_boards_of_depths_1_2(s(run));
-    const TASKS: &str = "evaluation-replan-depths-1-2-tasks.jsonl";
+    let tasks_file = format!("{TWO_BOARDS}-tasks.jsonl");
+    let tasks_file = tasks_file.as_str();
     let lines = |run: &std::path::Path| -> Vec<serde_json::Value> {
-        std::fs::read_to_string(run.join(TASKS))
+        std::fs::read_to_string(run.join(tasks_file))
             .unwrap()
             .lines()
             .map(|l| {
@@ -2497,13 +2831,13 @@ fn a_stopped_evaluation_resumes_from_its_finished_tasks() {
     let reference = evaluate(&whole);
     let whole_lines = lines(&whole);
     assert_eq!(whole_lines.len(), 4);
-    assert!(!whole.join(format!("{TASKS}.partial")).exists());
+    assert!(!whole.join(format!("{tasks_file}.partial")).exists());
     let record: serde_json::Value = serde_json::from_str(
-        &std::fs::read_to_string(whole.join("evaluation-replan-depths-1-2.json")).unwrap(),
+        &std::fs::read_to_string(whole.join(format!("{TWO_BOARDS}.json"))).unwrap(),
     )
     .unwrap();
     let header = |protocol: &serde_json::Value| serde_json::json!({"evaluation": {"protocol": protocol, "checkpoint": record["checkpoint"]}});
-    let first_two: Vec<String> = std::fs::read_to_string(whole.join(TASKS))
+    let first_two: Vec<String> = std::fs::read_to_string(whole.join(tasks_file))
         .unwrap()
         .lines()
         .take(2)
@@ -2534,7 +2868,7 @@ fn a_stopped_evaluation_resumes_from_its_finished_tasks() {
         "{}\n{planted}\n{second}\n{{\"depth\": 2, \"se",
         header(&record["protocol"])
     );
-    std::fs::write(resumed.join(format!("{TASKS}.partial")), partial).unwrap();
+    std::fs::write(resumed.join(format!("{tasks_file}.partial")), partial).unwrap();
     let out = evaluate_two_boards_of_depths_1_2_output(s(&resumed));
     let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
     let note = String::from_utf8_lossy(&out.stderr);
@@ -2561,7 +2895,7 @@ fn a_stopped_evaluation_resumes_from_its_finished_tasks() {
         "{version} {this}"
     );
     let resumed_record: serde_json::Value = serde_json::from_str(
-        &std::fs::read_to_string(resumed.join("evaluation-replan-depths-1-2.json")).unwrap(),
+        &std::fs::read_to_string(resumed.join(format!("{TWO_BOARDS}.json"))).unwrap(),
     )
     .unwrap();
     assert_eq!(
@@ -2575,10 +2909,10 @@ fn a_stopped_evaluation_resumes_from_its_finished_tasks() {
     let mut anonymous = second.clone();
     anonymous.as_object_mut().unwrap().remove("by");
     let partial = format!("{}\n{planted}\n{anonymous}\n", header(&record["protocol"]));
-    std::fs::write(unnamed.join(format!("{TASKS}.partial")), partial).unwrap();
+    std::fs::write(unnamed.join(format!("{tasks_file}.partial")), partial).unwrap();
     evaluate(&unnamed);
     let unnamed_record: serde_json::Value = serde_json::from_str(
-        &std::fs::read_to_string(unnamed.join("evaluation-replan-depths-1-2.json")).unwrap(),
+        &std::fs::read_to_string(unnamed.join(format!("{TWO_BOARDS}.json"))).unwrap(),
     )
     .unwrap();
     assert!(
@@ -2592,15 +2926,46 @@ fn a_stopped_evaluation_resumes_from_its_finished_tasks() {
         "{v}"
     );
     assert_eq!(v["success_rate"]["2"], reference["success_rate"]["2"]);
-    assert!(!resumed.join(format!("{TASKS}.partial")).exists());
+    assert!(!resumed.join(format!("{tasks_file}.partial")).exists());
     // Another protocol's file is not this evaluation's: everything is solved anew.
     let other = dir.path().join("other");
     copy_tiny_run(&other);
     let mut protocol = record["protocol"].clone();
     protocol["tasks"]["boards"] = 3.into();
     let partial = format!("{}\n{planted}\n", header(&protocol));
-    std::fs::write(other.join(format!("{TASKS}.partial")), partial).unwrap();
+    std::fs::write(other.join(format!("{tasks_file}.partial")), partial).unwrap();
     let v = evaluate(&other);
     assert_eq!(lines(&other), whole_lines);
     assert_eq!(v["success_rate"], reference["success_rate"]);
+    // A damaged line in the middle costs its own task only, and is said (issue 82: it threw
+    // every finished task away without a word): the planted task before it and the one after it
+    // stand, and the damaged one is solved again.
+    let damaged = dir.path().join("damaged");
+    copy_tiny_run(&damaged);
+    let whole_tasks = std::fs::read_to_string(whole.join(tasks_file)).unwrap();
+    let mut third: serde_json::Value =
+        serde_json::from_str(whole_tasks.lines().nth(2).unwrap()).unwrap();
+    third["planning_s"] = serde_json::json!(0.125);
+    third["by"] = earlier.clone();
+    let partial = format!(
+        "{}\n{planted}\n{{\"depth\": 1, garbage\n{third}\n",
+        header(&record["protocol"])
+    );
+    std::fs::write(damaged.join(format!("{tasks_file}.partial")), partial).unwrap();
+    let out = evaluate_two_boards_of_depths_1_2_output(s(&damaged));
+    let note = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        note.contains("resuming an evaluation: 2 of 4 tasks finished before"),
+        "{note}"
+    );
+    assert!(
+        note.contains("1 damaged line(s) in the journal of a stopped evaluation were left out"),
+        "{note}"
+    );
+    let mut expected = whole_lines.clone();
+    expected[0] = planted.clone();
+    expected[0].as_object_mut().unwrap().remove("planning_s");
+    expected[0].as_object_mut().unwrap().remove("by");
+    assert_eq!(lines(&damaged), expected);
+    assert!(!damaged.join(format!("{tasks_file}.partial")).exists());
 }

@@ -109,3 +109,120 @@ pub fn copy_dir(from: &Path, to: &Path) {
         }
     }
 }
+
+/// Every file under `dir` with its bytes, in path order.
+pub fn snapshot(dir: &Path) -> Vec<(std::path::PathBuf, Vec<u8>)> {
+    let mut files = Vec::new();
+    let mut stack = vec![dir.to_path_buf()];
+    while let Some(d) = stack.pop() {
+        for entry in std::fs::read_dir(&d).unwrap() {
+            let path = entry.unwrap().path();
+            if path.is_dir() {
+                stack.push(path);
+            } else {
+                files.push((path.clone(), std::fs::read(&path).unwrap()));
+            }
+        }
+    }
+    files.sort();
+    files
+}
+
+/// How [`damage_tensor`] changes one tensor of a checkpoint file.
+#[derive(Debug, Clone, Copy)]
+pub enum TensorDamage {
+    /// A `[1, n]` weight where the network has `[m, n]`: a copy would broadcast it.
+    Broadcast,
+    /// A scalar where the network has a matrix.
+    Scalar,
+    /// The first value NaN.
+    NotANumber,
+    /// The first value infinite.
+    Infinite,
+    /// The values stored as float64.
+    Float64,
+}
+
+/// Rewrites the first two-dimensional tensor (of more than one row) of the safetensors file
+/// `path` as `damage` says, leaving the others as they were (safetensors: a little-endian header
+/// length, the JSON header, the data). Returns the tensor's name.
+pub fn damage_tensor(path: &Path, damage: TensorDamage) -> String {
+    let bytes = std::fs::read(path).unwrap();
+    let length = u64::from_le_bytes(bytes[..8].try_into().unwrap()) as usize;
+    let header: serde_json::Map<String, serde_json::Value> =
+        serde_json::from_slice(&bytes[8..8 + length]).unwrap();
+    let data = &bytes[8 + length..];
+    let mut tensors: Vec<(String, serde_json::Value)> = header
+        .into_iter()
+        .filter(|(name, _)| name != "__metadata__")
+        .collect();
+    tensors.sort_by_key(|(_, info)| info["data_offsets"][0].as_u64().unwrap());
+    let target = tensors
+        .iter()
+        .find(|(_, info)| {
+            let shape = info["shape"].as_array().unwrap();
+            shape.len() == 2 && shape[0].as_u64().unwrap() > 1
+        })
+        .expect("a matrix of more than one row")
+        .0
+        .clone();
+    let mut out_header = serde_json::Map::new();
+    let mut out_data = Vec::new();
+    for (name, info) in tensors {
+        let (start, end) = (
+            info["data_offsets"][0].as_u64().unwrap() as usize,
+            info["data_offsets"][1].as_u64().unwrap() as usize,
+        );
+        let mut values: Vec<u8> = data[start..end].to_vec();
+        let mut info = info.clone();
+        if name == target {
+            let shape: Vec<u64> = info["shape"]
+                .as_array()
+                .unwrap()
+                .iter()
+                .map(|d| d.as_u64().unwrap())
+                .collect();
+            match damage {
+                TensorDamage::Broadcast => {
+                    values.truncate(4 * shape[1] as usize);
+                    info["shape"] = serde_json::json!([1, shape[1]]);
+                }
+                TensorDamage::Scalar => {
+                    values.truncate(4);
+                    info["shape"] = serde_json::json!([]);
+                }
+                TensorDamage::NotANumber => values[..4].copy_from_slice(&f32::NAN.to_le_bytes()),
+                TensorDamage::Infinite => {
+                    values[..4].copy_from_slice(&f32::INFINITY.to_le_bytes());
+                }
+                TensorDamage::Float64 => {
+                    values = values
+                        .chunks_exact(4)
+                        .flat_map(|b| {
+                            f64::from(f32::from_le_bytes(b.try_into().unwrap())).to_le_bytes()
+                        })
+                        .collect();
+                    info["dtype"] = "F64".into();
+                }
+            }
+        }
+        info["data_offsets"] = serde_json::json!([out_data.len(), out_data.len() + values.len()]);
+        out_data.extend(values);
+        out_header.insert(name, info);
+    }
+    let text = serde_json::to_vec(&out_header).unwrap();
+    let mut file = (text.len() as u64).to_le_bytes().to_vec();
+    file.extend(&text);
+    file.extend(out_data);
+    std::fs::write(path, file).unwrap();
+    target
+}
+
+/// [`snapshot`] without the run lock's note of who held it last (`task.lock`), which every
+/// command that takes the lock rewrites: the data of a run directory.
+pub fn data_snapshot(dir: &Path) -> Vec<(std::path::PathBuf, Vec<u8>)> {
+    snapshot(dir)
+        .into_iter()
+        .filter(|(path, _)| path.file_name().is_none_or(|n| n != "task.lock"))
+        .collect()
+}

@@ -13,7 +13,9 @@ use std::sync::OnceLock;
 
 use serde_json::Value;
 
-use crate::common::{copy_dir, kill_at_moment, metrics_without_clock, park_at_moment};
+use crate::common::{
+    TensorDamage, copy_dir, damage_tensor, kill_at_moment, metrics_without_clock, park_at_moment,
+};
 
 const SEADS: &str = env!("CARGO_BIN_EXE_seads");
 
@@ -238,6 +240,37 @@ fn a_torn_line_and_a_corrupt_latest_checkpoint_are_repaired() {
     assert_eq!(metrics_without_clock(&out), base.metrics);
 }
 
+/// A latest checkpoint whose actor holds a float64 tensor (issue 82: `train --resume` panicked
+/// on it) or whose forward model holds NaN is passed over like any unreadable checkpoint: the
+/// run resumes from the one before, says so, and ends as the run that was never damaged.
+#[test]
+fn a_latest_checkpoint_with_a_damaged_tensor_is_passed_over() {
+    let base = baseline();
+    let point = after_a_later_checkpoint(base);
+    let dir = tempfile::tempdir().unwrap();
+    for (file, damage) in [
+        ("sac_actor.safetensors", TensorDamage::Float64),
+        ("forward_model.safetensors", TensorDamage::NotANumber),
+    ] {
+        let out = dir.path().join(file);
+        start_and_kill(&base.config, &out, point);
+        let latest = std::fs::read_to_string(out.join("checkpoints/latest")).unwrap();
+        damage_tensor(
+            &out.join("checkpoints").join(latest.trim()).join(file),
+            damage,
+        );
+        let output = resume(&out);
+        let stderr = String::from_utf8_lossy(&output.stderr).into_owned();
+        assert!(output.status.success(), "{file}: {stderr}");
+        assert!(
+            stderr.contains("passed over checkpoint"),
+            "{file}: {stderr}"
+        );
+        assert!(!stderr.contains("panicked"), "{file}: {stderr}");
+        assert_eq!(metrics_without_clock(&out), base.metrics, "{file}");
+    }
+}
+
 /// `--env-steps` with `--resume` raises a finished run's budget and records it; lowering it is
 /// bad input.
 #[test]
@@ -444,11 +477,36 @@ fn a_twin_run_killed_and_resumed_is_the_run_never_killed() {
             .0;
     let resumed = dir.path().join("resumed");
     kill_at_moment(uarm(&resumed, &new), point);
-    // The same run with a checkpoint from before checkpoints kept the twin: it says that it goes
-    // on with a fresh twin, and it parts from the whole run.
+    // A checkpoint that lost the twin's state although its origin says it kept it is damaged,
+    // not old (issue 82: it was resumed with a fresh twin, "written before checkpoints kept
+    // it"): it is passed over, and with no other checkpoint the resume is refused, saying why.
+    let damaged = dir.path().join("damaged");
+    copy_dir(&resumed, &damaged);
+    let checkpoint = damaged.join("checkpoints/epoch-000100");
+    let origin = std::fs::read_to_string(checkpoint.join("origin.json")).unwrap();
+    assert!(origin.contains("\"carried_state\":true"), "{origin}");
+    std::fs::remove_file(checkpoint.join("environment.json")).unwrap();
+    let before = std::fs::read(damaged.join("metrics.jsonl")).unwrap();
+    let output = uarm(&damaged, &["--resume"]).output().unwrap();
+    let stderr = String::from_utf8_lossy(&output.stderr);
+    assert!(!output.status.success(), "{stderr}");
+    assert!(stderr.contains("environment.json is missing"), "{stderr}");
+    assert_eq!(
+        std::fs::read(damaged.join("metrics.jsonl")).unwrap(),
+        before
+    );
+    // The same run with a checkpoint from before checkpoints kept the twin (no environment.json,
+    // and an origin that does not say it kept one): it says that it goes on with a fresh twin,
+    // and it parts from the whole run.
     let stale = dir.path().join("stale");
     copy_dir(&resumed, &stale);
-    std::fs::remove_file(stale.join("checkpoints/epoch-000100/environment.json")).unwrap();
+    let checkpoint = stale.join("checkpoints/epoch-000100");
+    std::fs::remove_file(checkpoint.join("environment.json")).unwrap();
+    std::fs::write(
+        checkpoint.join("origin.json"),
+        origin.replace(",\"carried_state\":true", ""),
+    )
+    .unwrap();
     let output = uarm(&stale, &["--resume"]).output().unwrap();
     assert!(output.status.success(), "{output:?}");
     let stderr = String::from_utf8_lossy(&output.stderr);
@@ -467,13 +525,15 @@ fn a_twin_run_killed_and_resumed_is_the_run_never_killed() {
     assert_eq!(read(&resumed, last), read(&whole, last));
     // The evaluation, without the search times that differ between machines.
     let results = |run: &Path| {
-        let mut v: Value = serde_json::from_str(&read(run, "evaluation-replan.json")).unwrap();
+        let mut v: Value =
+            serde_json::from_str(&read(run, "evaluation-replan-boards-1-expanded-1000.json"))
+                .unwrap();
         for r in v["results"].as_array_mut().unwrap() {
             r.as_object_mut().unwrap().remove("planning_s");
         }
         v
     };
     assert_eq!(results(&resumed), results(&whole));
-    const TASKS: &str = "evaluation-replan-tasks.jsonl";
+    const TASKS: &str = "evaluation-replan-boards-1-expanded-1000-tasks.jsonl";
     assert_eq!(read(&resumed, TASKS), read(&whole, TASKS));
 }

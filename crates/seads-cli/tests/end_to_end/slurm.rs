@@ -315,7 +315,11 @@ fn a_sweep_runs_as_a_slurm_job_array_and_its_tasks_resume() {
         let last: serde_json::Value =
             serde_json::from_str(metrics.lines().last().unwrap()).unwrap();
         assert!(last["env_steps"].as_u64().unwrap() >= 1500);
-        assert!(run.join("evaluation-replan.json").is_file());
+        // Named by how the manifest's protocol departs from the standard one.
+        assert!(
+            run.join("evaluation-replan-boards-1-expanded-2000-timeout-600s.json")
+                .is_file()
+        );
     }
     let job = cluster.run("scontrol", &["show", "job", &format!("{array}_3")]);
     assert!(job.contains("JobState=FAILED"), "{job}");

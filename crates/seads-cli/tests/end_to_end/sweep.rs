@@ -54,26 +54,13 @@ fn seads_only_without_evaluation_over_training() -> String {
     )
 }
 
+/// The files of the manifest's evaluation (1 board per depth, searches of at most 2,000 states
+/// or 600 s): named by how their protocol departs from the standard one.
+const REPLAN: &str = "evaluation-replan-boards-1-expanded-2000-timeout-600s.json";
+const PLAN_ONCE: &str = "evaluation-plan-once-boards-1-expanded-2000-timeout-600s.json";
+
 fn status_json(sweep: &Path) -> serde_json::Value {
     serde_json::from_slice(&seads_ok(&["sweep", "status", s(sweep), "--json"]).stdout).unwrap()
-}
-
-/// Every file under `dir` with its bytes.
-fn snapshot(dir: &Path) -> Vec<(PathBuf, Vec<u8>)> {
-    let mut files = Vec::new();
-    let mut stack = vec![dir.to_path_buf()];
-    while let Some(d) = stack.pop() {
-        for entry in std::fs::read_dir(&d).unwrap() {
-            let path = entry.unwrap().path();
-            if path.is_dir() {
-                stack.push(path);
-            } else {
-                files.push((path.clone(), std::fs::read(&path).unwrap()));
-            }
-        }
-    }
-    files.sort();
-    files
 }
 
 #[test]
@@ -113,8 +100,8 @@ fn a_sweep_is_planned_once_run_to_the_end_and_reported() {
         let dir = PathBuf::from(run["dir"].as_str().unwrap());
         assert!(run["env_steps"].as_u64().unwrap() >= 600);
         for file in [
-            "evaluation-replan.json",
-            "evaluation-plan-once.json",
+            REPLAN,
+            PLAN_ONCE,
             "evaluation-over-training.jsonl",
             "task.log",
         ] {
@@ -278,7 +265,8 @@ fn a_sweep_is_planned_once_run_to_the_end_and_reported() {
             .is_file()
     );
     assert!(
-        data.join("runs/lightsout-cursor/seads/seed-1/evaluation-replan.json")
+        data.join("runs/lightsout-cursor/seads/seed-1")
+            .join(REPLAN)
             .is_file()
     );
     assert!(
@@ -319,7 +307,7 @@ fn a_sweep_is_planned_once_run_to_the_end_and_reported() {
         "the legend names each curve's runs"
     );
     // Tasks that ended at the clock are named in the report.
-    let evaluation = data.join("runs/lightsout-cursor/seads/seed-1/evaluation-replan.json");
+    let evaluation = data.join("runs/lightsout-cursor/seads/seed-1").join(REPLAN);
     let mut v: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(&evaluation).unwrap()).unwrap();
     v["results"][2]["timeouts"] = 1.into();
@@ -649,7 +637,7 @@ fn results(run: &Path) -> (Vec<serde_json::Value>, Vec<serde_json::Value>) {
         })
         .collect();
     let mut evaluations = Vec::new();
-    for file in ["evaluation-replan.json", "evaluation-plan-once.json"] {
+    for file in [REPLAN, PLAN_ONCE] {
         let mut v: serde_json::Value =
             serde_json::from_str(&std::fs::read_to_string(run.join(file)).unwrap()).unwrap();
         for depth in v["results"].as_array_mut().unwrap() {
@@ -939,6 +927,58 @@ fn a_study_refuses_a_dirty_binary() {
             stderr.contains(ordinary),
             "{args:?} --allow-dirty: {stderr}"
         );
+    }
+    assert_eq!(snapshot(&out), planned, "nothing trained or written");
+}
+
+/// `SEADS_ALLOW_DIRTY` takes the usual boolean spellings (issue 82: `1` made every `sweep run`
+/// fail with "invalid value '1' for '--allow-dirty'", naming a flag the user never passed), and a
+/// value that is none of them is one line of bad input that names the variable, not the flag.
+#[test]
+fn the_allow_dirty_variable_takes_the_usual_booleans_and_an_error_names_it() {
+    let tmp = tempfile::tempdir().unwrap();
+    let (_, out) = planned_sweep(tmp.path());
+    let planned = snapshot(&out);
+    let version = String::from_utf8(seads_ok(&["--version"]).stdout).unwrap();
+    let dirty = version.contains("uncommitted changes: true");
+    let with = |value: &str, args: &[&str]| {
+        let mut command = seads_command();
+        command.env("SEADS_ALLOW_DIRTY", value).args(args);
+        let output = command.output().unwrap();
+        let stderr = String::from_utf8_lossy(&output.stderr).into_owned();
+        assert_eq!(
+            output.status.code(),
+            Some(2),
+            "{value:?} {args:?}: {stderr}"
+        );
+        assert_eq!(stderr.lines().count(), 1, "one line: {stderr}");
+        stderr
+    };
+    for args in [
+        vec!["sweep", "run", s(&out), "--seeds", "7"],
+        vec!["sweep", "task", s(&out), "--index", "4"],
+    ] {
+        for yes in ["1", "true", "TRUE", "yes", "on"] {
+            let stderr = with(yes, &args);
+            assert!(
+                stderr.contains("has no seed 7") || stderr.contains("out of range"),
+                "{yes:?} allows: {stderr}"
+            );
+        }
+        for no in ["0", "false", "no", "off", ""] {
+            let stderr = with(no, &args);
+            let refused = stderr.contains("uncommitted changes");
+            assert_eq!(refused, dirty, "{no:?} does not allow: {stderr}");
+        }
+        for bad in ["maybe", "2"] {
+            for extra in [&[][..], &["--allow-dirty"][..]] {
+                let stderr = with(bad, &[&args[..], extra].concat());
+                assert!(
+                    stderr.contains("SEADS_ALLOW_DIRTY") && !stderr.contains("--allow-dirty"),
+                    "{bad:?}: {stderr}"
+                );
+            }
+        }
     }
     assert_eq!(snapshot(&out), planned, "nothing trained or written");
 }

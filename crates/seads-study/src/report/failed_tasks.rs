@@ -167,7 +167,7 @@ pub fn failed_task_tables(groups: &[Group<'_>]) -> Result<Option<(String, String
     for g in groups {
         let mut tasks = Vec::new();
         for run in &g.runs {
-            if let Some(lines) = read_tasks(&run.dir)? {
+            if let Some(lines) = read_tasks(run)? {
                 tasks.push((run, lines));
             }
         }

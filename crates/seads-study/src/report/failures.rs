@@ -10,8 +10,7 @@ use crate::Result;
 use serde::Deserialize;
 
 use super::csv_field;
-use super::runs::Group;
-use seads_planner::{EvaluationKind, STANDARD_DEPTHS};
+use super::runs::{Group, RunData};
 
 /// What the report reads of one line of a per-task file (`failed_tasks.rs` lists the failed
 /// ones).
@@ -100,13 +99,19 @@ impl Summary {
     }
 }
 
-/// The per-task lines of a run, or `None` if it has no per-task file.
-pub(super) fn read_tasks(run: &Path) -> Result<Option<Vec<TaskLine>>> {
-    let path = run.join(EvaluationKind::Replan.tasks_file(&STANDARD_DEPTHS, None));
+/// The per-task lines of the re-planning evaluation a report takes of `run` (its standard one,
+/// else its one of another protocol: [`RunData::replan_tasks`]), or `None` if it has no
+/// per-task file.
+pub(super) fn read_tasks(run: &RunData) -> Result<Option<Vec<TaskLine>>> {
+    read_tasks_file(&run.dir.join(&run.replan_tasks))
+}
+
+/// The per-task lines of the file `path`, or `None` if there is none.
+fn read_tasks_file(path: &Path) -> Result<Option<Vec<TaskLine>>> {
     if !path.exists() {
         return Ok(None);
     }
-    Ok(Some(seads_rl::store::read_json_lines(&path)?.0))
+    Ok(Some(seads_rl::store::read_json_lines(path)?.0))
 }
 
 /// The markdown section (without its heading) and two CSV tables (`failures.csv` per group,
@@ -116,7 +121,7 @@ pub fn failure_tables(groups: &[Group<'_>]) -> Result<Option<(String, String, St
     for g in groups {
         let mut summary = Summary::default();
         for run in &g.runs {
-            if let Some(tasks) = read_tasks(&run.dir)? {
+            if let Some(tasks) = read_tasks(run)? {
                 summary.add(&tasks);
             }
         }
@@ -181,7 +186,8 @@ pub fn failure_tables(groups: &[Group<'_>]) -> Result<Option<(String, String, St
             );
         }
     }
-    md += "\nFrom each run's `evaluation-replan-tasks.jsonl` (runs evaluated before that file existed \
+    md += "\nFrom each run's `evaluation-replan-tasks.jsonl`, or the per-task file of its one \
+           re-planning evaluation of another protocol (runs evaluated before that file existed \
            are not counted). A deviation is an executed skill that left another board than the \
            forward model predicted; \"board unchanged\" ones did nothing to the board (no push, or \
            the step limit). Every deviation with its boards is in the per-task files.\n";
@@ -234,15 +240,14 @@ mod tests {
 
     #[test]
     fn a_run_without_a_per_task_file_is_skipped_and_a_broken_line_is_an_error() {
+        use seads_planner::{EvaluationKind, STANDARD_DEPTHS};
         let dir = tempfile::tempdir().unwrap();
-        assert!(read_tasks(dir.path()).unwrap().is_none());
-        std::fs::write(
-            dir.path()
-                .join(EvaluationKind::Replan.tasks_file(&STANDARD_DEPTHS, None)),
-            "{\"solved\": true}\n",
-        )
-        .unwrap();
-        let err = read_tasks(dir.path()).unwrap_err();
+        let path = dir
+            .path()
+            .join(EvaluationKind::Replan.tasks_file(&STANDARD_DEPTHS, None));
+        assert!(read_tasks_file(&path).unwrap().is_none());
+        std::fs::write(&path, "{\"solved\": true}\n").unwrap();
+        let err = read_tasks_file(&path).unwrap_err();
         assert!(format!("{err:#}").contains("tasks.jsonl:1"), "{err:#}");
     }
 }

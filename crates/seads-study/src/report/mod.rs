@@ -22,6 +22,7 @@ use std::path::{Path, PathBuf};
 use crate::{Context as _, Result, StudyError};
 
 pub use runs::data_files;
+pub use versions::is_repository;
 
 /// A CSV field, quoted when it holds a comma or a quote (RFC 4180).
 fn csv_field(text: &str) -> String {

@@ -47,6 +47,13 @@ pub struct RunData {
     pub replan: Option<Vec<DepthResult>>,
     /// Final task evaluation without re-planning, if any.
     pub plan_once: Option<Vec<DepthResult>>,
+    /// The per-task file of the re-planning evaluation taken (`evaluation-replan-tasks.jsonl`
+    /// for the standard protocol), in the run directory.
+    pub replan_tasks: String,
+    /// The protocol of each of these three final evaluations (re-planning, plan once, policy),
+    /// in a few words ([`Protocol::label`]: `standard`, or how it departs from the standard
+    /// one; `not recorded` for a record without its protocol).
+    pub success_protocols: [Option<String>; 3],
     /// Final task evaluations under action noise: (σ, with re-planning, per depth), in the
     /// order of their files' names.
     pub noisy: Vec<(f64, bool, Vec<DepthResult>)>,
@@ -110,16 +117,55 @@ impl RunData {
         let mut evaluation_notes = Vec::new();
         let mut unrecorded_evaluations = 0;
         let mut evaluated_by = Evaluators::default();
-        let mut evaluation = |kind: EvaluationKind| -> Result<Option<Vec<DepthResult>>> {
+        let further = further_evaluations(dir, last_epoch, &mut damage, &mut evaluated_by);
+        // A run's final evaluation of a kind on the standard depths: the standard protocol's
+        // file (whatever protocol an older binary wrote there), else the one evaluation of
+        // another protocol there is (a study that set its own boards or limits); several are
+        // left out, since none of them is the run's. Each comes with its protocol's label.
+        let mut replan_tasks = EvaluationKind::Replan.tasks_file(&STANDARD_DEPTHS, None);
+        let mut evaluation = |kind: EvaluationKind| -> Result<Option<(Vec<DepthResult>, String)>> {
             let file = kind.results_file(&STANDARD_DEPTHS, None);
             let record = match crate::evaluation::read_evaluation(&dir.join(&file)) {
                 Ok(Some(record)) => record,
-                Ok(None) => return Ok(None),
+                Ok(None) => {
+                    let others: Vec<&(Protocol, Vec<DepthResult>)> = further
+                        .iter()
+                        .filter(|(p, _)| {
+                            p.kind == kind
+                                && p.tasks.depths == STANDARD_DEPTHS
+                                && p.action_noise.is_none()
+                        })
+                        .collect();
+                    return Ok(match others.as_slice() {
+                        [] => None,
+                        [(protocol, results)] => {
+                            if kind == EvaluationKind::Replan {
+                                replan_tasks = protocol.tasks_file(None);
+                            }
+                            Some((results.clone(), protocol.label()))
+                        }
+                        several => {
+                            let labels: Vec<String> =
+                                several.iter().map(|(p, _)| p.label()).collect();
+                            evaluation_notes.push(format!(
+                                "{} evaluations ({}) of other protocols than the standard one \
+                                 and none of it: left out",
+                                kind.name(),
+                                labels.join("; ")
+                            ));
+                            None
+                        }
+                    });
+                }
                 Err(e) => {
                     damage.push(format!("{e:#}"));
                     return Ok(None);
                 }
             };
+            let protocol = record
+                .protocol
+                .as_ref()
+                .map_or_else(|| "not recorded".to_owned(), Protocol::label);
             match record.checkpoint {
                 Some(c) if Some(c.epoch) != last_epoch => {
                     evaluation_notes.push(format!(
@@ -131,12 +177,12 @@ impl RunData {
                 }
                 Some(_) => {
                     evaluated_by.add(record.evaluated_by);
-                    Ok(Some(record.results))
+                    Ok(Some((record.results, protocol)))
                 }
                 None => {
                     unrecorded_evaluations += 1;
                     evaluated_by.add(record.evaluated_by);
-                    Ok(Some(record.results))
+                    Ok(Some((record.results, protocol)))
                 }
             }
         };
@@ -145,7 +191,10 @@ impl RunData {
             evaluation(EvaluationKind::PlanOnce)?,
             evaluation(EvaluationKind::Policy)?,
         );
-        let further = further_evaluations(dir, last_epoch, &mut damage, &mut evaluated_by);
+        let success_protocols = [&replan, &plan_once, &policy]
+            .map(|e| e.as_ref().map(|(_, protocol)| protocol.clone()));
+        let [replan, plan_once, policy] =
+            [replan, plan_once, policy].map(|e| e.map(|(results, _)| results));
         let (noisy, deep) = (noisy_evaluations(&further), deep_search(&further));
         let over_training = crate::evaluation::read_over_training(dir)?;
         for line in &over_training {
@@ -158,6 +207,8 @@ impl RunData {
             replan,
             plan_once,
             policy,
+            success_protocols,
+            replan_tasks,
             noisy,
             deep,
             evaluation_notes,
@@ -243,7 +294,6 @@ fn further_evaluations(
         if let (Some(protocol), true) = (record.protocol, at_end)
             && protocol.tasks.split == seads_games::Split::Test
             && protocol.tasks.seed.is_none()
-            && protocol.kind != EvaluationKind::Policy
         {
             evaluated_by.add(record.evaluated_by);
             found.push((protocol, record.results));
@@ -516,6 +566,8 @@ pub(crate) fn bare_run(seed: u32) -> RunData {
         policy: None,
         replan: None,
         plan_once: None,
+        success_protocols: [None, None, None],
+        replan_tasks: EvaluationKind::Replan.tasks_file(&STANDARD_DEPTHS, None),
         noisy: Vec::new(),
         deep: None,
         evaluated_by: Evaluators::default(),

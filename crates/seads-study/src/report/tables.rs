@@ -2,9 +2,10 @@
 //! Mann–Whitney test against the reference (Table 1), final task success per depth, and the
 //! median skill and solution lengths.
 
+use std::collections::BTreeMap;
 use std::fmt::Write as _;
 
-use seads_planner::DepthResult;
+use seads_planner::{DEFAULT_MAX_EXPANDED, DepthResult, STANDARD_BOARDS};
 
 use super::csv_field;
 use super::runs::{Group, RunData};
@@ -183,6 +184,19 @@ fn evaluation(run: &RunData, mode: Mode) -> Option<&Vec<DepthResult>> {
     }
 }
 
+/// The protocol of a run's final evaluation in one mode, in a few words (`standard`, or how it
+/// departs from the standard one).
+fn protocol(run: &RunData, mode: Mode) -> &str {
+    let index = match mode {
+        Mode::Replan => 0,
+        Mode::PlanOnce => 1,
+        Mode::Policy => 2,
+    };
+    run.success_protocols[index]
+        .as_deref()
+        .unwrap_or("standard")
+}
+
 /// Depths evaluated in a group.
 fn depths(groups: &[Group<'_>]) -> Vec<usize> {
     let mut depths: Vec<usize> = groups
@@ -303,39 +317,62 @@ fn depth_cells(
     all
 }
 
-/// Final task success per depth (mean over runs of each run's success rate), Markdown and CSV.
+/// Final task success per depth (mean over runs of each run's success rate), Markdown and CSV:
+/// one row per group, mode and evaluation protocol, so that runs evaluated under other boards or
+/// limits are never pooled with, or taken for, the standard evaluation.
 pub fn success_tables(groups: &[Group<'_>]) -> (String, String) {
     let depths = depths(groups);
-    let mut md = String::from("| environment | variant | mode | runs |");
+    let mut md = String::from("| environment | variant | mode | protocol | runs |");
     for d in &depths {
         let _ = write!(md, " depth {d} |");
     }
-    md += "\n|---|---|---|---|";
+    md += "\n|---|---|---|---|---|";
     md += &"---|".repeat(depths.len());
     md.push('\n');
-    let mut csv = String::from("env,variant,mode,runs,depth,mean_success,std_success\n");
+    let mut csv = String::from("env,variant,mode,protocol,runs,depth,mean_success,std_success\n");
+    let mut other_protocols = false;
     for g in groups {
         for mode in [Mode::Replan, Mode::PlanOnce, Mode::Policy] {
-            let evaluated: Vec<&Vec<DepthResult>> =
-                g.runs.iter().filter_map(|r| evaluation(r, mode)).collect();
-            if evaluated.is_empty() {
-                continue;
+            let mut by_protocol: BTreeMap<&str, Vec<&Vec<DepthResult>>> = BTreeMap::new();
+            for run in &g.runs {
+                if let Some(e) = evaluation(run, mode) {
+                    by_protocol.entry(protocol(run, mode)).or_default().push(e);
+                }
             }
-            let mode = label(mode);
-            let _ = write!(
-                md,
-                "| {} | {} | {mode} | {} |",
-                g.env,
-                g.variant,
-                evaluated.len()
-            );
-            let row = format!("{},{},{mode}", csv_field(&g.env), csv_field(&g.variant));
-            depth_cells(&mut md, &mut csv, &row, &depths, &evaluated);
-            md.push('\n');
+            for (protocol, evaluated) in by_protocol {
+                other_protocols |= protocol != "standard";
+                let mode = label(mode);
+                let _ = write!(
+                    md,
+                    "| {} | {} | {mode} | {protocol} | {} |",
+                    g.env,
+                    g.variant,
+                    evaluated.len()
+                );
+                let row = format!(
+                    "{},{},{mode},{}",
+                    csv_field(&g.env),
+                    csv_field(&g.variant),
+                    csv_field(protocol)
+                );
+                depth_cells(&mut md, &mut csv, &row, &depths, &evaluated);
+                md.push('\n');
+            }
         }
     }
-    md += "\nShare of test boards solved at the end of training, per solution depth, mean over the runs \
-           (20 boards per depth and run unless the sweep says otherwise).\n";
+    let _ = writeln!(
+        md,
+        "\nShare of test boards solved at the end of training, per solution depth, mean over the \
+         runs. The standard protocol: {STANDARD_BOARDS} test boards per depth and run (the authors' \
+         seeds), each search bounded by {DEFAULT_MAX_EXPANDED} expanded states without a clock, \
+         the most likely plan, breadth-first."
+    );
+    if other_protocols {
+        md += "Another protocol is named by how it departs from the standard one (`boards-N`, \
+               `expanded-N` or `unbounded`, `timeout-Ns`, the plan choice, `both-ends`, \
+               `memory-NNmib`; `not recorded` for a record older than protocols); runs of \
+               different protocols are never pooled in one row.\n";
+    }
     let timeouts: usize = groups
         .iter()
         .flat_map(|g| g.runs.iter())
@@ -543,6 +580,58 @@ mod tests {
                 runs: vec![&runs[2]],
             }])
             .is_none()
+        );
+    }
+
+    /// Runs evaluated under different protocols are never pooled (issue 82: an evaluation of 2
+    /// boards with a 1-state limit sat beside the standard ones under a caption saying "20 boards
+    /// per depth"): one row per protocol, each named, by hand: the standard runs solve 20/20 and
+    /// 18/20 (95 %), the other 0/2.
+    #[test]
+    fn success_rows_are_one_per_protocol_and_name_it() {
+        let mut a = bare_run(1);
+        a.replan = Some(vec![depth(1, 20)]);
+        let mut b = bare_run(2);
+        b.replan = Some(vec![depth(1, 18)]);
+        let mut c = bare_run(3);
+        c.replan = Some(vec![DepthResult {
+            tasks: 2,
+            solved: 0,
+            ..DepthResult::new(1)
+        }]);
+        c.success_protocols[0] = Some("boards-2, expanded-1".into());
+        for run in [&mut a, &mut b] {
+            run.success_protocols[0] = Some("standard".into());
+        }
+        let runs = [a, b, c];
+        let group = Group {
+            env: "lightsout-cursor".into(),
+            variant: "seads".into(),
+            runs: runs.iter().collect(),
+        };
+        let (md, csv) = success_tables(&[group]);
+        assert!(
+            md.contains("| lightsout-cursor | seads | re-planning | standard | 2 | 95.0 % |"),
+            "{md}"
+        );
+        assert!(
+            md.contains(
+                "| lightsout-cursor | seads | re-planning | boards-2, expanded-1 | 1 | 0.0 % |"
+            ),
+            "{md}"
+        );
+        assert!(md.contains("never pooled"), "{md}");
+        assert!(!md.contains("20 boards per depth and run unless"), "{md}");
+        let rows: Vec<&str> = csv.lines().collect();
+        assert_eq!(
+            rows[0],
+            "env,variant,mode,protocol,runs,depth,mean_success,std_success"
+        );
+        assert!(
+            rows.contains(
+                &"lightsout-cursor,seads,re-planning,\"boards-2, expanded-1\",1,1,0.0000,0.0000"
+            ),
+            "{csv}"
         );
     }
 }

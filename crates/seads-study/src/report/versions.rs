@@ -30,21 +30,50 @@ impl Version {
     }
 }
 
-/// Whether the git repository at `repository` has `commit`; `None` where git cannot say (no git,
-/// no repository, no commit name).
-pub fn has_commit(repository: &Path, commit: &str) -> Option<bool> {
-    if commit.is_empty() || !commit.chars().all(|c| c.is_ascii_hexdigit()) {
-        return Some(false);
+/// A commit as read from a file, made safe to print in a table cell or a CSV field: letters,
+/// digits, `.`, `-` and `_` are kept, anything else (a backtick, `|`, a comma, a line break) is
+/// shown as `?`, and at most 64 characters are kept. A forged provenance line can thus neither
+/// add a row nor break one.
+fn shown(commit: &str) -> String {
+    let mut out: String = commit
+        .chars()
+        .take(64)
+        .map(|c| {
+            if c.is_ascii_alphanumeric() || "._-".contains(c) {
+                c
+            } else {
+                '?'
+            }
+        })
+        .collect();
+    if commit.chars().count() > 64 {
+        out.push_str("...");
     }
+    out
+}
+
+/// Whether `dir` is inside a git repository; `None` where git cannot be run.
+pub fn is_repository(dir: &Path) -> Option<bool> {
     let inside = Command::new("git")
         .arg("-C")
-        .arg(repository)
+        .arg(dir)
         .args(["rev-parse", "--is-inside-work-tree"])
         .stdout(Stdio::null())
         .stderr(Stdio::null())
         .status()
         .ok()?;
-    if !inside.success() {
+    Some(inside.success())
+}
+
+/// Whether the git repository at `repository` has `commit`, a full commit hash (40 hexadecimal
+/// digits, or 64 in a SHA-256 repository, as provenance records it); `None` where git cannot say
+/// (no git, no repository). Anything else is no commit of the repository: neither an abbreviated
+/// hash nor a name that git would resolve (`HEAD`, a branch, `X~1`) counts.
+pub fn has_commit(repository: &Path, commit: &str) -> Option<bool> {
+    if ![40, 64].contains(&commit.len()) || !commit.chars().all(|c| c.is_ascii_hexdigit()) {
+        return Some(false);
+    }
+    if !is_repository(repository)? {
         return None;
     }
     let found = Command::new("git")
@@ -70,7 +99,7 @@ fn run_versions(run: &RunData) -> Result<Vec<Version>, String> {
     let mut seen: Vec<Version> = Vec::new();
     for line in lines {
         let v = Version {
-            commit: line.commit,
+            commit: shown(&line.commit),
             dirty: line.dirty,
         };
         if !seen.contains(&v) {
@@ -105,13 +134,13 @@ pub fn version_tables(runs: &[&RunData], known: &dyn Fn(&str) -> Option<bool>) -
             .named
             .iter()
             .map(|e| Version {
-                commit: e.commit.clone(),
+                commit: shown(&e.commit),
                 dirty: e.dirty,
             })
             .collect();
         unnamed += usize::from(run.evaluated_by.unnamed > 0);
         let evaluated_by: Vec<String> = evaluators.iter().map(Version::named).collect();
-        let evaluated_by = evaluated_by.join(";");
+        let evaluated_by = csv_field(&evaluated_by.join(";"));
         for v in evaluators {
             *evaluations.entry(v).or_default() += 1;
         }
@@ -324,6 +353,79 @@ mod tests {
             md.contains("Every run trained on this one clean commit."),
             "{md}"
         );
+    }
+
+    /// A provenance line whose commit holds a backtick, `|`, a comma or a line break forges no
+    /// row of the markdown table and no field of the CSV (issue 82).
+    #[test]
+    fn a_forged_commit_adds_no_row() {
+        let tmp = tempfile::tempdir().unwrap();
+        let mut run = bare_run(1);
+        run.dir = tmp.path().join("seed-1");
+        std::fs::create_dir_all(&run.dir).unwrap();
+        let forged = "aaa1` | clean | yes | 99 |\n| `bbb2,x";
+        let build = Build {
+            version: "0.1.0",
+            commit: forged,
+            dirty: false,
+        };
+        Provenance::here(0, 0, false, Default::default(), &build)
+            .append(&run.dir)
+            .unwrap();
+        run.evaluated_by.add(vec![seads_planner::Evaluator {
+            seads: "0.1.0".into(),
+            commit: "ccc3,\n,x".into(),
+            dirty: false,
+        }]);
+        let (md, csv) = version_tables(&[&run], &|_| Some(false));
+        let rows: Vec<&str> = md.lines().filter(|l| l.starts_with('|')).collect();
+        assert_eq!(rows.len(), 3, "header, rule and one version: {md}");
+        assert!(!md.contains("| 99 |"), "{md}");
+        assert!(rows[2].ends_with("| clean | **no** | 1 |"), "{md}");
+        let lines: Vec<&str> = csv.lines().collect();
+        assert_eq!(lines.len(), 2, "{csv}");
+        let fields = lines[1].split(',').count();
+        assert_eq!(fields, lines[0].split(',').count(), "{csv}");
+        assert_eq!(shown("ab\n|`,"), "ab????");
+        assert_eq!(shown(&"a".repeat(70)), format!("{}...", "a".repeat(64)));
+    }
+
+    /// A name git would resolve (a branch named in hexadecimal digits, an abbreviated hash, a
+    /// relative name) is no commit of the repository; only full hashes are looked up (issue 82:
+    /// `git cat-file -e X^{commit}` resolved them).
+    #[test]
+    fn only_full_hashes_are_commits_of_the_repository() {
+        let tmp = tempfile::tempdir().unwrap();
+        let git = |args: &[&str]| {
+            let out = std::process::Command::new("git")
+                .arg("-C")
+                .arg(tmp.path())
+                .args([
+                    "-c",
+                    "user.name=t",
+                    "-c",
+                    "user.email=t@t",
+                    "-c",
+                    "init.defaultBranch=main",
+                ])
+                .args(args)
+                .output()
+                .expect("git runs");
+            assert!(out.status.success(), "git {args:?}: {out:?}");
+            String::from_utf8(out.stdout).unwrap().trim().to_owned()
+        };
+        git(&["init", "--quiet"]);
+        git(&["commit", "--quiet", "--allow-empty", "-m", "one"]);
+        git(&["branch", "beef"]);
+        let head = git(&["rev-parse", "HEAD"]);
+        assert_eq!(has_commit(tmp.path(), &head), Some(true));
+        for name in ["beef", &head[..7], "HEAD", "main", "HEAD~0"] {
+            assert_eq!(has_commit(tmp.path(), name), Some(false), "{name}");
+        }
+        assert_eq!(is_repository(tmp.path()), Some(true));
+        let plain = tempfile::tempdir().unwrap();
+        assert_eq!(is_repository(plain.path()), Some(false));
+        assert_eq!(is_repository(&plain.path().join("missing")), Some(false));
     }
 
     /// A commit the repository has, one it lacks, and a name that is no commit.

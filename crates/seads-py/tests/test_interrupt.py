@@ -1,0 +1,78 @@
+"""Ctrl-C stops a long computation, in a real Python process (issue 82: the 15-puzzle's solver,
+``Agent.solve`` and ``Agent.plan`` held the GIL, or ran to their end, long after SIGINT). The
+child starts a search far longer than this test, the test waits until the child is busy inside
+it (its CPU time grows), sends SIGINT, and the child must end with ``KeyboardInterrupt``; the
+time limit below only keeps a broken build from hanging the suite."""
+
+import os
+import signal
+import subprocess
+import sys
+import textwrap
+
+import pytest
+
+pytestmark = pytest.mark.without_gymnasium
+
+# The tiles 1-15 reversed, two swapped so that the board can reach the goal (an even number of
+# inversions with the gap on the last row): some 60 or more slides from the goal, far beyond
+# what IDA* with the Manhattan distance solves in minutes.
+FAR = [14, 15, 13, 12, 11, 10, 9, 8, 7, 6, 5, 4, 3, 2, 1, 0]
+
+CHILD = textwrap.dedent(
+    f"""
+    import threading
+    import time
+
+    import seads
+
+    game = seads.Game("sliding", 4)
+    # A thread that ticks while it may: it goes on during the search only if the search has
+    # released the GIL.
+    ticks = []
+
+    def tick():
+        while True:
+            ticks.append(1)
+            time.sleep(0.001)
+
+    threading.Thread(target=tick, daemon=True).start()
+    print("ready", flush=True)
+    before = len(ticks)
+    try:
+        game.solve({FAR})
+        print("finished", flush=True)
+    except KeyboardInterrupt:
+        print("interrupted", len(ticks) > before + 10, flush=True)
+    """
+)
+
+
+def cpu_seconds(pid):
+    """User and system CPU time of process `pid` and its threads (Linux)."""
+    with open(f"/proc/{pid}/stat") as f:
+        fields = f.read().rsplit(")", 1)[1].split()
+    return (int(fields[11]) + int(fields[12])) / os.sysconf("SC_CLK_TCK")
+
+
+@pytest.mark.skipif(not sys.platform.startswith("linux"), reason="reads /proc")
+def test_ctrl_c_stops_the_fifteen_puzzles_solver():
+    child = subprocess.Popen(
+        [sys.executable, "-c", CHILD],
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+    )
+    try:
+        assert child.stdout.readline().strip() == "ready"
+        # Busy inside the search: a second of CPU beyond what it had used when it said so.
+        start = cpu_seconds(child.pid)
+        while cpu_seconds(child.pid) < start + 1.0:
+            assert child.poll() is None, child.stderr.read()
+            os.sched_yield()
+        child.send_signal(signal.SIGINT)
+        out, err = child.communicate(timeout=120)
+    finally:
+        child.kill()
+    assert out.split() == ["interrupted", "True"], (out, err)
+    assert child.returncode == 0, err
