@@ -29,7 +29,7 @@ const MAX_CELLS: usize = 16;
 /// Search nodes the 15-puzzle's sampler may spend on drawing one board deeper than the listed
 /// depths: past them a reset says that no board of that depth was found, instead of drawing
 /// for minutes (the random walks rarely stay optimal past about 45 moves).
-pub const SAMPLE_NODES: u64 = 400_000_000;
+const SAMPLE_NODES: u64 = 400_000_000;
 
 /// Depths up to which the 15-puzzle's boards of one depth are listed, to draw among them and to
 /// tell whether a split lacks them (depth 12 has 7,808 boards); deeper layers hold many boards in
@@ -232,7 +232,7 @@ impl BoardGame for SlidingPuzzle {
     /// A board of exactly `depth` in `split`: drawn among the listed boards of that depth up to
     /// depth 12 (`LISTED_DEPTHS`); deeper, a random walk of `depth` slides that never undoes the
     /// last one, kept when the solver finds it that deep and it lies in `split`. The 15-puzzle's
-    /// solver is bounded by [`SAMPLE_NODES`] over all draws: `None` once they are spent.
+    /// solver is bounded by `SAMPLE_NODES` search nodes over all draws: `None` once they are spent.
     fn sample_at_depth(
         &self,
         depth: usize,

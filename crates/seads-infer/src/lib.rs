@@ -218,6 +218,13 @@ impl Agent {
 /// The config a checkpoint was saved with.
 fn saved_config(dir: &Path) -> Result<SavedConfig, InferError> {
     let path = dir.join("config.toml");
+    // A FIFO or a device would block the read or never end it.
+    if path.exists() && !path.is_file() {
+        return Err(InferError::Damaged {
+            path: path.display().to_string(),
+            reason: "not a regular file".into(),
+        });
+    }
     let text = std::fs::read_to_string(&path).map_err(|e| InferError::Io {
         what: format!("reading {}", path.display()),
         source: e,

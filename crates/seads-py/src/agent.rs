@@ -2,14 +2,15 @@
 //! the forward model's successors, plans, and solving a board in an environment.
 
 use std::path::PathBuf;
+use std::sync::Mutex;
 
 use numpy::{PyArray1, PyArray2, PyArrayMethods, PyReadonlyArrayDyn, PyUntypedArrayMethods};
+use pyo3::exceptions::PyMemoryError;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 use seads_embodiment::{Environment, Filmed, Push, SkillPolicy, execute_skill};
-use std::sync::Mutex;
 
 use seads_games::{BoardGame, Successor, SymbolicState};
 use seads_infer::ForwardModel;
@@ -31,6 +32,9 @@ pub struct Agent {
     obs_dim: usize,
     action_dim: usize,
 }
+
+/// Observation rows the policy runs on at once in `act`.
+const ACT_ROWS: usize = 4096;
 
 /// The forward model, whichever thread used it last (a panic there leaves it whole: it is
 /// only read and its buffers rewritten).
@@ -185,29 +189,18 @@ impl Agent {
         seed: Option<u64>,
     ) -> PyResult<Bound<'py, PyAny>> {
         // float32 as it is; float64 (NumPy's default) converted, where every value fits.
-        let (shape, values): (Vec<usize>, Vec<f32>) =
-            if let Ok(obs) = obs.extract::<PyReadonlyArrayDyn<'py, f32>>() {
-                (
-                    obs.shape().to_vec(),
-                    obs.as_array().iter().copied().collect(),
-                )
-            } else if let Ok(obs) = obs.extract::<PyReadonlyArrayDyn<'py, f64>>() {
-                let values = obs.as_array().iter().map(|&v| v as f32).collect::<Vec<_>>();
-                if let Some(v) = obs
-                    .as_array()
-                    .iter()
-                    .find(|v| v.is_finite() && (**v as f32).is_infinite())
-                {
-                    return Err(value_error(format!(
-                        "an observation of {v} lies beyond float32's range"
-                    )));
-                }
-                (obs.shape().to_vec(), values)
-            } else {
-                return Err(value_error(
-                    "observations: a NumPy array of float32 (or float64) values",
-                ));
-            };
+        let f32_obs = obs.extract::<PyReadonlyArrayDyn<'py, f32>>().ok();
+        let f64_obs = match f32_obs {
+            Some(_) => None,
+            None => Some(obs.extract::<PyReadonlyArrayDyn<'py, f64>>().map_err(|_| {
+                value_error("observations: a NumPy array of float32 (or float64) values")
+            })?),
+        };
+        let shape = match (&f32_obs, &f64_obs) {
+            (Some(o), _) => o.shape().to_vec(),
+            (_, Some(o)) => o.shape().to_vec(),
+            _ => unreachable!("one of them was extracted"),
+        };
         let rows = match shape[..] {
             [n] if n == self.obs_dim => 1,
             [rows, n] if n == self.obs_dim => rows,
@@ -218,31 +211,76 @@ impl Agent {
                 )));
             }
         };
-        let skills: Vec<usize> = match skill.extract::<usize>() {
-            Ok(k) => vec![k; rows],
-            Err(_) => skill.extract::<Vec<usize>>().map_err(|_| {
-                value_error("skill: a non-negative whole number or one per observation row")
-            })?,
+        // One skill for every row is never repeated into a list of all rows.
+        let (one, each): (Option<usize>, Vec<usize>) = match skill.extract::<usize>() {
+            Ok(k) => (Some(k), Vec::new()),
+            Err(_) => (
+                None,
+                skill.extract::<Vec<usize>>().map_err(|_| {
+                    value_error("skill: a non-negative whole number or one per observation row")
+                })?,
+            ),
         };
-        if skills.len() != rows {
+        if one.is_none() && each.len() != rows {
             return Err(value_error(format!(
                 "{} skills for {rows} observation rows",
-                skills.len()
+                each.len()
             )));
         }
-        let policy = &self.inner.policy;
-        let actions = match (deterministic, seed) {
-            (true, _) => policy.actions::<ChaCha8Rng>(&values, &skills, None),
-            (false, Some(seed)) => {
-                policy.actions(&values, &skills, Some(&mut ChaCha8Rng::seed_from_u64(seed)))
-            }
+        let mut rng = match (deterministic, seed) {
+            (true, _) => None,
+            (false, Some(seed)) => Some(ChaCha8Rng::seed_from_u64(seed)),
             (false, None) => {
                 return Err(value_error(
                     "a sampled action needs a seed (act(..., deterministic=False, seed=S))",
                 ));
             }
+        };
+        // The actions are reserved up front, so that too many rows are a MemoryError, not an
+        // abort; the policy runs on chunks of rows, so that its layers hold a chunk at a time.
+        let mut actions: Vec<f32> = Vec::new();
+        actions
+            .try_reserve_exact(rows.saturating_mul(self.action_dim))
+            .map_err(|_| {
+                PyMemoryError::new_err(format!("no memory for the actions of {rows} observations"))
+            })?;
+        let f32_view = f32_obs.as_ref().map(|o| o.as_array());
+        let f64_view = f64_obs.as_ref().map(|o| o.as_array());
+        let mut f32_values = f32_view.iter().flat_map(|v| v.iter().copied());
+        let mut f64_values = f64_view.iter().flat_map(|v| v.iter().copied());
+        let mut chunk: Vec<f32> = Vec::with_capacity(ACT_ROWS * self.obs_dim);
+        for first in (0..rows).step_by(ACT_ROWS) {
+            let last = (first + ACT_ROWS).min(rows);
+            let n = (last - first) * self.obs_dim;
+            chunk.clear();
+            if f32_view.is_some() {
+                chunk.extend(f32_values.by_ref().take(n));
+            } else {
+                for v in f64_values.by_ref().take(n) {
+                    let narrow = v as f32;
+                    if v.is_finite() && narrow.is_infinite() {
+                        return Err(value_error(format!(
+                            "an observation of {v} lies beyond float32's range"
+                        )));
+                    }
+                    chunk.push(narrow);
+                }
+            }
+            let repeated;
+            let skills = match one {
+                Some(k) => {
+                    repeated = vec![k; last - first];
+                    &repeated[..]
+                }
+                None => &each[first..last],
+            };
+            let part = self
+                .inner
+                .policy
+                .actions(&chunk, skills, rng.as_mut())
+                .map_err(value_error)?;
+            actions.extend(part);
         }
-        .map_err(value_error)?;
         if shape.len() == 1 {
             Ok(PyArray1::from_vec(py, actions).into_any())
         } else {

@@ -5,6 +5,7 @@ it (its CPU time grows), sends SIGINT, and the child must end with ``KeyboardInt
 time limit below only keeps a broken build from hanging the suite."""
 
 import os
+import pathlib
 import signal
 import subprocess
 import sys
@@ -76,3 +77,46 @@ def test_ctrl_c_stops_the_fifteen_puzzles_solver():
         child.kill()
     assert out.split() == ["interrupted", "True"], (out, err)
     assert child.returncode == 0, err
+
+
+RUN = pathlib.Path(__file__).with_name("data") / "agent-run"
+
+MEMORY_CHILD = textwrap.dedent(
+    f"""
+    import resource
+
+    import numpy as np
+    import seads
+
+    agent = seads.Agent.load({str(RUN)!r})
+    obs = np.zeros((10_000_000, 28), dtype=np.float32)  # 1.1 GB
+    with open("/proc/self/status") as f:
+        size = next(int(line.split()[1]) * 1024 for line in f if line.startswith("VmSize:"))
+
+    def limit(extra_mib):
+        resource.setrlimit(resource.RLIMIT_AS, (size + extra_mib * 2**20, resource.RLIM_INFINITY))
+
+    # Room for the actions (80 MB) but not for another copy of the observations: a copy of them
+    # was an abort of the interpreter.
+    limit(600)
+    print(agent.act(obs, 3).shape, flush=True)
+    # No room for the actions: a MemoryError, and the interpreter goes on.
+    limit(40)
+    try:
+        agent.act(obs, 3)
+    except MemoryError:
+        print("memory error", flush=True)
+    """
+)
+
+
+@pytest.mark.skipif(not sys.platform.startswith("linux"), reason="reads /proc")
+def test_actions_of_many_observations_fit_the_memory_or_raise_memory_error():
+    """Issue 82: ``act`` on 10⁷ observations under an address-space limit aborted the
+    interpreter (exit 134); it works on chunks of rows, and where even the actions do not fit it
+    raises ``MemoryError``."""
+    child = subprocess.run(
+        [sys.executable, "-c", MEMORY_CHILD], capture_output=True, text=True, timeout=600
+    )
+    assert child.returncode == 0, child.stderr
+    assert child.stdout.split("\n")[:2] == ["(10000000, 2)", "memory error"], child.stdout
