@@ -98,8 +98,9 @@ MEMORY_CHILD = textwrap.dedent(
 
     # Room for the actions (80 MB) but not for another copy of the observations: a copy of them
     # was an abort of the interpreter.
+    width = len(agent.act(obs[0], 3))
     limit(600)
-    print(agent.act(obs, 3).shape, flush=True)
+    print(agent.act(obs, 3).shape == (len(obs), width), flush=True)
     # No room for the actions: a MemoryError, and the interpreter goes on.
     limit(40)
     try:
@@ -119,4 +120,4 @@ def test_actions_of_many_observations_fit_the_memory_or_raise_memory_error():
         [sys.executable, "-c", MEMORY_CHILD], capture_output=True, text=True, timeout=600
     )
     assert child.returncode == 0, child.stderr
-    assert child.stdout.split("\n")[:2] == ["(10000000, 2)", "memory error"], child.stdout
+    assert child.stdout.split("\n")[:2] == ["True", "memory error"], child.stdout
