@@ -246,6 +246,13 @@ pub enum PlanError {
     /// Another thread raised the search's [`Interrupt`].
     #[error("planning was interrupted")]
     Interrupted,
+    /// The machine had no memory for the search's next states, below its own bound (an
+    /// address-space limit, a full machine).
+    #[error("planning stopped: no memory for more than {discovered} states")]
+    OutOfMemory {
+        /// Distinct states discovered.
+        discovered: usize,
+    },
 }
 
 /// A symbolic state packed into a hash key as small as the state allows.
@@ -351,6 +358,20 @@ impl<K: Key> Visited<K> {
             new[*i as usize] = true;
         }
         self.len += added.iter().map(Vec::len).sum::<usize>();
+    }
+
+    /// Makes room for every key of `keys` in its shard, or fails without inserting any: so that
+    /// [`Visited::insert_all`] never grows a set, and a machine without the memory is an error,
+    /// not an abort.
+    fn try_reserve_for(&mut self, keys: &[K]) -> Result<(), std::collections::TryReserveError> {
+        let mut counts = vec![0usize; self.shards.len()];
+        for key in keys {
+            counts[Self::shard(key)] += 1;
+        }
+        for (set, count) in self.shards.iter_mut().zip(counts) {
+            set.try_reserve(count)?;
+        }
+        Ok(())
     }
 
     /// Bytes the sets take, roughly (their capacity, a key and a control byte per slot).
@@ -463,7 +484,17 @@ fn search<K: Key>(
             keys.par_extend(out[..seen].par_iter().map(|&z| K::pack(z)));
             new.clear();
             new.resize(seen, false);
+            let out_of_memory = |nodes: &Vec<Node>| PlanError::OutOfMemory {
+                discovered: nodes.len(),
+            };
+            visited
+                .try_reserve_for(&keys)
+                .map_err(|_| out_of_memory(&nodes))?;
             visited.insert_all(&keys, &mut new);
+            let added = new.iter().filter(|&&n| n).count();
+            nodes
+                .try_reserve(added)
+                .map_err(|_| out_of_memory(&nodes))?;
             for chunk in &chunks {
                 expanded += chunk.len();
                 for parent in chunk.clone() {

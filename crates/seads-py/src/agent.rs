@@ -333,7 +333,7 @@ impl Agent {
             || config.interrupt.raise(),
         )?
         .map(|plan| plan.skills)
-        .map_err(value_error)
+        .map_err(crate::plan_error)
     }
 
     /// `solve(env, board=None, replan=True, max_expanded=4194304, search="breadth",

@@ -233,5 +233,5 @@ pub fn plan(
         || config.interrupt.raise(),
     )?
     .map(|plan| plan.skills)
-    .map_err(value_error)
+    .map_err(crate::plan_error)
 }

@@ -34,12 +34,18 @@ pub(crate) fn interruptible<T: Send>(
     let finished = (Mutex::new(false), Condvar::new());
     std::thread::scope(|scope| {
         let signal = &finished;
-        let helper = scope.spawn(move || {
-            let out = work();
-            *signal.0.lock().unwrap_or_else(|e| e.into_inner()) = true;
-            signal.1.notify_all();
-            out
-        });
+        // A thread the system cannot start (no memory for its stack) is an exception too.
+        let helper = std::thread::Builder::new()
+            .name("seads-work".into())
+            .spawn_scoped(scope, move || {
+                let out = work();
+                *signal.0.lock().unwrap_or_else(|e| e.into_inner()) = true;
+                signal.1.notify_all();
+                out
+            })
+            .map_err(|e| {
+                pyo3::exceptions::PyMemoryError::new_err(format!("starting a thread: {e}"))
+            })?;
         let mut interrupted = None;
         loop {
             let done = py.detach(|| {
@@ -73,6 +79,17 @@ pub(crate) fn interruptible<T: Send>(
             PyRuntimeError::new_err(format!("the computation failed: {why}"))
         })
     })
+}
+
+/// A search that found no plan as a Python exception: `MemoryError` where the machine had no
+/// memory for it, `ValueError` otherwise.
+fn plan_error(e: seads_planner::PlanError) -> PyErr {
+    match e {
+        seads_planner::PlanError::OutOfMemory { .. } => {
+            pyo3::exceptions::PyMemoryError::new_err(e.to_string())
+        }
+        other => value_error(other),
+    }
 }
 
 /// Any error of the Rust libraries as a Python `ValueError` with its message.

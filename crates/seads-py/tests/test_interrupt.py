@@ -121,3 +121,38 @@ def test_actions_of_many_observations_fit_the_memory_or_raise_memory_error():
     )
     assert child.returncode == 0, child.stderr
     assert child.stdout.split("\n")[:2] == ["True", "memory error"], child.stdout
+
+
+PLAN_CHILD = textwrap.dedent(
+    """
+    import resource
+
+    import seads
+
+    game = seads.Game("lightsout", 7)
+    board = game.goal()
+    for move in range(0, 49, 3):
+        board = game.apply(board, move)
+    with open("/proc/self/status") as f:
+        size = next(int(line.split()[1]) * 1024 for line in f if line.startswith("VmSize:"))
+    # Far less than the search's own bound (4 GiB): the machine runs out first.
+    resource.setrlimit(resource.RLIMIT_AS, (size + 300 * 2**20, resource.RLIM_INFINITY))
+    try:
+        seads.plan(game, board, max_expanded=None)
+        print("planned", flush=True)
+    except MemoryError:
+        print("memory error", flush=True)
+    """
+)
+
+
+@pytest.mark.skipif(not sys.platform.startswith("linux"), reason="reads /proc")
+def test_a_search_without_memory_raises_memory_error():
+    """Issue 82: ``plan(max_expanded=None)`` under an address-space limit aborted the interpreter
+    (exit 134). A 7×7 LightsOut board 17 presses from the goal, searched breadth-first with the
+    true rules, outgrows 300 MB long before its own bound: a ``MemoryError``."""
+    child = subprocess.run(
+        [sys.executable, "-c", PLAN_CHILD], capture_output=True, text=True, timeout=600
+    )
+    assert child.returncode == 0, child.stderr
+    assert child.stdout.strip() == "memory error", child.stdout
