@@ -595,6 +595,16 @@ impl Environment for UarmEnv {
         if !crate::game().is_valid(carried.board) {
             return Err(invalid("not a LightsOut 5×5 board".into()));
         }
+        // The environment's board is the one the newest report it received showed: where that
+        // is the twin's newest report, it is the twin's board (issue 82: a board that disagreed
+        // was taken). Behind it (a late report), the twin's board may have moved on.
+        if carried.seq == carried.twin.seq() && carried.board != carried.twin.board() {
+            return Err(invalid(
+                "the environment's board is not the twin's, though it received the twin's newest \
+                 report"
+                    .into(),
+            ));
+        }
         twin.restore(&carried.twin)
             .map_err(|e| invalid(e.to_string()))?;
         let mut hw = self.lock();

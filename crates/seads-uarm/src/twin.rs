@@ -123,6 +123,18 @@ pub struct TwinState {
     noise_rng: ChaCha8Rng,
 }
 
+impl TwinState {
+    /// The board the twin's tablet shows.
+    pub fn board(&self) -> SymbolicState {
+        self.board
+    }
+
+    /// The number of the tablet's newest report.
+    pub fn seq(&self) -> u64 {
+        self.seq
+    }
+}
+
 /// The shared simulated world; hand out its arm transport and its tablet.
 #[derive(Clone)]
 pub struct Twin {

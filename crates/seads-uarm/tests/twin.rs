@@ -666,6 +666,14 @@ fn carried_states_that_cannot_be_are_refused() {
         with("/twin/board/words/0", serde_json::json!(u64::MAX)),
         with("/twin/last_move", serde_json::json!(25)),
         with("/twin/timed", serde_json::json!(u64::MAX)),
+        // Issue 82: a pen far beyond the arm's reach, and an environment board other than the
+        // twin's although the environment received the twin's newest report.
+        with("/twin/pen", serde_json::json!([1e308, -1e308, 1e308])),
+        with(
+            "/board",
+            serde_json::to_value(seads_games::BoardGame::apply(&seads_uarm::game(), board, 0))
+                .unwrap(),
+        ),
     ] {
         let err = env.restore_carried_state(&bad).unwrap_err();
         assert!(matches!(err, EnvError::InvalidState { .. }), "{bad}: {err}");
