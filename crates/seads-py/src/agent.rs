@@ -11,7 +11,6 @@ use pyo3::types::PyDict;
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 use seads_embodiment::{Environment, Filmed, Push, SkillPolicy, execute_skill};
-
 use seads_games::{BoardGame, Successor, SymbolicState};
 use seads_infer::ForwardModel;
 use seads_planner::{PlanChoice, PlannerConfig, Search, SolveConfig, find_plan};

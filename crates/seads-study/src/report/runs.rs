@@ -148,8 +148,8 @@ impl RunData {
                             let labels: Vec<String> =
                                 several.iter().map(|(p, _)| p.label()).collect();
                             evaluation_notes.push(format!(
-                                "{} evaluations ({}) of other protocols than the standard one \
-                                 and none of it: left out",
+                                "{} evaluations of other protocols ({}) and none of the standard \
+                                 one: left out",
                                 kind.name(),
                                 labels.join("; ")
                             ));
@@ -250,10 +250,11 @@ impl Evaluators {
     }
 }
 
-/// The run's planning evaluations, other than the standard ones, that evaluated its last
-/// checkpoint on the test split with the standard seeds (`evaluation-replan-noise-0.05.json`,
-/// `evaluation-replan-depths-6-10.json`, …), in the order of their files' names, with the
-/// binaries they name added to `evaluated_by`; an unreadable one is damage.
+/// The run's evaluations (planning and policy), other than the standard ones, that evaluated its
+/// last checkpoint on the test split with the standard seeds (`evaluation-replan-noise-0.05.json`,
+/// `evaluation-replan-depths-6-10.json`, `evaluation-replan-boards-2.json`, …), in the order of
+/// their files' names, with the binaries they name added to `evaluated_by`; an unreadable one is
+/// damage.
 fn further_evaluations(
     dir: &Path,
     last_epoch: Option<u64>,
