@@ -31,7 +31,7 @@
 //! assert_eq!(runs[1].rel_dir(), "runs/lightsout-cursor/seads/seed-2");
 //!
 //! let dir = tempfile::tempdir()?;
-//! let planned = Sweep::plan(&manifest, "…", dir.path())?;
+//! let planned = Sweep::plan(&manifest, "…", dir.path(), None)?;
 //! assert_eq!((planned.runs, planned.created), (2, 2));
 //! let status = seads_study::sweep::status(&dir.path().join(runs[0].rel_dir()))?;
 //! assert_eq!(status.0, seads_study::sweep::Status::Pending);

@@ -101,6 +101,10 @@ pub struct RunArgs {
     /// SEADS_ALLOW_DIRTY=1 (or true, yes, on) does the same.
     #[arg(long)]
     allow_dirty: bool,
+    /// Train with this binary although the sweep was planned by a binary of another commit
+    /// (refused by default, so that a cell's runs never mix code versions).
+    #[arg(long)]
+    allow_other_commit: bool,
     /// No progress bar.
     #[arg(long)]
     quiet: bool,
@@ -130,6 +134,10 @@ pub struct TaskArgs {
     /// (refused by default; see `seads sweep run --allow-dirty`; or SEADS_ALLOW_DIRTY=1).
     #[arg(long)]
     allow_dirty: bool,
+    /// Train with this binary although the sweep was planned by a binary of another commit
+    /// (refused by default; see `seads sweep run --allow-other-commit`).
+    #[arg(long)]
+    allow_other_commit: bool,
     /// Started by `seads sweep run`: die with the parent, and if another task holds the run,
     /// exit with status 3 (taken elsewhere) after two seconds.
     #[arg(long, hide = true)]
@@ -177,6 +185,10 @@ pub struct SlurmArgs {
     /// (refused by default; see `seads sweep run --allow-dirty`; or SEADS_ALLOW_DIRTY=1).
     #[arg(long)]
     allow_dirty: bool,
+    /// Let the tasks train although the sweep was planned by a binary of another commit
+    /// (refused by default; see `seads sweep run --allow-other-commit`).
+    #[arg(long)]
+    allow_other_commit: bool,
 }
 
 /// Arguments of `seads sweep status`.
@@ -197,6 +209,7 @@ pub fn run(command: SweepCommand) -> Result<()> {
             crate::build()
                 .allows_study(allow_dirty(args.allow_dirty)?)
                 .map_err(crate::study_error)?;
+            allows_commit(&args.dir, args.allow_other_commit)?;
             let cores = match args.cores {
                 Some(c) => thread_count("--cores", c)?,
                 None => cores(),
@@ -225,6 +238,7 @@ pub fn run(command: SweepCommand) -> Result<()> {
             crate::build()
                 .allows_study(allow_dirty(args.allow_dirty)?)
                 .map_err(crate::study_error)?;
+            allows_commit(&args.dir, args.allow_other_commit)?;
             // `seads sweep run` looked at the run an instant ago and found it free: if another
             // task holds it now, it took it meanwhile, and the child leaves it to that one.
             let patience = if args.child {
@@ -260,7 +274,8 @@ fn plan(args: PlanArgs) -> Result<()> {
         .map_err(|e| BadInput(anyhow!("reading {}: {e}", args.manifest.display())))?;
     let manifest =
         Manifest::parse(&text, &args.manifest.display().to_string()).map_err(crate::bad_input)?;
-    let planned = Sweep::plan(&manifest, &text, &args.out).map_err(crate::bad_input)?;
+    let planned = Sweep::plan(&manifest, &text, &args.out, Some(crate::build().commit))
+        .map_err(crate::bad_input)?;
     if planned.created == 0 {
         outln!(
             "sweep {:?} in {} is already planned ({} runs); nothing changed",
@@ -320,6 +335,7 @@ fn slurm(args: SlurmArgs) -> Result<()> {
         device: args.device,
         populations,
         allow_dirty: allow_dirty(args.allow_dirty)?,
+        allow_other_commit: args.allow_other_commit,
     };
     let (array, report) =
         slurm::write_scripts(&dir, &sweep, &options).map_err(crate::study_error)?;
@@ -347,6 +363,18 @@ fn status(args: StatusArgs) -> Result<()> {
         outln!("{}", overview.table());
     }
     Ok(())
+}
+
+/// Refuses to train the runs of the sweep in `dir` with this binary if another commit planned
+/// the sweep, unless `allow_other` (bad input, naming both commits); a sweep that cannot be read
+/// is left to the command, which says why.
+fn allows_commit(dir: &std::path::Path, allow_other: bool) -> Result<()> {
+    match Sweep::load(dir) {
+        Ok(sweep) => sweep
+            .allows_commit(crate::build().commit, allow_other)
+            .map_err(crate::study_error),
+        Err(_) => Ok(()),
+    }
 }
 
 /// The environment variable that allows a study to train with a binary built from a working tree

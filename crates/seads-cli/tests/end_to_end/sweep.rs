@@ -983,6 +983,56 @@ fn the_allow_dirty_variable_takes_the_usual_booleans_and_an_error_names_it() {
     assert_eq!(snapshot(&out), planned, "nothing trained or written");
 }
 
+/// A sweep records the commit of the binary that planned it, and `sweep run` and `sweep task`
+/// refuse a binary of another commit (exit 2, one line naming both, nothing trained) unless
+/// `--allow-other-commit`, so that a cell's runs never mix code versions (issue 81 item 4);
+/// planning the same manifest again keeps the commit that planned it first.
+#[test]
+fn a_sweep_refuses_a_binary_of_another_commit() {
+    let tmp = tempfile::tempdir().unwrap();
+    let (manifest, out) = planned_sweep(tmp.path());
+    let version = String::from_utf8(seads_ok(&["--version"]).stdout).unwrap();
+    let commit = version
+        .split("commit ")
+        .nth(1)
+        .and_then(|rest| rest.split(',').next())
+        .unwrap()
+        .to_owned();
+    let index_path = out.join("sweep.json");
+    let mut index: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&index_path).unwrap()).unwrap();
+    assert_eq!(index["planned_by"], commit.as_str(), "{index}");
+    // As if another commit had planned it.
+    let other = "0123456789abcdef0123456789abcdef01234567";
+    index["planned_by"] = other.into();
+    std::fs::write(&index_path, index.to_string()).unwrap();
+    seads_ok(&["sweep", "plan", s(&manifest), "--out", s(&out)]);
+    let again: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&index_path).unwrap()).unwrap();
+    assert_eq!(
+        again["planned_by"], other,
+        "planning again keeps the first commit"
+    );
+    let planned = snapshot(&out);
+    for (args, ordinary) in [
+        (
+            vec!["sweep", "run", s(&out), "--seeds", "7"],
+            "has no seed 7",
+        ),
+        (
+            vec!["sweep", "task", s(&out), "--index", "4"],
+            "out of range",
+        ),
+    ] {
+        check_bad_input(&args, &format!("was planned by commit {other}"));
+        let allowed = seads(&[&args[..], &["--allow-other-commit"]].concat());
+        let stderr = String::from_utf8_lossy(&allowed.stderr);
+        assert_eq!(allowed.status.code(), Some(2), "{stderr}");
+        assert!(stderr.contains(ordinary), "{args:?}: {stderr}");
+    }
+    assert_eq!(snapshot(&out), planned, "nothing trained or written");
+}
+
 /// Threads and workers beyond what the machine can run (four per core) are one line of bad input,
 /// before a thread is spawned or anything written: never a panic or a machine that hangs.
 #[test]

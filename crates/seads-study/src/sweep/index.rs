@@ -29,6 +29,11 @@ pub struct Sweep {
     pub evaluation: EvaluationPlan,
     /// The runs, in order; a run's position is its index (the Slurm array task id).
     pub runs: Vec<SweepRun>,
+    /// The commit of the binary that planned the sweep: its runs train on that commit, so that a
+    /// cell never mixes code versions ([`Sweep::allows_commit`]). `None` for a sweep planned
+    /// before it was recorded, or by code that knows no commit.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub planned_by: Option<String>,
 }
 
 /// One run of the index.
@@ -55,6 +60,23 @@ pub struct Planned {
 }
 
 impl Sweep {
+    /// Whether a binary built from `commit` may train this sweep's runs: one of the commit that
+    /// planned the sweep, any where the sweep records none, any with `allow_other`. Another is
+    /// [`StudyError::Invalid`](crate::StudyError::Invalid), naming both commits.
+    pub fn allows_commit(&self, commit: &str, allow_other: bool) -> Result<()> {
+        match &self.planned_by {
+            Some(planned) if planned != commit && !allow_other => {
+                Err(crate::StudyError::invalid(format!(
+                    "sweep {:?} was planned by commit {planned}, and this binary was built from \
+                     {commit}: a study's runs train on one commit (run the binary of {planned}, \
+                     scripts/freeze.sh {planned}), or pass --allow-other-commit",
+                    self.name
+                )))
+            }
+            _ => Ok(()),
+        }
+    }
+
     /// The indices of the runs with one of `seeds` (all runs for `None`), in index order; a seed
     /// the sweep does not have is [`StudyError::Invalid`](crate::StudyError::Invalid).
     pub fn runs_of_seeds(&self, seeds: Option<&[u64]>) -> Result<Vec<usize>> {
@@ -140,11 +162,17 @@ impl Sweep {
         Ok((run, true))
     }
 
-    /// Writes the sweep of `manifest` into `out`. Planning the same manifest again writes
-    /// nothing (only run directories that were deleted are made again); a different manifest
-    /// in the same folder is an error, and nothing is written. Validation errors come back as
-    /// `Err` before any write.
-    pub fn plan(manifest: &Manifest, text: &str, out: &Path) -> Result<Planned> {
+    /// Writes the sweep of `manifest` into `out`, recording `planned_by`, the commit of the
+    /// binary that plans it. Planning the same manifest again writes nothing (only run
+    /// directories that were deleted are made again; the index keeps the commit that planned it
+    /// first); a different manifest in the same folder is an error, and nothing is written.
+    /// Validation errors come back as `Err` before any write.
+    pub fn plan(
+        manifest: &Manifest,
+        text: &str,
+        out: &Path,
+        planned_by: Option<&str>,
+    ) -> Result<Planned> {
         let runs = manifest.expand()?;
         let sweep = Sweep {
             name: manifest.name.clone(),
@@ -160,11 +188,16 @@ impl Sweep {
                     dir: r.rel_dir(),
                 })
                 .collect(),
+            planned_by: planned_by.map(str::to_owned),
         };
         let index_text = serde_json::to_string_pretty(&sweep)? + "\n";
         if out.join(INDEX).exists() {
             let existing = Sweep::load(out)?;
-            if existing != sweep {
+            let same = Sweep {
+                planned_by: existing.planned_by.clone(),
+                ..sweep.clone()
+            };
+            if existing != same {
                 fail!(
                     "{} already holds a different sweep ({:?}); plan into another directory",
                     out.display(),

@@ -40,6 +40,8 @@ pub struct SlurmOptions {
     /// Whether the tasks may train with a binary built from a working tree with uncommitted
     /// changes (`sweep task --allow-dirty`).
     pub allow_dirty: bool,
+    /// Pass `--allow-other-commit` to the tasks.
+    pub allow_other_commit: bool,
 }
 
 /// A word for bash, single-quoted.
@@ -105,10 +107,11 @@ pub fn scripts(dir: &Path, sweep: &Sweep, options: &SlurmOptions) -> (String, St
          {members}\
          exec {seads} sweep task {dir} --index {index} --cores \"${{SLURM_CPUS_PER_TASK:-{cpus}}}\"{device}{dirty}\n",
         name = sweep.name,
-        dirty = if options.allow_dirty {
-            " --allow-dirty"
-        } else {
-            ""
+        dirty = match (options.allow_dirty, options.allow_other_commit) {
+            (true, true) => " --allow-dirty --allow-other-commit",
+            (true, false) => " --allow-dirty",
+            (false, true) => " --allow-other-commit",
+            (false, false) => "",
         },
         unit = if options.populations.is_some() {
             "population of runs"
