@@ -329,18 +329,35 @@ impl<K: Key> Visited<K> {
     }
 
     /// Inserts `keys` in order and marks in `new` (same length, all false) the ones that were
-    /// not there before: the first occurrence of each unseen key. Uses the current rayon pool.
-    fn insert_all(&mut self, keys: &[K], new: &mut [bool]) {
+    /// not there before: the first occurrence of each unseen key; returns how many. Uses the
+    /// current rayon pool. Room for every key is made in its shard first, fallibly: a machine
+    /// without the memory is an error and nothing is inserted, never an abort.
+    fn insert_all(
+        &mut self,
+        keys: &[K],
+        new: &mut [bool],
+    ) -> Result<usize, std::collections::TryReserveError> {
+        let before = self.len;
         if keys.len() < PARALLEL_MIN || rayon::current_num_threads() == 1 {
+            let mut counts = vec![0usize; self.shards.len()];
+            for key in keys {
+                counts[Self::shard(key)] += 1;
+            }
+            for (set, count) in self.shards.iter_mut().zip(counts) {
+                set.try_reserve(count)?;
+            }
             for (key, new) in keys.iter().zip(new.iter_mut()) {
                 *new = self.insert(*key);
             }
-            return;
+            return Ok(self.len - before);
         }
         let shard_of: Vec<u8> = keys.par_iter().map(|k| Self::shard(k) as u8).collect();
         let mut members: Vec<Vec<u32>> = vec![Vec::new(); self.shards.len()];
         for (i, &s) in shard_of.iter().enumerate() {
             members[usize::from(s)].push(i as u32);
+        }
+        for (set, members) in self.shards.iter_mut().zip(&members) {
+            set.try_reserve(members.len())?;
         }
         let added: Vec<Vec<u32>> = self
             .shards
@@ -358,20 +375,7 @@ impl<K: Key> Visited<K> {
             new[*i as usize] = true;
         }
         self.len += added.iter().map(Vec::len).sum::<usize>();
-    }
-
-    /// Makes room for every key of `keys` in its shard, or fails without inserting any: so that
-    /// [`Visited::insert_all`] never grows a set, and a machine without the memory is an error,
-    /// not an abort.
-    fn try_reserve_for(&mut self, keys: &[K]) -> Result<(), std::collections::TryReserveError> {
-        let mut counts = vec![0usize; self.shards.len()];
-        for key in keys {
-            counts[Self::shard(key)] += 1;
-        }
-        for (set, count) in self.shards.iter_mut().zip(counts) {
-            set.try_reserve(count)?;
-        }
-        Ok(())
+        Ok(self.len - before)
     }
 
     /// Bytes the sets take, roughly (their capacity, a key and a control byte per slot).
@@ -484,14 +488,14 @@ fn search<K: Key>(
             keys.par_extend(out[..seen].par_iter().map(|&z| K::pack(z)));
             new.clear();
             new.resize(seen, false);
+            // The search's two growing structures take their room fallibly: a machine without
+            // the memory ends the search with a reason.
             let out_of_memory = |nodes: &Vec<Node>| PlanError::OutOfMemory {
                 discovered: nodes.len(),
             };
-            visited
-                .try_reserve_for(&keys)
+            let added = visited
+                .insert_all(&keys, &mut new)
                 .map_err(|_| out_of_memory(&nodes))?;
-            visited.insert_all(&keys, &mut new);
-            let added = new.iter().filter(|&&n| n).count();
             nodes
                 .try_reserve(added)
                 .map_err(|_| out_of_memory(&nodes))?;

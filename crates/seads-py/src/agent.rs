@@ -10,9 +10,9 @@ use pyo3::prelude::*;
 use pyo3::types::PyDict;
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
-use seads_embodiment::{Environment, Filmed, Push, SkillPolicy, execute_skill};
+use seads_embodiment::{EnvConfig, EnvSpec, Environment, Filmed, Push, SkillPolicy, execute_skill};
 use seads_games::{BoardGame, Successor, SymbolicState};
-use seads_infer::ForwardModel;
+use seads_infer::{ForwardModel, Policy};
 use seads_planner::{PlanChoice, PlannerConfig, Search, SolveConfig, find_plan};
 
 use crate::env::Env;
@@ -24,12 +24,17 @@ use crate::{Values, value_error};
 /// that the thread holding it needs).
 #[pyclass(module = "seads._seads")]
 pub struct Agent {
-    /// The checkpoint (its forward model is the one in `model`).
-    inner: seads_infer::Agent,
+    /// The skill policy.
+    policy: Policy,
+    /// The forward model, one search at a time.
     model: Mutex<ForwardModel>,
+    /// The environment the agent was trained on, its options and its dimensions.
+    env: String,
+    env_config: EnvConfig,
+    spec: EnvSpec,
+    /// The checkpoint's epoch.
+    epoch: u64,
     game: Box<dyn BoardGame + Send + Sync>,
-    obs_dim: usize,
-    action_dim: usize,
 }
 
 /// Observation rows the policy runs on at once in `act`.
@@ -87,7 +92,7 @@ impl Agent {
         // The whole world must be the run's: its name and dimensions (a 7×7 board is no 5×5
         // one), and the options that shape it beyond them (spacing, the manipulator's).
         let spec = environment.spec();
-        let trained = &self.inner;
+        let trained = self;
         let differs = if spec.name != trained.env {
             Some(format!("a {} environment", spec.name))
         } else if spec != &trained.spec {
@@ -142,17 +147,25 @@ impl Agent {
     #[staticmethod]
     #[pyo3(signature = (run_dir, checkpoint=None))]
     fn load(py: Python<'_>, run_dir: PathBuf, checkpoint: Option<u64>) -> PyResult<Self> {
-        let inner = py
+        let seads_infer::Agent {
+            policy,
+            model,
+            env,
+            env_config,
+            spec,
+            epoch,
+        } = py
             .detach(|| seads_infer::Agent::load(&run_dir, checkpoint))
             .map_err(value_error)?;
         // The game of the run's own environment (its board size, from `[env_config]`).
-        let spec = &inner.spec;
         let game = spec.game.build(spec.board_size).map_err(value_error)?;
         Ok(Self {
-            obs_dim: spec.obs_dim,
-            action_dim: spec.action_dim,
-            model: Mutex::new(inner.model.clone()),
-            inner,
+            policy,
+            model: Mutex::new(model),
+            env,
+            env_config,
+            spec,
+            epoch,
             game,
         })
     }
@@ -160,19 +173,19 @@ impl Agent {
     /// The environment the agent was trained on.
     #[getter]
     fn env(&self) -> String {
-        self.inner.env.clone()
+        self.env.clone()
     }
 
     /// The checkpoint's epoch.
     #[getter]
     fn epoch(&self) -> u64 {
-        self.inner.epoch
+        self.epoch
     }
 
     /// The number of skills K.
     #[getter]
     fn num_skills(&self) -> usize {
-        self.inner.policy.num_skills()
+        self.policy.num_skills()
     }
 
     /// `act(obs, skill, deterministic=True, seed=None)`: actions for observations (one, or
@@ -201,12 +214,12 @@ impl Agent {
             _ => unreachable!("one of them was extracted"),
         };
         let rows = match shape[..] {
-            [n] if n == self.obs_dim => 1,
-            [rows, n] if n == self.obs_dim => rows,
+            [n] if n == self.spec.obs_dim => 1,
+            [rows, n] if n == self.spec.obs_dim => rows,
             _ => {
                 return Err(value_error(format!(
                     "observations of shape {shape:?}: ({}) or (rows, {})",
-                    self.obs_dim, self.obs_dim
+                    self.spec.obs_dim, self.spec.obs_dim
                 )));
             }
         };
@@ -239,7 +252,7 @@ impl Agent {
         // abort; the policy runs on chunks of rows, so that its layers hold a chunk at a time.
         let mut actions: Vec<f32> = Vec::new();
         actions
-            .try_reserve_exact(rows.saturating_mul(self.action_dim))
+            .try_reserve_exact(rows.saturating_mul(self.spec.action_dim))
             .map_err(|_| {
                 PyMemoryError::new_err(format!("no memory for the actions of {rows} observations"))
             })?;
@@ -247,10 +260,12 @@ impl Agent {
         let f64_view = f64_obs.as_ref().map(|o| o.as_array());
         let mut f32_values = f32_view.iter().flat_map(|v| v.iter().copied());
         let mut f64_values = f64_view.iter().flat_map(|v| v.iter().copied());
-        let mut chunk: Vec<f32> = Vec::with_capacity(ACT_ROWS * self.obs_dim);
+        let mut chunk: Vec<f32> = Vec::with_capacity(ACT_ROWS * self.spec.obs_dim);
+        // One skill for every row: a chunk's worth of it, made once.
+        let repeated = one.map_or_else(Vec::new, |k| vec![k; ACT_ROWS.min(rows)]);
         for first in (0..rows).step_by(ACT_ROWS) {
             let last = (first + ACT_ROWS).min(rows);
-            let n = (last - first) * self.obs_dim;
+            let n = (last - first) * self.spec.obs_dim;
             chunk.clear();
             if f32_view.is_some() {
                 chunk.extend(f32_values.by_ref().take(n));
@@ -265,16 +280,11 @@ impl Agent {
                     chunk.push(narrow);
                 }
             }
-            let repeated;
             let skills = match one {
-                Some(k) => {
-                    repeated = vec![k; last - first];
-                    &repeated[..]
-                }
+                Some(_) => &repeated[..last - first],
                 None => &each[first..last],
             };
             let part = self
-                .inner
                 .policy
                 .actions(&chunk, skills, rng.as_mut())
                 .map_err(value_error)?;
@@ -284,7 +294,7 @@ impl Agent {
             Ok(PyArray1::from_vec(py, actions).into_any())
         } else {
             let array = PyArray1::from_vec(py, actions);
-            Ok(array.reshape([rows, self.action_dim])?.into_any())
+            Ok(array.reshape([rows, self.spec.action_dim])?.into_any())
         }
     }
 
@@ -373,7 +383,7 @@ impl Agent {
         if let Some(start) = start {
             environment.set_board(start).map_err(value_error)?;
         }
-        let policy = &self.inner.policy;
+        let policy = &self.policy;
         if render {
             crate::render::check_size(size)?;
         }
@@ -447,17 +457,17 @@ impl Agent {
         crate::render::check_size(size)?;
         let skill = usize::try_from(skill)
             .ok()
-            .filter(|&k| k < self.inner.policy.num_skills())
+            .filter(|&k| k < self.policy.num_skills())
             .ok_or_else(|| {
                 value_error(format!(
                     "skill {skill}: the agent has skills 0 to {}",
-                    self.inner.policy.num_skills() - 1
+                    self.policy.num_skills() - 1
                 ))
             })?;
         let core = env_core(env)?;
         let mut core = core.borrow_mut();
         let environment = self.own_env(&mut core)?;
-        let policy = &self.inner.policy;
+        let policy = &self.policy;
         let (run, scenes) = py.detach(|| {
             let mut filmed = Filmed::new(environment.box_clone());
             let run = execute_skill(&mut filmed, policy, skill);
