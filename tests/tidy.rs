@@ -139,9 +139,16 @@ fn crate_dependencies_point_one_way_and_only_five_crates_link_libtorch() {
     let expected: &[(&str, &[&str])] = &[
         ("seads-games", &[]),
         ("seads-weights", &[]),
-        ("seads-nn", &["seads-weights"]),
+        (
+            "seads-run",
+            &["seads-embodiment", "seads-games", "seads-planner"],
+        ),
+        ("seads-nn", &["seads-run", "seads-weights"]),
         ("seads-embodiment", &["seads-games"]),
-        ("seads-skillmodel", &["seads-games", "seads-nn"]),
+        (
+            "seads-skillmodel",
+            &["seads-games", "seads-nn", "seads-run"],
+        ),
         (
             "seads-rl",
             &[
@@ -149,6 +156,7 @@ fn crate_dependencies_point_one_way_and_only_five_crates_link_libtorch() {
                 "seads-games",
                 "seads-nn",
                 "seads-planner",
+                "seads-run",
                 "seads-skillmodel",
             ],
         ),
@@ -173,8 +181,21 @@ fn crate_dependencies_point_one_way_and_only_five_crates_link_libtorch() {
                 "seads-embodiment",
                 "seads-games",
                 "seads-planner",
+                "seads-run",
+                "seads-uarm",
+            ],
+        ),
+        (
+            "seads-evaluation",
+            &[
+                "seads-embodiment",
+                "seads-games",
+                "seads-nn",
+                "seads-planner",
                 "seads-rl",
+                "seads-run",
                 "seads-skillmodel",
+                "seads-study",
                 "seads-uarm",
             ],
         ),
@@ -182,10 +203,12 @@ fn crate_dependencies_point_one_way_and_only_five_crates_link_libtorch() {
             "seads-cli",
             &[
                 "seads-embodiment",
+                "seads-evaluation",
                 "seads-games",
                 "seads-nn",
                 "seads-planner",
                 "seads-rl",
+                "seads-run",
                 "seads-skillmodel",
                 "seads-study",
                 "seads-uarm",
@@ -231,7 +254,7 @@ fn crate_dependencies_point_one_way_and_only_five_crates_link_libtorch() {
             "seads-nn",
             "seads-skillmodel",
             "seads-rl",
-            "seads-study",
+            "seads-evaluation",
             "seads-cli"
         ]
     );
@@ -268,8 +291,9 @@ fn tree(args: &[&str]) -> Vec<String> {
 }
 
 /// A user of the games, the planner, the robot, Cursor or Reacher downloads neither PyTorch nor
-/// a physics engine: libtorch only behind `seads-skillmodel`, rapier3d only behind
-/// `seads-embodiment`'s default feature `jaco` (docs/ARCHITECTURE.md).
+/// a physics engine: libtorch only behind `seads-nn`, rapier3d only behind `seads-embodiment`'s
+/// default feature `jaco` (docs/ARCHITECTURE.md). A run's data (`seads-run`) and the reports
+/// and sweeps that read it (`seads-study`) build without libtorch.
 #[test]
 fn light_crates_pull_in_neither_libtorch_nor_rapier() {
     for (args, heavy) in [
@@ -281,6 +305,9 @@ fn light_crates_pull_in_neither_libtorch_nor_rapier() {
         (&["-p", "seads-infer"], &["tch", "torch-sys", "rapier3d"]),
         (&["-p", "seads-weights"], &["tch", "torch-sys", "rapier3d"]),
         (&["-p", "seads-uarm"], &["tch", "torch-sys", "rapier3d"]),
+        // A run's data, and the reports and sweeps that read it: no libtorch (issue 78).
+        (&["-p", "seads-run"], &["tch", "torch-sys", "rapier3d"]),
+        (&["-p", "seads-study"], &["tch", "torch-sys"]),
         (
             &["-p", "seads-embodiment", "--no-default-features"],
             &["tch", "torch-sys", "rapier3d"],
@@ -398,7 +425,7 @@ fn the_python_bindings_write_no_unsafe_code() {
 }
 
 /// Every registered environment has a shipped preset (the trainer embeds every file of
-/// `configs/` by its name: `every_preset_file_is_embedded_under_its_name` in seads-rl).
+/// `configs/` by its name: `every_preset_file_is_embedded_under_its_name` in seads-run).
 #[test]
 fn every_environment_has_a_preset() {
     let envs = seads_embodiment::env_names();

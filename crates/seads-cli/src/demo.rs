@@ -81,7 +81,7 @@ pub fn run(args: RunArgs) -> Result<()> {
         }
         if let Some(steps) = args.env_steps {
             seads_rl::raise_budget(&args.out, steps).map_err(|e| match e {
-                seads_rl::RlError::Config(_) => BadInput(e.into()).into(),
+                seads_run::RunError::Config(_) => BadInput(e.into()).into(),
                 other => anyhow::Error::from(other),
             })?;
         }

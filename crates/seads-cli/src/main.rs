@@ -27,6 +27,7 @@ mod sweep;
 mod train;
 mod uarm;
 
+use seads_nn::Resolve as _;
 use std::process::ExitCode;
 
 use clap::{Parser, Subcommand};
@@ -176,6 +177,15 @@ pub fn study_error(e: seads_study::StudyError) -> anyhow::Error {
     }
 }
 
+/// An evaluation's error as the binary's: input the user must fix is bad input (exit 2).
+pub fn eval_error(e: seads_evaluation::EvalError) -> anyhow::Error {
+    if e.is_invalid() {
+        BadInput(e.into()).into()
+    } else {
+        e.into()
+    }
+}
+
 /// Takes the run directory `dir` for this command, the one writer it may have at a time (see
 /// [`seads_rl::store::RunLock`]); another writer holding it is exit 2, naming it. Waits a moment, for a
 /// `sweep status` that looks at the lock.
@@ -221,7 +231,7 @@ fn acquire(
         .take(200)
         .collect();
     seads_rl::store::RunLock::acquire(dir, &command, patience).map_err(|e| match e {
-        seads_rl::RlError::Busy { .. } => BadInput(e.into()).into(),
+        seads_run::RunError::Busy { .. } => BadInput(e.into()).into(),
         other => anyhow::Error::from(other),
     })
 }

@@ -104,27 +104,33 @@ pub fn train(args: TrainArgs) -> Result<()> {
             crate::usable_device(device)?;
             if let Some(steps) = args.env_steps {
                 seads_rl::raise_budget(dir, steps).map_err(|e| match e {
-                    seads_rl::RlError::Config(_) => BadInput(e.into()).into(),
+                    seads_run::RunError::Config(_) => BadInput(e.into()).into(),
                     other => anyhow::Error::from(other),
                 })?;
             }
             let config = crate::run_config(dir)?;
             crate::kernels::use_kernels(config.portable_numerics)?;
-            config.algorithm.with_learner(Resume {
-                dir,
-                device,
-                quiet: args.quiet,
-            })
+            seads_rl::with_learner(
+                config.algorithm,
+                Resume {
+                    dir,
+                    device,
+                    quiet: args.quiet,
+                },
+            )
         }
         None => {
             let config = config(&args)?;
             crate::kernels::use_kernels(config.portable_numerics)?;
             let out = args.out.as_ref().expect("clap requires --out");
-            config.algorithm.with_learner(Create {
-                out,
-                config,
-                quiet: args.quiet,
-            })
+            seads_rl::with_learner(
+                config.algorithm,
+                Create {
+                    out,
+                    config,
+                    quiet: args.quiet,
+                },
+            )
         }
     }
 }
@@ -241,8 +247,7 @@ pub fn drive<L: InWords>(run: &mut Run<L>, quiet: bool) -> Result<()> {
         run.set_hook(hook);
     }
     let budget = run.trainer().config().env_steps;
-    seads_study::provenance::Provenance::record(run, &crate::build())
-        .context("recording the run's provenance")?;
+    record_provenance(run, &crate::build()).context("recording the run's provenance")?;
     let template = "{elapsed_precise} [{bar:30}] {pos}/{len} steps {msg}";
     let bar = crate::progress_bar(budget, quiet, template);
     bar.set_position(run.trainer().steps().min(budget));
@@ -283,4 +288,23 @@ pub fn drive<L: InWords>(run: &mut Run<L>, quiet: bool) -> Result<()> {
     );
     outln!("time per phase: {}", run.trainer().phases());
     Ok(())
+}
+
+/// Appends this process of `build` to the provenance of `run`, about to train it on from where
+/// it stands; nothing for a run that has finished.
+pub fn record_provenance<L: InWords>(
+    run: &Run<L>,
+    build: &seads_study::provenance::Build,
+) -> Result<(), seads_rl::RlError> {
+    if run.finished() {
+        return Ok(());
+    }
+    let trainer = run.trainer();
+    let at = (trainer.epoch(), trainer.steps());
+    Ok(seads_study::provenance::Provenance::record(
+        run.dir(),
+        trainer.config(),
+        at,
+        build,
+    )?)
 }

@@ -410,7 +410,7 @@ pub fn train(mut args: UarmTrainArgs) -> Result<()> {
         let lock = crate::lock_run(&args.out)?;
         if let Some(steps) = args.env_steps {
             seads_rl::raise_budget(&args.out, steps).map_err(|e| match e {
-                seads_rl::RlError::Config(_) => BadInput(e.into()).into(),
+                seads_run::RunError::Config(_) => BadInput(e.into()).into(),
                 other => anyhow::Error::from(other),
             })?;
         }
@@ -568,14 +568,14 @@ fn evaluate(
     quiet: bool,
 ) -> Result<()> {
     let checkpoint = find_checkpoint(run, epoch).map_err(|e| BadInput(e.into()))?;
-    let evaluation = seads_study::robot::RobotEvaluation {
+    let evaluation = seads_evaluation::robot::RobotEvaluation {
         twin_seed,
         boards,
         limits,
     };
     let before = evaluation
         .finished_before(run, &checkpoint)
-        .map_err(crate::study_error)?;
+        .map_err(crate::eval_error)?;
     let tasks = 5 * boards as u64;
     crate::plan::warn_damaged_journal(run, before.damaged);
     let before = before.finished;
@@ -592,7 +592,7 @@ fn evaluate(
     let bar = crate::progress_bar(tasks, quiet, "{wide_bar} {pos}/{len}");
     let record = evaluation
         .run(run, &checkpoint, env, || bar.inc(1))
-        .map_err(crate::study_error)?;
+        .map_err(crate::eval_error)?;
     bar.finish_and_clear();
     let results = record.results;
     let (solved, tasks) = results

@@ -8,7 +8,7 @@ pub mod numerics;
 pub mod process;
 mod stacked;
 
-pub use device::{ComputeDevice, DeviceError};
+pub use device::{ComputeDevice, DeviceError, Resolve};
 pub use seads_weights::WeightsError;
 pub use stacked::{StackedAdam, StackedLinear, StackedMlp, StackedParameters, upload};
 

@@ -1,6 +1,7 @@
 //! A trained agent loaded from a run directory: the skill policy (for executing skills) and the
 //! forward model (for planning); and a baseline's task policy loaded from its checkpoint.
 
+use seads_nn::Resolve as _;
 use std::path::{Path, PathBuf};
 
 use seads_embodiment::{EnvSpec, SkillPolicy, make_env};
@@ -178,11 +179,14 @@ pub fn load_policy(
 ) -> Result<Box<dyn TaskPolicy>, RlError> {
     crate::store::check_origin(checkpoint, config)?;
     let spec = make_env(&config.env, &config.env_config)?.spec().clone();
-    config.algorithm.with_learner(LoadPolicy {
-        config,
-        spec: &spec,
-        checkpoint,
-    })
+    crate::with_learner(
+        config.algorithm,
+        LoadPolicy {
+            config,
+            spec: &spec,
+            checkpoint,
+        },
+    )
 }
 
 /// [`load_policy`]'s work with the run's learner.

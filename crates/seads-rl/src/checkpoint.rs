@@ -10,15 +10,7 @@ use tch::{Kind, Tensor};
 
 use crate::{Episode, RlError, TransitionBatch};
 
-/// The episode buffer (long-term buffer; the recent episodes are its tail).
-pub const EPISODES_FILE: &str = "episodes.safetensors";
-/// The next epoch's updates, prepared while SAC updated (absent when there are none).
-pub const PREPARED_FILE: &str = "prepared.safetensors";
-/// Epoch, environment steps, time per phase and the random streams.
-pub const PROGRESS_FILE: &str = "progress.json";
-/// What the environments carry from one episode to the next (absent when they carry nothing):
-/// a JSON list of each training slot's state, then the coverage environment's.
-pub const ENVIRONMENT_FILE: &str = "environment.json";
+pub use seads_run::store::{ENVIRONMENT_FILE, EPISODES_FILE, PREPARED_FILE, PROGRESS_FILE};
 
 /// Every file of a checkpoint that only resuming needs (evaluation needs the actor and the
 /// skill model's parameters): they are dropped from all but the two newest checkpoints.

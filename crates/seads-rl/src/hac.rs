@@ -61,6 +61,7 @@
 //! baseline: the open episodes are replayed from their seeds and actions, which also restores
 //! each environment's observations since its subgoal began.
 
+use seads_nn::Resolve as _;
 use std::path::Path;
 use std::time::Instant;
 
@@ -70,11 +71,12 @@ use seads_games::SymbolicState;
 use seads_planner::{DepthResult, TaskSet};
 use serde::{Deserialize, Serialize};
 
+use crate::TaskTimings;
 use crate::learner::Learner;
 use crate::replay::Replay;
 use crate::task_episodes::{
-    self, LossMean, OpenEpisode, Streams, TaskEpisodes, TaskEpochStats, TaskTimings, read_progress,
-    updates_due, write_progress,
+    self, LossMean, OpenEpisode, Streams, TaskEpisodes, TaskEpochStats, read_progress, updates_due,
+    write_progress,
 };
 use crate::task_policy::TaskPolicy;
 use crate::{
@@ -756,7 +758,7 @@ impl Learner for Hac {
     fn metrics(&mut self, stats: &TaskEpochStats, wall_s: f64) -> Result<TaskMetrics, RlError> {
         let results = self.task_success(self.config.hac.eval_boards)?;
         let p = &mut self.progress;
-        let mut line = TaskMetrics::new(&results, &p.shared, wall_s, stats);
+        let mut line = crate::task_sac::task_metrics(&results, &p.shared, wall_s, stats);
         let (attempts, reached) = (p.attempts - p.reported.0, p.reached - p.reported.1);
         line.subgoals_reached = Some(reached as f64 / attempts.max(1) as f64);
         p.reported = (p.attempts, p.reached);

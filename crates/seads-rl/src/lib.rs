@@ -38,9 +38,7 @@
 mod agent;
 mod buffers;
 mod checkpoint;
-mod config;
 mod episode;
-mod flat_layout;
 mod hac;
 mod in_words;
 mod learner;
@@ -52,11 +50,9 @@ mod relaxed;
 mod replay;
 mod run;
 mod sac;
-mod sections;
 mod seeds;
 mod stacked;
 mod stacked_population;
-pub mod store;
 mod task_episodes;
 mod task_policy;
 mod task_sac;
@@ -66,27 +62,30 @@ use std::path::Path;
 
 pub use agent::{Agent, AgentPolicy, find_checkpoint, load_policy};
 pub use buffers::{RelabelBatch, Relabelling};
-pub use config::{TrainConfig, machine_memory_bytes, merge_toml};
 pub use episode::{Episode, run_episodes, skill_coverage};
-pub use flat_layout::upgrade as upgrade_flat_layout;
 pub use hac::{Hac, HacPolicy};
 pub use in_words::{BaselineInWords, InWords};
 pub use learner::{Hook, Learner, Moment};
-pub use learners::WithLearner;
-pub use metrics::{Metrics, read_metrics};
+pub use learners::{WithLearner, with_learner};
 pub use numerics::{PORTABLE_KERNELS, kernel_environment, portable_kernels_active};
-pub use population::{Members, Population, PopulationKey, check_population};
+pub use population::{Members, Population};
 pub use relaxed::RelaxedBernoulli;
-pub use run::{Run, RunEvent, load_config, raise_budget};
-pub use sac::{Sac, SacConfig, SacLosses, TransitionBatch, checkpoint_files};
-pub use seads_nn::{ComputeDevice, DeviceError};
-pub use sections::{Algorithm, BaselineConfig, HacConfig, RelabelConfig, SeadsConfig};
+pub use run::{Run, RunEvent};
+pub use sac::{Sac, SacLosses, TransitionBatch, checkpoint_files};
 pub use seeds::{Purpose, derived_seed, stream};
 pub use stacked_population::StackedPopulation;
-pub use task_episodes::{TaskEpochStats, TaskTimings, updates_due};
+pub use task_episodes::{TaskEpochStats, updates_due};
 pub use task_policy::{TaskPolicy, task_success};
-pub use task_sac::{TaskMetrics, TaskSac};
-pub use trainer::{COVERAGE_SEED, EpochStats, Timings, Trainer};
+pub use task_sac::TaskSac;
+pub use trainer::{COVERAGE_SEED, EpochStats, Trainer};
+// A run's data (configuration, directory, metrics lines) is `seads-run`'s, re-exported here for
+// the learners and their users.
+pub use seads_run::{
+    Algorithm, BaselineConfig, ComputeDevice, DeviceError, HacConfig, Metrics, PopulationKey,
+    RelabelConfig, RunError, SacConfig, SeadsConfig, TaskMetrics, TaskTimings, Timings,
+    TrainConfig, check_population, load_config, machine_memory_bytes, merge_toml, raise_budget,
+    read_metrics, store, upgrade_flat_layout,
+};
 
 /// Sets the number of libtorch intra-op threads of the process.
 pub fn set_threads(n: usize) {
@@ -188,6 +187,22 @@ pub enum RlError {
         #[source]
         source: Box<RlError>,
     },
+}
+
+/// A run's data errors keep their kind: a bad configuration is [`RlError::Config`], a busy run
+/// [`RlError::Busy`], and so on.
+impl From<RunError> for RlError {
+    fn from(e: RunError) -> Self {
+        match e {
+            RunError::Config(message) => RlError::Config(message),
+            RunError::Env(e) => RlError::Env(e),
+            RunError::Io { path, source } => RlError::Io { path, source },
+            RunError::Checkpoint { path, reason } => RlError::Checkpoint { path, reason },
+            RunError::Unreadable { path, source } => RlError::Unreadable { path, source },
+            RunError::Damaged { dir, reason } => RlError::Damaged { dir, reason },
+            RunError::Busy { dir, holder } => RlError::Busy { dir, holder },
+        }
+    }
 }
 
 impl RlError {

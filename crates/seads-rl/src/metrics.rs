@@ -2,59 +2,8 @@
 
 use std::path::Path;
 
-use serde::{Deserialize, Serialize};
-
 use crate::learner::{Learner, Moment};
-use crate::store::{MetricsLine, read_metrics_as};
-use crate::{EpochStats, RlError, Timings, TrainConfig, Trainer};
-
-/// One line of `metrics.jsonl`.
-#[derive(Debug, Clone, Serialize, Deserialize)]
-pub struct Metrics {
-    /// Epochs completed.
-    pub epoch: u64,
-    /// Environment steps so far.
-    pub env_steps: u64,
-    /// Mean number of distinct game moves made by the skills (SPEC §4.5).
-    pub skill_coverage: f64,
-    /// Wall-clock seconds since the run started (across resumes).
-    pub wall_s: f64,
-    /// Mean final reward of the last SAC batch.
-    pub mean_reward: f32,
-    /// Fraction of the last epoch's new episodes that changed the board.
-    pub changed: f32,
-    /// Last skill-model loss.
-    pub skill_model_loss: f32,
-    /// Last critic loss.
-    pub critic_loss: f32,
-    /// Last actor loss.
-    pub actor_loss: f32,
-    /// Environment steps per wall-clock second since the start of the run.
-    pub steps_per_s: f64,
-    /// Seconds per phase since the start of the run.
-    pub timings: Timings,
-}
-
-impl MetricsLine for Metrics {
-    fn epoch(&self) -> u64 {
-        self.epoch
-    }
-    fn wall_s(&self) -> f64 {
-        self.wall_s
-    }
-    fn env_steps(&self) -> u64 {
-        self.env_steps
-    }
-    fn steps_per_s(&self) -> f64 {
-        self.steps_per_s
-    }
-}
-
-/// The lines of `dir/metrics.jsonl`. A last line without its newline is the trace of a crash
-/// during the append and is left out; any other line that does not parse is an error.
-pub fn read_metrics(dir: &Path) -> Result<Vec<Metrics>, RlError> {
-    read_metrics_as(dir)
-}
+use crate::{EpochStats, Metrics, RlError, TrainConfig, Trainer};
 
 impl Learner for Trainer {
     type Stats = EpochStats;

@@ -19,7 +19,7 @@ use crate::store::{
     checkpoint_name, checkpoints, clean_leftovers, commit_dir, hidden_sibling, read_metrics_text,
     write_atomic, write_metrics, write_origin,
 };
-use crate::{RlError, TrainConfig, Trainer};
+use crate::{RlError, TrainConfig, Trainer, load_config};
 
 /// What a call to [`Run::step`] did.
 #[derive(Debug, Clone)]
@@ -160,7 +160,10 @@ impl<L: Learner> Run<L> {
         let mut failures: Vec<RlError> = Vec::new();
         let mut resumed = None;
         for candidate in candidates {
-            match check_origin(&candidate, &config).and_then(|()| trainer.load(&candidate)) {
+            let loaded = check_origin(&candidate, &config)
+                .map_err(RlError::from)
+                .and_then(|()| trainer.load(&candidate));
+            match loaded {
                 Ok(()) => {
                     resumed = Some(candidate);
                     break;
@@ -359,32 +362,4 @@ pub(crate) fn due(config: &TrainConfig, first: bool, epoch: u64, done: bool) -> 
         first || epoch.is_multiple_of(config.eval_every) || done,
         epoch.is_multiple_of(config.checkpoint_every) || done,
     )
-}
-
-/// Raises the budget of the run in `dir` to `env_steps` environment steps and records it in its
-/// config; the run continues with `seads train --resume`. A budget below the current one is a
-/// configuration error.
-pub fn raise_budget(dir: &Path, env_steps: u64) -> Result<(), RlError> {
-    let mut config = load_config(dir)?;
-    if env_steps < config.env_steps {
-        return Err(RlError::Config(format!(
-            "--env-steps {env_steps} is below the run's budget of {}; a budget can only be raised",
-            config.env_steps
-        )));
-    }
-    if env_steps > config.env_steps {
-        config.env_steps = env_steps;
-        // Checked before it is written: a run never holds a config it cannot read.
-        config.validate_values()?;
-        write_atomic(&dir.join(CONFIG), config.to_toml().as_bytes())?;
-    }
-    Ok(())
-}
-
-/// Reads and validates `dir/config.toml`.
-pub fn load_config(dir: &Path) -> Result<TrainConfig, RlError> {
-    let path = dir.join(CONFIG);
-    let text = fs::read_to_string(&path).map_err(|e| RlError::io(&path, e))?;
-    TrainConfig::from_user_toml(&text, None, None)
-        .map_err(|e| RlError::Config(format!("{}: {e}", path.display())))
 }

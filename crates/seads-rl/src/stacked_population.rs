@@ -11,6 +11,7 @@
 //! stacked members change. So each member's run directory is a single run's, and its checkpoint
 //! resumes or evaluates as one.
 
+use seads_nn::Resolve as _;
 use std::time::Instant;
 
 use tch::Device;

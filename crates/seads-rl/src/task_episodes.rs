@@ -13,6 +13,7 @@ use seads_games::Split;
 use serde::de::DeserializeOwned;
 use serde::{Deserialize, Serialize};
 
+use crate::TaskTimings;
 use crate::seeds::{Purpose, derived_seed, stream};
 use crate::{RlError, SacLosses, TrainConfig};
 
@@ -31,17 +32,6 @@ pub(crate) struct Streams {
     pub(crate) collect: ChaCha8Rng,
     pub(crate) sample: ChaCha8Rng,
     pub(crate) sac: ChaCha8Rng,
-}
-
-/// Seconds per phase since the start of the run.
-#[derive(Debug, Clone, Copy, Default, PartialEq, Serialize, Deserialize)]
-pub struct TaskTimings {
-    /// Environment steps and policy calls.
-    pub collect: f64,
-    /// SAC gradient steps.
-    pub sac: f64,
-    /// Task-success evaluations.
-    pub evaluate: f64,
 }
 
 /// What one epoch of a baseline did.

@@ -21,94 +21,47 @@
 //! random streams, and for each environment the seed and actions of its open episode, which
 //! resuming replays (the simulations are deterministic given a seed).
 
+use seads_nn::Resolve as _;
 use std::path::Path;
 use std::time::Instant;
 
 use seads_planner::{DepthResult, TaskSet};
-use serde::{Deserialize, Serialize};
 
 use crate::learner::Learner;
 use crate::replay::Replay;
-use crate::store::MetricsLine;
 use crate::task_episodes::{
-    LossMean, Progress, TaskEpisodes, TaskEpochStats, TaskTimings, read_progress, updates_due,
-    write_progress,
+    LossMean, Progress, TaskEpisodes, TaskEpochStats, read_progress, updates_due, write_progress,
 };
 use crate::{Moment, Purpose, RlError, Sac, TrainConfig, derived_seed, task_success};
+use crate::{TaskMetrics, TaskTimings};
 
 /// The replay buffer of a run's checkpoint.
 pub const REPLAY_FILE: &str = "replay.safetensors";
 /// Epoch, steps, random streams and open episodes of a run's checkpoint.
 pub const TASK_PROGRESS_FILE: &str = "task-progress.json";
 
-/// One line of a baseline run's `metrics.jsonl`.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-pub struct TaskMetrics {
-    /// Epochs completed.
-    pub epoch: u64,
-    /// Environment steps so far.
-    pub env_steps: u64,
-    /// Wall-clock seconds since the run started (across resumes).
-    pub wall_s: f64,
-    /// Share of the test boards solved per depth 1–5, deterministic policy.
-    pub success: Vec<f64>,
-    /// Mean of `success`.
-    pub mean_success: f64,
-    /// Share of the training episodes ended so far that solved their board.
-    pub train_solved: f64,
-    /// Last critic loss.
-    pub critic_loss: f32,
-    /// Last actor loss.
-    pub actor_loss: f32,
-    /// Environment steps per wall-clock second since the start of the run.
-    pub steps_per_s: f64,
-    /// Seconds per phase since the start of the run.
-    pub timings: TaskTimings,
-    /// HAC: share of the subgoal attempts ended since the previous line that reached their
-    /// subgoal (absent for SAC).
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub subgoals_reached: Option<f64>,
-}
-
-impl TaskMetrics {
-    /// The line after the epoch that `progress` has reached, for the per-depth `results` of an
-    /// evaluation.
-    pub(crate) fn new(
-        results: &[DepthResult],
-        progress: &Progress,
-        wall_s: f64,
-        stats: &TaskEpochStats,
-    ) -> Self {
-        let (epoch, env_steps) = (progress.epoch, progress.env_steps);
-        let success: Vec<f64> = results.iter().map(DepthResult::success_rate).collect();
-        Self {
-            epoch,
-            env_steps,
-            wall_s,
-            mean_success: success.iter().sum::<f64>() / success.len().max(1) as f64,
-            success,
-            train_solved: progress.train_solved(),
-            critic_loss: stats.sac.critic,
-            actor_loss: stats.sac.actor,
-            steps_per_s: env_steps as f64 / wall_s.max(1e-9),
-            timings: progress.timings,
-            subgoals_reached: None,
-        }
-    }
-}
-
-impl MetricsLine for TaskMetrics {
-    fn epoch(&self) -> u64 {
-        self.epoch
-    }
-    fn wall_s(&self) -> f64 {
-        self.wall_s
-    }
-    fn env_steps(&self) -> u64 {
-        self.env_steps
-    }
-    fn steps_per_s(&self) -> f64 {
-        self.steps_per_s
+/// The line after the epoch that `progress` has reached, for the per-depth `results` of an
+/// evaluation.
+pub(crate) fn task_metrics(
+    results: &[DepthResult],
+    progress: &Progress,
+    wall_s: f64,
+    stats: &TaskEpochStats,
+) -> TaskMetrics {
+    let (epoch, env_steps) = (progress.epoch, progress.env_steps);
+    let success: Vec<f64> = results.iter().map(DepthResult::success_rate).collect();
+    TaskMetrics {
+        epoch,
+        env_steps,
+        wall_s,
+        mean_success: success.iter().sum::<f64>() / success.len().max(1) as f64,
+        success,
+        train_solved: progress.train_solved(),
+        critic_loss: stats.sac.critic,
+        actor_loss: stats.sac.actor,
+        steps_per_s: env_steps as f64 / wall_s.max(1e-9),
+        timings: progress.timings,
+        subgoals_reached: None,
     }
 }
 
@@ -299,7 +252,7 @@ impl Learner for TaskSac {
     }
     fn metrics(&mut self, stats: &TaskEpochStats, wall_s: f64) -> Result<TaskMetrics, RlError> {
         let results = self.task_success(self.config.sac_baseline.eval_boards)?;
-        Ok(TaskMetrics::new(&results, &self.progress, wall_s, stats))
+        Ok(task_metrics(&results, &self.progress, wall_s, stats))
     }
     fn save(&self, dir: &Path) -> Result<(), RlError> {
         TaskSac::save(self, dir)

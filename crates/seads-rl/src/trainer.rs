@@ -1,6 +1,7 @@
 //! The SEADS training loop (SPEC §3.7, Algorithm 3): collect episodes with the skill policy,
 //! relabel them with the skill model, update the skill model and SAC.
 
+use seads_nn::Resolve as _;
 use std::collections::VecDeque;
 use std::path::Path;
 use std::sync::atomic::{AtomicBool, Ordering};
@@ -13,15 +14,16 @@ use seads_games::Split;
 use seads_skillmodel::{SkillModel, SkillTransition};
 use serde::{Deserialize, Serialize};
 
+use crate::Timings;
 use crate::buffers::{Buffers, RelabelObserver};
 use crate::checkpoint::{self, Prepared};
 use crate::episode::{run_episodes, skill_coverage};
 use crate::seeds::{Purpose, derived_seed, stream, train_env_seed};
 use crate::stacked::SacWork;
 use crate::{Episode, Moment, RlError, Sac, SacLosses, TrainConfig, TransitionBatch};
+use seads_skillmodel::BuildSkillModel as _;
 
-/// First seed of the skill-coverage evaluation (the paper's 444555 … 444574).
-pub const COVERAGE_SEED: u64 = 444_555;
+pub use seads_run::COVERAGE_SEED;
 
 /// Independent random streams of a run (one per purpose).
 #[derive(Debug, Clone, Serialize, Deserialize)]
@@ -34,23 +36,6 @@ struct Streams {
     sample: ChaCha8Rng,
     /// SAC update noise.
     sac: ChaCha8Rng,
-}
-
-/// Seconds spent per phase since the start of the run (the epoch profile). Relabelling and the
-/// skill-model steps run beside SAC (see [`Trainer::run_epoch`]), so the phases add up to more
-/// than the wall time.
-#[derive(Debug, Clone, Copy, Default, Serialize, Deserialize)]
-pub struct Timings {
-    /// Episode collection (environment steps and policy calls).
-    pub collect: f64,
-    /// Skill-model scores, rewards and assignments for both batches, and SAC minibatch assembly.
-    pub relabel: f64,
-    /// Skill-model gradient steps.
-    pub skill_model: f64,
-    /// SAC gradient steps.
-    pub sac: f64,
-    /// Skill-coverage evaluations.
-    pub evaluate: f64,
 }
 
 /// What one epoch did.

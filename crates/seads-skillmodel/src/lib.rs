@@ -35,8 +35,8 @@ mod screen;
 
 pub use groundtruth::{agreement_with_game, fit_to_game};
 pub use model::{
-    ForwardModel, OPTIMISER_FILES, SkillDiscriminator, SkillModel, SkillModelConfig,
-    SkillModelKind, SkillTransition, fast_int8_products,
+    BuildSkillModel, ForwardModel, OPTIMISER_FILES, SkillDiscriminator, SkillModel,
+    SkillModelConfig, SkillModelKind, SkillTransition, fast_int8_products,
 };
 pub use relabel::{RelabelKind, relabel, relabel_assignment, relabel_max};
 pub use reward::{

@@ -7,13 +7,13 @@ use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 use rayon::prelude::*;
 use seads_games::SymbolicState;
-use serde::{Deserialize, Serialize};
 use tch::nn::{self, Module};
 use tch::{Device, Kind, Tensor};
 
 use crate::SkillModelError;
 use crate::screen::{Activations, Int8Screen, MAX_WIDTH, MIN_ROWS};
 use seads_nn::{Adam, Init, Mlp, mean_f32};
+pub use seads_run::{SkillModelConfig, SkillModelKind};
 
 /// States per successor call on a GPU (25 skills: 8·10⁵ network rows, about 2 GiB of
 /// activations for 256-unit layers): enough rows that a call's launches and copies are a small
@@ -53,70 +53,20 @@ pub trait SkillModel: Send {
     fn load(&mut self, dir: &Path, optimiser: bool) -> Result<(), SkillModelError>;
 }
 
-/// Which skill model, and its network and optimiser. `Default` = the paper's forward model.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields, default)]
-pub struct SkillModelConfig {
-    /// `forward` (SEADS) or `vic` (skill discriminator, no planning).
-    pub kind: SkillModelKind,
-    /// Hidden layer sizes.
-    pub hidden: Vec<i64>,
-    /// Adam learning rate.
-    pub lr: f64,
-    /// Tuples per gradient step.
-    pub batch_size: usize,
-    /// Gradient steps per epoch.
-    pub updates_per_epoch: usize,
+/// Builds a skill model from its settings ([`SkillModelConfig`], which lives with the run's
+/// configuration in `seads-run`).
+pub trait BuildSkillModel {
+    /// The model for symbolic states of `d` bits and `k` skills, initialised from `seed`.
+    fn build(&self, d: usize, k: usize, device: Device, seed: u64) -> Box<dyn SkillModel>;
 }
 
-impl Default for SkillModelConfig {
-    fn default() -> Self {
-        Self {
-            kind: SkillModelKind::Forward,
-            hidden: vec![256, 256],
-            lr: 1e-3,
-            batch_size: 32,
-            updates_per_epoch: 4,
-        }
-    }
-}
-
-impl SkillModelConfig {
-    /// Checks the values.
-    pub fn validate(&self) -> Result<(), SkillModelError> {
-        let bad = |m: String| Err(SkillModelError::Config(m));
-        if self.hidden.is_empty() || self.hidden.iter().any(|&h| h <= 0) {
-            return bad(format!(
-                "skill_model.hidden must be positive layer sizes, got {:?}",
-                self.hidden
-            ));
-        }
-        if !(self.lr > 0.0 && self.lr.is_finite()) {
-            return bad(format!("skill_model.lr must be positive, got {}", self.lr));
-        }
-        if self.batch_size == 0 {
-            return bad("skill_model.batch_size must be at least 1".into());
-        }
-        Ok(())
-    }
-
-    /// Builds the model for symbolic states of `d` bits and `k` skills, initialised from `seed`.
-    pub fn build(&self, d: usize, k: usize, device: Device, seed: u64) -> Box<dyn SkillModel> {
+impl BuildSkillModel for SkillModelConfig {
+    fn build(&self, d: usize, k: usize, device: Device, seed: u64) -> Box<dyn SkillModel> {
         match self.kind {
             SkillModelKind::Forward => Box::new(ForwardModel::new(d, k, self, device, seed)),
             SkillModelKind::Vic => Box::new(SkillDiscriminator::new(d, k, self, device, seed)),
         }
     }
-}
-
-/// The kind of skill model.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
-#[serde(rename_all = "lowercase")]
-pub enum SkillModelKind {
-    /// SEADS: the forward model q(z_T | z_0, k).
-    Forward,
-    /// VIC: the discriminator q(k | z_0, z_T).
-    Vic,
 }
 
 /// Writes the first `d` bits of each state as 0/1 floats into consecutive rows of width `width`

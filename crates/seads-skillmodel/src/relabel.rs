@@ -2,17 +2,7 @@
 //! best, either jointly by a minimum-cost assignment that keeps the multiset of labels, or
 //! independently by the maximum.
 
-use serde::{Deserialize, Serialize};
-
-/// How chosen episodes are relabelled.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
-#[serde(rename_all = "lowercase")]
-pub enum RelabelKind {
-    /// One linear assignment over all chosen episodes (SEADS).
-    Assignment,
-    /// Each episode independently gets `argmax_k C_e[k]` (not used in the paper).
-    Max,
-}
+pub use seads_run::RelabelKind;
 
 /// New labels by assignment (SPEC §3.6): slot i carries label `labels[i]`, column j is episode j,
 /// the cost of giving episode j label `labels[i]` is `−C_j[labels[i]]`; a minimum-cost assignment

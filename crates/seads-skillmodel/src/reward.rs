@@ -1,38 +1,7 @@
 //! The intrinsic reward of SEADS (SPEC §3.5): how well the final label explains the episode's
 //! effect on the board, relative to the runner-up skill, plus a novelty bonus.
 
-use serde::{Deserialize, Serialize};
-
-/// What replaces the second-best normalisation in the "no SBN" ablation.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
-#[serde(rename_all = "snake_case")]
-pub enum Normalisation {
-    /// SEADS: subtract the second-largest clipped log-posterior.
-    SecondBest,
-    /// Add log K (the reference's alternative; plain VIC's choice).
-    LogK,
-    /// No normalisation.
-    None,
-}
-
-/// Reward switches (the ablations of SPEC §3.10). `Default` = SEADS.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields, default)]
-pub struct RewardConfig {
-    /// Normalisation of the clipped log-posterior.
-    pub normalisation: Normalisation,
-    /// Add the novelty bonus (only defined for the forward model).
-    pub novelty_bonus: bool,
-}
-
-impl Default for RewardConfig {
-    fn default() -> Self {
-        Self {
-            normalisation: Normalisation::SecondBest,
-            novelty_bonus: true,
-        }
-    }
-}
+pub use seads_run::{Normalisation, RewardConfig};
 
 /// The reward of an episode that did not change the board: −2·log K, for every label.
 pub fn minimum_reward(k: usize) -> f32 {

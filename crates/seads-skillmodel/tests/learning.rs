@@ -2,6 +2,7 @@
 
 use proptest::prelude::*;
 use seads_games::{BoardGame, LightsOut, SymbolicState, TileSwap};
+use seads_skillmodel::BuildSkillModel as _;
 use seads_skillmodel::{
     OPTIMISER_FILES, SkillModelConfig, SkillModelError, SkillModelKind, SkillTransition,
     relabel_assignment,

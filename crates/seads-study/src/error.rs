@@ -46,7 +46,7 @@ pub enum StudyError {
     Taken(#[from] Taken),
     /// A run directory could not be read or written.
     #[error(transparent)]
-    Run(#[from] seads_rl::RlError),
+    Run(#[from] seads_run::RunError),
     /// Drawing a figure failed.
     #[error("drawing a figure: {0}")]
     Plot(String),

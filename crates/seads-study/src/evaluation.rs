@@ -1,27 +1,24 @@
 //! The files an evaluation writes into a run directory: the end-of-training records, named by
 //! their protocol and checkpoint ([`seads_planner::EvaluationKind`] names them), and the
 //! evaluations over training (the paper's Fig. 3), one line per checkpoint and mode in
-//! [`OVER_TRAINING`]; and running an evaluation of a trained agent or a baseline's policy.
+//! [`OVER_TRAINING`]. Running an evaluation is `seads-evaluation`'s.
 
-use std::collections::BTreeMap;
 use std::path::Path;
 
 use seads_games::BoardGame;
 use seads_planner::{
-    CheckpointId, DepthResult, Evaluation, EvaluationKind, EvaluationRecord, Evaluator, Protocol,
-    SearchLimits, SolveConfig, TaskRecord, TaskSet, TaskSummary, evaluate_resuming,
+    CheckpointId, DepthResult, EvaluationKind, EvaluationRecord, Evaluator, Protocol, SearchLimits,
+    TaskRecord, TaskSet,
 };
-use seads_rl::{Agent, TrainConfig};
 use serde::{Deserialize, Serialize};
 
-use crate::journal::Place;
 use crate::{Context as _, Result, StudyError};
 
 /// Which checkpoint `agent` is, and `None` where it is the run's latest (whose evaluation takes
 /// the plain file names) or `Some(epoch)` for an earlier one.
 pub fn checkpoint_of(run: &Path, checkpoint: &Path) -> Result<(CheckpointId, Option<u64>)> {
-    let id = seads_rl::store::checkpoint_id(run, checkpoint)?;
-    let latest = seads_rl::store::latest_checkpoint(run)?;
+    let id = seads_run::store::checkpoint_id(run, checkpoint)?;
+    let latest = seads_run::store::latest_checkpoint(run)?;
     let named = (latest.as_deref() != Some(checkpoint)).then_some(id.epoch);
     Ok((id, named))
 }
@@ -41,12 +38,12 @@ pub fn save_evaluation(
         .as_ref()
         .ok_or_else(|| StudyError::failed("an evaluation is saved with its protocol"))?;
     keep_another_protocols(run, protocol, named_epoch)?;
-    seads_rl::store::write_atomic(
+    seads_run::store::write_atomic(
         &run.join(protocol.results_file(named_epoch)),
         record.to_json().as_bytes(),
     )?;
     if let Some(lines) = task_lines {
-        seads_rl::store::write_atomic(
+        seads_run::store::write_atomic(
             &run.join(protocol.tasks_file(named_epoch)),
             lines.as_bytes(),
         )?;
@@ -58,7 +55,7 @@ pub fn save_evaluation(
 /// (of the checkpoint `named_epoch`), to the names its own protocol gives; one whose protocol is
 /// not recorded goes to `…-protocol-unknown.json`. Where those names are taken too, nothing is
 /// moved and the evaluation is refused, so that no record is lost.
-pub(crate) fn keep_another_protocols(
+pub fn keep_another_protocols(
     run: &Path,
     protocol: &Protocol,
     named_epoch: Option<u64>,
@@ -170,7 +167,7 @@ pub fn read_over_training(run: &Path) -> Result<Vec<CheckpointEvaluation>> {
     if !path.exists() {
         return Ok(Vec::new());
     }
-    Ok(seads_rl::store::read_json_lines(&path)?.0)
+    Ok(seads_run::store::read_json_lines(&path)?.0)
 }
 
 /// The evaluations over training of the run in `run` made on `tasks` with `limits` (the file may
@@ -217,160 +214,9 @@ pub fn over_training_protocol(tasks: &TaskSet, limits: SearchLimits, replan: boo
     }
 }
 
-/// Evaluates the agent with `protocol` (a planning kind), calling `each` with every task as it
-/// ends (for progress). An evaluation the agent's environment cannot play is
-/// [`StudyError::Invalid`].
-pub fn evaluate_agent(
-    agent: &mut Agent,
-    protocol: &Protocol,
-    each: impl FnMut(&TaskRecord<'_>),
-) -> Result<Vec<DepthResult>> {
-    evaluate_agent_resuming(agent, protocol, |_, _| None, each)
-}
-
-/// [`evaluate_agent`], counting the tasks `finished` knows (by depth and seed) as they ended
-/// before instead of solving them again.
-fn evaluate_agent_resuming(
-    agent: &mut Agent,
-    protocol: &Protocol,
-    finished: impl FnMut(usize, u64) -> Option<TaskSummary>,
-    mut each: impl FnMut(&TaskRecord<'_>),
-) -> Result<Vec<DepthResult>> {
-    let limits = protocol
-        .limits
-        .ok_or_else(|| StudyError::failed("a planning evaluation needs search limits"))?;
-    let evaluation = Evaluation {
-        env: agent.config.env.clone(),
-        env_config: agent.config.env_config.clone(),
-        tasks: protocol.tasks.clone(),
-        solve: SolveConfig {
-            replan: protocol.kind == EvaluationKind::Replan,
-            planner: limits.planner(),
-            ..SolveConfig::default()
-        },
-        action_noise: protocol.action_noise,
-    };
-    let (policy, model) = agent.parts()?;
-    evaluate_resuming(&evaluation, policy, model, finished, |task| each(task))
-        .map_err(StudyError::Environment)
-}
-
-/// Evaluates the agent with `protocol` and saves the record and one line per task into the run
-/// directory (`evaluation-replan.json` and `evaluation-replan-tasks.jsonl` for the standard
-/// depths of the latest checkpoint), calling `each` with every task solved now.
-///
-/// It resumes: each task's line is appended, as the task ends, to the tasks file's `.partial`
-/// beside it, headed by the protocol and the checkpoint (`journal.rs`). An evaluation of the
-/// same protocol and checkpoint that finds it counts the tasks written there as they ended and
-/// solves only the others (a task depends on nothing but its seed, so the results are those of
-/// one whole run); the `.partial` file is removed once the record is saved.
-pub fn run_evaluation(
-    agent: &mut Agent,
-    run: &Path,
-    protocol: &Protocol,
-    mut each: impl FnMut(&TaskRecord<'_>),
-) -> Result<EvaluationRecord> {
-    let game = crate::run_game(&agent.config)?;
-    let (checkpoint, named) = checkpoint_of(run, &agent.checkpoint)?;
-    // Before any work: an evaluation of another protocol in the way is moved to its own name,
-    // or the evaluation is refused with nothing solved.
-    keep_another_protocols(run, protocol, named)?;
-    let mut journal = Place::new(run, protocol, &checkpoint, named, &[]).open()?;
-    let mut now = BTreeMap::new();
-    let finished = journal.summaries();
-    let results = evaluate_agent_resuming(
-        agent,
-        protocol,
-        |depth, seed| finished.get(&(depth, seed)).cloned(),
-        |task| {
-            let line = task_line(game.as_ref(), task);
-            // The search time is kept for the resumed record only: the tasks file holds what
-            // repeats on any machine.
-            journal.append(&line, task.outcome.planning_s);
-            now.insert((task.depth, task.seed), line);
-            each(task);
-        },
-    )?;
-    let mut lines = String::new();
-    let seeds = protocol.tasks.seeds();
-    for &depth in &protocol.tasks.depths {
-        for &seed in &seeds {
-            let line = now
-                .get(&(depth, seed))
-                .or_else(|| journal.earlier(depth, seed).map(|(_, line)| line))
-                .ok_or_else(|| StudyError::failed(format!("task {depth}/{seed} has no line")))?;
-            lines += &line.to_string();
-            lines.push('\n');
-        }
-    }
-    let record = EvaluationRecord {
-        checkpoint: Some(checkpoint),
-        protocol: Some(protocol.clone()),
-        evaluated_by: journal.evaluated_by(),
-        results,
-    };
-    journal.finish(|| save_evaluation(run, &record, named, Some(&lines)))?;
-    Ok(record)
-}
-
-/// What a stopped evaluation of `protocol` of the agent's checkpoint in `run` left: the tasks it
-/// finished, which [`run_evaluation`] counts instead of solving them again, and its damaged
-/// journal lines, whose tasks it solves again.
-pub fn finished_before(agent: &Agent, run: &Path, protocol: &Protocol) -> Result<crate::Resumed> {
-    let (checkpoint, named) = checkpoint_of(run, &agent.checkpoint)?;
-    Place::new(run, protocol, &checkpoint, named, &[]).finished_before()
-}
-
-/// Evaluates a baseline's policy saved in `checkpoint` alone on `tasks` and saves the record
-/// and one line per task (depth, seed, board, solved) into the run directory
-/// (`evaluation-policy.json` for the standard depths of the latest checkpoint).
-pub fn run_policy_evaluation(
-    config: &TrainConfig,
-    run: &Path,
-    checkpoint: &Path,
-    tasks: TaskSet,
-) -> Result<EvaluationRecord> {
-    let mut policy = seads_rl::load_policy(config, checkpoint)
-        .doing(|| format!("loading the policy of run {}", run.display()))?;
-    let game = crate::run_game(config)?;
-    let mut lines = String::new();
-    let results = seads_rl::task_success(
-        config,
-        policy.as_mut(),
-        &tasks,
-        |depth, seed, board, solved| {
-            let line = serde_json::json!({
-                "depth": depth,
-                "seed": seed,
-                "board": game.format(board),
-                "solved": solved,
-            });
-            lines += &line.to_string();
-            lines.push('\n');
-        },
-    )?;
-    let (id, named) = checkpoint_of(run, checkpoint)?;
-    let record = EvaluationRecord {
-        checkpoint: Some(id),
-        protocol: Some(Protocol {
-            kind: EvaluationKind::Policy,
-            tasks,
-            limits: None,
-            action_noise: None,
-        }),
-        evaluated_by: crate::provenance::this_binary()
-            .into_iter()
-            .cloned()
-            .collect(),
-        results,
-    };
-    save_evaluation(run, &record, named, Some(&lines))?;
-    Ok(record)
-}
-
 /// One line of `evaluation-*-tasks.jsonl`: a task, how it ended, and every skill that left
 /// another board than the forward model predicted (boards as `seads solve --board` takes them).
-pub(crate) fn task_line(game: &dyn BoardGame, task: &TaskRecord<'_>) -> serde_json::Value {
+pub fn task_line(game: &dyn BoardGame, task: &TaskRecord<'_>) -> serde_json::Value {
     let o = task.outcome;
     let deviations: Vec<serde_json::Value> = o
         .deviations

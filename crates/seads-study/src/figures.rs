@@ -6,9 +6,9 @@ use std::path::Path;
 
 use plotters::coord::Shift;
 use plotters::prelude::*;
-use seads_embodiment::{Environment, SkillRun, execute_skill};
+use seads_embodiment::{Environment, SkillPolicy, SkillRun, execute_skill};
 use seads_planner::DepthResult;
-use seads_rl::{AgentPolicy, COVERAGE_SEED};
+use seads_run::COVERAGE_SEED;
 
 use crate::draw::{draw_paths, draw_scene, plot_err, render_to, skill_colour};
 use crate::{Result, StudyError};
@@ -17,7 +17,7 @@ use crate::{Result, StudyError};
 /// initialisations.
 pub fn skill_figures<E: Into<crate::BoxError>>(
     env: &mut dyn Environment,
-    policy: &AgentPolicy,
+    policy: &dyn SkillPolicy,
     title: &str,
     mut both: impl FnMut(&str, &dyn Fn(&Path) -> Result<()>) -> std::result::Result<(), E>,
 ) -> Result<()> {
@@ -38,8 +38,11 @@ pub fn skill_figures<E: Into<crate::BoxError>>(
 /// Every skill executed from the 20 coverage initialisations of `env` (for registry
 /// environments, test boards under the training reset distribution): `runs[k]` holds skill k's 20
 /// executions.
-pub fn skill_runs(env: &mut dyn Environment, policy: &AgentPolicy) -> Result<Vec<Vec<SkillRun>>> {
-    let k = seads_embodiment::SkillPolicy::num_skills(policy);
+pub fn skill_runs(
+    env: &mut dyn Environment,
+    policy: &dyn SkillPolicy,
+) -> Result<Vec<Vec<SkillRun>>> {
+    let k = policy.num_skills();
     (0..k)
         .map(|skill| {
             (0..20)
@@ -58,7 +61,7 @@ pub fn skill_runs(env: &mut dyn Environment, policy: &AgentPolicy) -> Result<Vec
 /// Skill coverage over training (from the run's metrics), of `k` skills.
 pub fn coverage_figure(
     out: &Path,
-    metrics: &[seads_rl::Metrics],
+    metrics: &[seads_run::Metrics],
     k: usize,
     title: &str,
 ) -> Result<()> {

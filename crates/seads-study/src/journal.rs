@@ -15,10 +15,10 @@ use crate::{Context as _, Result, StudyError};
 
 /// A finished task as its journal line holds it: what it adds to its depth's result, and the
 /// line the tasks file keeps (without the search time, which differs between machines).
-pub(crate) type Finished = (TaskSummary, serde_json::Value);
+pub type Finished = (TaskSummary, serde_json::Value);
 
 /// An open journal.
-pub(crate) struct Journal {
+pub struct Journal {
     partial: PathBuf,
     /// Finished tasks from before, by protocol depth and seed.
     earlier: BTreeMap<(usize, u64), Finished>,
@@ -31,7 +31,7 @@ pub(crate) struct Journal {
 }
 
 /// Where the journal of one evaluation lies, and the header its tasks are written under.
-pub(crate) struct Place {
+pub struct Place {
     partial: PathBuf,
     header: serde_json::Value,
 }
@@ -40,7 +40,7 @@ impl Place {
     /// The `.partial` file of the evaluation of `checkpoint` (`named` by its epoch unless it is
     /// the run's latest) with `protocol` in `run`, its header holding `extra` keys beside the
     /// protocol and the checkpoint.
-    pub(crate) fn new(
+    pub fn new(
         run: &Path,
         protocol: &Protocol,
         checkpoint: &CheckpointId,
@@ -58,7 +58,7 @@ impl Place {
 
     /// What a stopped evaluation wrote under this header: its finished tasks, and its damaged
     /// lines, whose tasks are solved again.
-    pub(crate) fn finished_before(&self) -> Result<Resumed> {
+    pub fn finished_before(&self) -> Result<Resumed> {
         let earlier = finished_tasks(&self.partial, &self.header)?;
         Ok(Resumed {
             finished: earlier.tasks.len(),
@@ -69,7 +69,7 @@ impl Place {
     /// Opens the journal: reads the tasks a stopped evaluation under the same header wrote, or
     /// starts a new journal with the header. A journal with damaged lines is written again
     /// without them, so that the tasks appended now follow whole lines only.
-    pub(crate) fn open(self) -> Result<Journal> {
+    pub fn open(self) -> Result<Journal> {
         let Earlier {
             tasks: earlier,
             by: earlier_by,
@@ -83,7 +83,7 @@ impl Place {
                 text += line;
                 text.push('\n');
             }
-            seads_rl::store::write_atomic(&self.partial, text.as_bytes())?;
+            seads_run::store::write_atomic(&self.partial, text.as_bytes())?;
         }
         Ok(Journal {
             partial: self.partial,
@@ -96,12 +96,12 @@ impl Place {
 
 impl Journal {
     /// The task of `depth` and `seed`, if it finished before.
-    pub(crate) fn earlier(&self, depth: usize, seed: u64) -> Option<&Finished> {
+    pub fn earlier(&self, depth: usize, seed: u64) -> Option<&Finished> {
         self.earlier.get(&(depth, seed))
     }
 
     /// What each task that finished before adds to its depth's result, by depth and seed.
-    pub(crate) fn summaries(&self) -> BTreeMap<(usize, u64), TaskSummary> {
+    pub fn summaries(&self) -> BTreeMap<(usize, u64), TaskSummary> {
         self.earlier
             .iter()
             .map(|(&key, (summary, _))| (key, summary.clone()))
@@ -111,7 +111,7 @@ impl Journal {
     /// The binaries that solved the evaluation's tasks: those named by the tasks from before,
     /// then this process's, each once; none where one of them is unknown (a task from before
     /// that names no binary, or a process that declared none).
-    pub(crate) fn evaluated_by(&self) -> Vec<Evaluator> {
+    pub fn evaluated_by(&self) -> Vec<Evaluator> {
         let (Some(earlier), Some(this)) = (&self.earlier_by, crate::provenance::this_binary())
         else {
             return Vec::new();
@@ -124,7 +124,7 @@ impl Journal {
     }
 
     /// Writes a task's `line` as it ends, with its search time and the binary that solved it.
-    pub(crate) fn append(&mut self, line: &serde_json::Value, planning_s: f64) {
+    pub fn append(&mut self, line: &serde_json::Value, planning_s: f64) {
         if self.append_error.is_some() {
             return;
         }
@@ -133,14 +133,14 @@ impl Journal {
         if let Some(this) = crate::provenance::this_binary() {
             resumable[BY] = serde_json::json!(this);
         }
-        if let Err(e) = seads_rl::store::append_json_line(&self.partial, &resumable) {
+        if let Err(e) = seads_run::store::append_json_line(&self.partial, &resumable) {
             self.append_error = Some(e.into());
         }
     }
 
     /// Saves the evaluation with `save` and removes the journal; an append that failed is the
     /// error instead.
-    pub(crate) fn finish(self, save: impl FnOnce() -> Result<()>) -> Result<()> {
+    pub fn finish(self, save: impl FnOnce() -> Result<()>) -> Result<()> {
         if let Some(e) = self.append_error {
             return Err(e);
         }

@@ -4,14 +4,16 @@
 //! - [`sweep`]: a [`Manifest`](sweep::Manifest) (TOML) expands into a planned
 //!   [`Sweep`](sweep::Sweep) on disk, one run directory per run; [`sweep::status`] reads where a
 //!   run stands from its directory alone; [`sweep::slurm`] writes a Slurm job array for it.
-//! - [`evaluation`]: the files an evaluation of a run writes, named by its protocol and
-//!   checkpoint, and the evaluations over training.
+//! - [`evaluation`], [`journal`]: the files an evaluation of a run writes, named by its protocol
+//!   and checkpoint, its journal while it runs, and the evaluations over training (running one is
+//!   `seads-evaluation`'s).
 //! - [`report`]: Table 1 with the one-sided Mann–Whitney test (exact p too), task success,
 //!   solution lengths, failure analysis, wall time and figures, from sweeps and runs.
 //! - [`figures`]: the figures of one run: coverage, success, skill trajectories and pushes.
 //! - [`provenance`]: which code on which processor trained which part of a run.
 //!
-//! The `seads` command (`seads sweep`, `seads report`) is the front end; this crate never prints.
+//! It reads run directories through `seads-run` and links no libtorch. The `seads` command
+//! (`seads sweep`, `seads report`) is the front end; this crate never prints.
 //!
 //! ```
 //! use seads_study::sweep::{Manifest, Sweep};
@@ -39,38 +41,44 @@
 //! ```
 
 pub mod animation;
-pub mod bench;
 pub mod draw;
 mod error;
 pub mod evaluation;
 pub mod figures;
-mod journal;
-pub mod over_training;
+pub mod journal;
 pub mod provenance;
 pub mod recording;
 pub mod report;
-pub mod robot;
 pub mod sweep;
 
 pub use error::{BoxError, Context, Result, StudyError};
 pub use journal::Resumed;
 
-/// The number of skills K of a run: its `num_skills`, else the moves of its environment's game
-/// (for a robot run, whose environment is not in the registry, the tablet's LightsOut 5×5).
-pub fn run_skills(config: &seads_rl::TrainConfig) -> usize {
-    config.seads.num_skills.unwrap_or_else(|| {
-        match seads_embodiment::make_env(&config.env, &config.env_config) {
-            Ok(env) => env.spec().num_skills,
-            Err(_) => seads_uarm::BOARD_SIZE * seads_uarm::BOARD_SIZE,
-        }
-    })
+/// The number of skills K of a run: its `num_skills`, else its environment's (for a robot run,
+/// whose environment is not in the registry, one per field of the tablet's LightsOut 5×5). An
+/// environment that is neither is [`StudyError::Environment`].
+pub fn run_skills(config: &seads_run::TrainConfig) -> Result<usize> {
+    if let Some(k) = config.seads.num_skills {
+        return Ok(k);
+    }
+    if seads_uarm::ActionSpace::of_env(&config.env).is_some() {
+        return Ok(seads_uarm::BOARD_SIZE * seads_uarm::BOARD_SIZE);
+    }
+    let env = seads_embodiment::make_env(&config.env, &config.env_config)
+        .map_err(StudyError::Environment)?;
+    Ok(env.spec().num_skills)
 }
 
-/// The board game of a run's environment (for a robot run, the tablet's LightsOut 5×5).
-pub fn run_game(config: &seads_rl::TrainConfig) -> Result<Box<dyn seads_games::BoardGame>> {
-    let game = match seads_embodiment::make_env(&config.env, &config.env_config) {
-        Ok(env) => env.spec().game.build(env.spec().board_size),
-        Err(_) => Ok(Box::new(seads_uarm::game()) as Box<dyn seads_games::BoardGame>),
-    };
-    game.doing(|| format!("building the game of {}", config.env))
+/// The board game a run plays: its environment's, or the robot's LightsOut 5×5. An environment
+/// that is neither is [`StudyError::Environment`].
+pub fn run_game(config: &seads_run::TrainConfig) -> Result<Box<dyn seads_games::BoardGame>> {
+    if seads_uarm::ActionSpace::of_env(&config.env).is_some() {
+        return Ok(Box::new(seads_uarm::game()));
+    }
+    let env = seads_embodiment::make_env(&config.env, &config.env_config)
+        .map_err(StudyError::Environment)?;
+    env.spec()
+        .game
+        .build(env.spec().board_size)
+        .doing(|| format!("building the game of {}", config.env))
 }

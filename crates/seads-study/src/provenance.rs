@@ -10,7 +10,7 @@
 use std::path::Path;
 
 use seads_planner::Evaluator;
-use seads_rl::ComputeDevice;
+use seads_run::ComputeDevice;
 use serde::{Deserialize, Serialize};
 
 /// The file in a run directory.
@@ -68,7 +68,7 @@ impl Build<'_> {
 static THIS_BINARY: std::sync::OnceLock<Evaluator> = std::sync::OnceLock::new();
 
 /// The binary this process declared, if it did.
-pub(crate) fn this_binary() -> Option<&'static Evaluator> {
+pub fn this_binary() -> Option<&'static Evaluator> {
     THIS_BINARY.get()
 }
 
@@ -138,12 +138,12 @@ impl Provenance {
     /// The processors that trained the run in `run_dir`, distinct, in the order they first
     /// trained it ("unknown" for one that did not tell); empty for a run without the file
     /// (trained before 2026-11-25's provenance, or never trained).
-    pub fn processors(run_dir: &Path) -> Result<Vec<String>, seads_rl::RlError> {
+    pub fn processors(run_dir: &Path) -> Result<Vec<String>, seads_run::RunError> {
         let path = run_dir.join(PROVENANCE);
         if !path.is_file() {
             return Ok(Vec::new());
         }
-        let (lines, _) = seads_rl::store::read_json_lines::<Provenance>(&path)?;
+        let (lines, _) = seads_run::store::read_json_lines::<Provenance>(&path)?;
         let mut seen: Vec<String> = Vec::new();
         for line in lines {
             let cpu = line.cpu_model.unwrap_or_else(|| "unknown".to_owned());
@@ -154,29 +154,27 @@ impl Provenance {
         Ok(seen)
     }
 
-    /// Appends this process of `build` to the provenance of `run`, about to train it on from
-    /// where it stands; nothing for a run that has finished.
-    pub fn record<L: seads_rl::InWords>(
-        run: &seads_rl::Run<L>,
+    /// Appends this process of `build` to the provenance of the run in `run_dir` with `config`,
+    /// about to train it on from `epoch` and `env_steps` (the caller skips a finished run).
+    pub fn record(
+        run_dir: &Path,
+        config: &seads_run::TrainConfig,
+        (epoch, env_steps): (u64, u64),
         build: &Build,
-    ) -> Result<(), seads_rl::RlError> {
-        if run.finished() {
-            return Ok(());
-        }
-        let (trainer, config) = (run.trainer(), run.trainer().config());
+    ) -> Result<(), seads_run::RunError> {
         let here = Self::here(
-            trainer.epoch(),
-            trainer.steps(),
+            epoch,
+            env_steps,
             config.portable_numerics,
             config.device,
             build,
         );
-        here.append(run.dir())
+        here.append(run_dir)
     }
 
     /// Appends this line to `run_dir`'s provenance file (a torn last line is repaired first).
-    pub fn append(&self, run_dir: &Path) -> Result<(), seads_rl::RlError> {
-        seads_rl::store::append_json_line(&run_dir.join(PROVENANCE), self)
+    pub fn append(&self, run_dir: &Path) -> Result<(), seads_run::RunError> {
+        seads_run::store::append_json_line(&run_dir.join(PROVENANCE), self)
     }
 }
 

@@ -3,7 +3,7 @@
 
 use anyhow::{Context, Result};
 use clap::Args;
-use seads_study::bench::PlanBench;
+use seads_evaluation::bench::PlanBench;
 
 /// Arguments of `seads plan-bench`.
 #[derive(Debug, Args)]
@@ -86,7 +86,7 @@ pub fn plan_bench(args: PlanBenchArgs) -> Result<()> {
                 }
             })
         })
-        .map_err(crate::study_error)?;
+        .map_err(crate::eval_error)?;
     written.map_err(|e| anyhow::anyhow!("writing to standard output: {e}"))?;
     if args.json {
         outln!("{}", serde_json::to_string(&report)?);

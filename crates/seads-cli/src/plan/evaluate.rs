@@ -11,7 +11,8 @@ use seads_rl::ComputeDevice;
 
 use super::{load_agent, run_evaluation};
 use crate::BadInput;
-use seads_study::evaluation::{self, run_policy_evaluation};
+use seads_evaluation::evaluation::run_policy_evaluation;
+use seads_study::evaluation;
 
 /// Arguments of `seads evaluate`.
 #[derive(Debug, Args)]
@@ -42,7 +43,7 @@ pub struct EvaluateArgs {
     /// appending to evaluation-over-training.jsonl in the run directory. Checkpoints already
     /// there are skipped.
     #[arg(long, conflicts_with_all = ["checkpoint", "replan", "seed"])]
-    checkpoints: Option<seads_study::over_training::Selection>,
+    checkpoints: Option<seads_evaluation::over_training::Selection>,
     #[command(flatten)]
     search: super::SearchArgs,
     /// Execute skills with Gaussian noise of this standard deviation on every low-level action

@@ -4,9 +4,9 @@
 use std::path::Path;
 
 use anyhow::Result;
+use seads_evaluation::over_training::{self, Progress, Selection};
 use seads_planner::{EvaluationRecord, Protocol, SearchLimits, TaskSet};
 use seads_rl::Agent;
-use seads_study::over_training::{self, Progress, Selection};
 
 /// Evaluates the agent with `protocol` and saves the record and one line per task into the run
 /// directory, with a progress bar unless `quiet`.
@@ -22,8 +22,8 @@ pub fn run_evaluation(
         "{wide_bar} {pos}/{len} {msg}",
     );
     // A resumed evaluation starts from the tasks its stopped run finished.
-    let before = seads_study::evaluation::finished_before(agent, run, protocol)
-        .map_err(crate::study_error)?;
+    let before = seads_evaluation::evaluation::finished_before(agent, run, protocol)
+        .map_err(crate::eval_error)?;
     if before.finished > 0 {
         eprintln!(
             "seads: {}: resuming an evaluation: {} of {} tasks finished before",
@@ -34,17 +34,17 @@ pub fn run_evaluation(
     }
     crate::plan::warn_damaged_journal(run, before.damaged);
     bar.set_position(before.finished as u64);
-    let record = seads_study::evaluation::run_evaluation(agent, run, protocol, |task| {
+    let record = seads_evaluation::evaluation::run_evaluation(agent, run, protocol, |task| {
         bar.set_message(format!("depth {}", task.depth));
         bar.inc(1);
     })
-    .map_err(crate::study_error)?;
+    .map_err(crate::eval_error)?;
     bar.finish_and_clear();
     Ok(record)
 }
 
 /// Evaluates the selected checkpoints of `run` over training
-/// ([`seads_study::over_training::evaluate_checkpoints`]), with a progress bar unless `quiet`;
+/// ([`seads_evaluation::over_training::evaluate_checkpoints`]), with a progress bar unless `quiet`;
 /// returns the number of lines appended.
 pub fn evaluate_checkpoints(
     run: &Path,
@@ -67,7 +67,7 @@ pub fn evaluate_checkpoints(
                 bar.inc(1);
             }
         })
-        .map_err(crate::study_error)?;
+        .map_err(crate::eval_error)?;
     bar.finish_and_clear();
     Ok(added)
 }

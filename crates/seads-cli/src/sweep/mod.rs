@@ -3,6 +3,7 @@
 
 mod pool;
 pub(crate) mod task;
+pub(crate) mod train;
 
 use std::path::PathBuf;
 use std::time::Duration;

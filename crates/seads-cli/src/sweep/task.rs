@@ -16,10 +16,10 @@ use super::index::Sweep;
 use crate::BadInput;
 use crate::plan::evaluate_checkpoints;
 use crate::plan::{load_agent, run_evaluation};
+use crate::sweep::train::member_config;
+use seads_evaluation::evaluation::run_policy_evaluation;
+use seads_evaluation::over_training::Selection;
 use seads_planner::{EvaluationKind, Protocol, TaskSet};
-use seads_study::evaluation::run_policy_evaluation;
-use seads_study::over_training::Selection;
-use seads_study::sweep::train::member_config;
 use seads_study::sweep::{Task, Work};
 
 /// Runs the task of the runs `indices` of the sweep in `dir` with `cores` cores and the networks
@@ -83,9 +83,7 @@ fn train(run: &Path, cores: usize, device: ComputeDevice) -> Result<()> {
     let config =
         seads_rl::load_config(run).with_context(|| format!("loading {}", run.display()))?;
     crate::kernels::use_kernels(config.portable_numerics)?;
-    config
-        .algorithm
-        .with_learner(TrainOne { run, cores, device })
+    seads_rl::with_learner(config.algorithm, TrainOne { run, cores, device })
 }
 
 /// [`train`]'s work with the run's learner.
@@ -138,11 +136,14 @@ fn train_population(runs: &[&Path], cores: usize, device: ComputeDevice) -> Resu
             seads_rl::StackedPopulation::new(members, cores, device)
         });
     }
-    config.algorithm.with_learner(TrainPopulation {
-        runs,
-        cores,
-        device,
-    })
+    seads_rl::with_learner(
+        config.algorithm,
+        TrainPopulation {
+            runs,
+            cores,
+            device,
+        },
+    )
 }
 
 /// [`train_population`]'s work with the runs' learner, on the CPU or one device.
@@ -193,7 +194,7 @@ where
         Ok(())
     };
     let build = crate::build();
-    seads_study::sweep::train::train_population(&mut population, &build, hook, |run, m| {
+    crate::sweep::train::train_population(&mut population, &build, hook, |run, m| {
         show(run, m).map_err(Into::into)
     })
     .context("training the population")

@@ -111,7 +111,7 @@ fn read_tasks_file(path: &Path) -> Result<Option<Vec<TaskLine>>> {
     if !path.exists() {
         return Ok(None);
     }
-    Ok(Some(seads_rl::store::read_json_lines(path)?.0))
+    Ok(Some(seads_run::store::read_json_lines(path)?.0))
 }
 
 /// The markdown section (without its heading) and two CSV tables (`failures.csv` per group,

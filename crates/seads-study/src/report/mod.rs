@@ -85,7 +85,7 @@ pub fn write_report(options: &ReportOptions, out: &Path) -> Result<ReportSummary
     }
     std::fs::create_dir_all(out).doing(|| format!("creating {}", out.display()))?;
     let write = |name: &str, text: &str| -> Result<()> {
-        seads_rl::store::write_atomic(&out.join(name), text.as_bytes())?;
+        seads_run::store::write_atomic(&out.join(name), text.as_bytes())?;
         Ok(())
     };
     let cells = tables::coverage_cells(&groups, reference.as_deref());
@@ -274,7 +274,7 @@ pub fn write_report(options: &ReportOptions, out: &Path) -> Result<ReportSummary
             for file in [crate::sweep::INDEX, crate::sweep::MANIFEST] {
                 let bytes = std::fs::read(dir.join(file))
                     .doing(|| format!("reading {}", dir.join(file).display()))?;
-                seads_rl::store::write_atomic(&dest.join(file), &bytes)?;
+                seads_run::store::write_atomic(&dest.join(file), &bytes)?;
             }
         }
         // What the tables rest on: finished, undamaged runs (the others resume where they are).
@@ -288,7 +288,7 @@ pub fn write_report(options: &ReportOptions, out: &Path) -> Result<ReportSummary
             for file in runs::data_files(&run.dir)? {
                 let bytes = std::fs::read(&file).doing(|| format!("reading {}", file.display()))?;
                 let name = file.file_name().expect("a file has a name");
-                seads_rl::store::write_atomic(&dest.join(name), &bytes)?;
+                seads_run::store::write_atomic(&dest.join(name), &bytes)?;
             }
         }
         let _ = writeln!(

@@ -9,7 +9,7 @@ use crate::{Context as _, Result};
 use seads_planner::{
     DepthResult, EvaluationKind, Evaluator, Protocol, STANDARD_DEPTHS, SearchLimits,
 };
-use seads_rl::{Algorithm, Metrics, TaskMetrics, TrainConfig};
+use seads_run::{Algorithm, Metrics, TaskMetrics, TrainConfig};
 
 use crate::evaluation::CheckpointEvaluation;
 use crate::sweep::Sweep;
@@ -37,6 +37,8 @@ pub struct RunData {
     pub variant: String,
     /// Configuration.
     pub config: TrainConfig,
+    /// Its number of skills K ([`crate::run_skills`]).
+    pub skills: usize,
     /// Skill-coverage evaluations (SEADS).
     pub metrics: Vec<Metrics>,
     /// Task-success evaluations over training (the SAC baseline).
@@ -100,7 +102,8 @@ impl RunData {
     }
 
     fn load(dir: &Path, variant: String, copy_to: PathBuf) -> Result<Self> {
-        let config = seads_rl::load_config(dir)?;
+        let config = seads_run::load_config(dir)?;
+        let skills = crate::run_skills(&config)?;
         let mut damage = Vec::new();
         let (metrics, task_metrics) = match config.algorithm {
             Algorithm::Seads => (metrics_or_damage::<Metrics>(dir, &mut damage), Vec::new()),
@@ -220,6 +223,7 @@ impl RunData {
                 .doing(|| format!("reading the provenance of {}", dir.display()))?,
             evaluated_by,
             config,
+            skills,
             metrics,
             task_metrics,
         })
@@ -357,11 +361,11 @@ fn deep_search(further: &[(Protocol, Vec<DepthResult>)]) -> Option<DeepSearch> {
 
 /// The metrics lines of the run in `dir`; none without a metrics file (not started), and none
 /// with the reason added to `damage` when the file exists but cannot be read.
-fn metrics_or_damage<M: seads_rl::store::MetricsLine>(
+fn metrics_or_damage<M: seads_run::store::MetricsLine>(
     dir: &Path,
     damage: &mut Vec<String>,
 ) -> Vec<M> {
-    match seads_rl::store::read_metrics_as::<M>(dir) {
+    match seads_run::store::read_metrics_as::<M>(dir) {
         Ok(lines) => lines,
         Err(e) => {
             if dir.join("metrics.jsonl").exists() {
@@ -562,6 +566,7 @@ pub(crate) fn bare_run(seed: u32) -> RunData {
         copy_to: format!("seed-{seed}").into(),
         variant: "seads".into(),
         config: TrainConfig::default(),
+        skills: 25,
         metrics: Vec::new(),
         task_metrics: Vec::new(),
         policy: None,

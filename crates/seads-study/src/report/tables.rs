@@ -30,7 +30,7 @@ pub struct CoverageCell {
 
 /// Skills of a run: the configured K, or the game's moves.
 pub fn skills(run: &RunData) -> usize {
-    crate::run_skills(&run.config)
+    run.skills
 }
 
 /// The cells of Table 1, in group order.

@@ -94,7 +94,7 @@ fn run_versions(run: &RunData) -> Result<Vec<Version>, String> {
     if !path.is_file() {
         return Err("no provenance".to_owned());
     }
-    let (lines, _) = seads_rl::store::read_json_lines::<Provenance>(&path)
+    let (lines, _) = seads_run::store::read_json_lines::<Provenance>(&path)
         .map_err(|e| format!("provenance unreadable: {e}"))?;
     let mut seen: Vec<Version> = Vec::new();
     for line in lines {

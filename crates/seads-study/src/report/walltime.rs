@@ -3,7 +3,7 @@
 
 use std::fmt::Write as _;
 
-use seads_rl::Algorithm;
+use seads_run::Algorithm;
 
 use super::csv_field;
 use super::runs::{Group, RunData};

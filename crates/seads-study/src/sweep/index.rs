@@ -5,7 +5,7 @@ use std::path::{Path, PathBuf};
 
 use crate::error::{fail, failure};
 use crate::{Context as _, Result};
-use seads_rl::TrainConfig;
+use seads_run::TrainConfig;
 use serde::{Deserialize, Serialize};
 
 use super::manifest::{EvaluationPlan, Manifest};
@@ -155,7 +155,7 @@ impl Sweep {
             );
         };
         std::fs::create_dir_all(&run).doing(|| format!("creating {}", run.display()))?;
-        seads_rl::store::write_atomic(
+        seads_run::store::write_atomic(
             &run.join("config.toml"),
             planned.config.to_toml().as_bytes(),
         )?;
@@ -231,12 +231,12 @@ impl Sweep {
         for (run, planned) in missing {
             let dir = out.join(run.rel_dir());
             std::fs::create_dir_all(&dir).doing(|| format!("creating {}", dir.display()))?;
-            seads_rl::store::write_atomic(&dir.join("config.toml"), planned.as_bytes())?;
+            seads_run::store::write_atomic(&dir.join("config.toml"), planned.as_bytes())?;
         }
         if !out.join(INDEX).exists() {
-            seads_rl::store::write_atomic(&out.join(MANIFEST), text.as_bytes())?;
+            seads_run::store::write_atomic(&out.join(MANIFEST), text.as_bytes())?;
             // The index last: a folder with an index is a complete plan.
-            seads_rl::store::write_atomic(&out.join(INDEX), index_text.as_bytes())?;
+            seads_run::store::write_atomic(&out.join(INDEX), index_text.as_bytes())?;
         }
         Ok(Planned {
             runs: runs.len(),

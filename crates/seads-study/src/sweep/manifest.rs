@@ -7,7 +7,7 @@ use std::collections::BTreeMap;
 use crate::Result;
 use crate::error::{fail, failure};
 use seads_embodiment::env_names;
-use seads_rl::{Algorithm, TrainConfig};
+use seads_run::{Algorithm, TrainConfig};
 use serde::{Deserialize, Serialize};
 
 /// A study, as written in `experiments/*.toml`.
@@ -273,9 +273,9 @@ impl Manifest {
             }
             // A manifest of an older version overrides in the flat layout.
             let mut layer = layer.clone();
-            seads_rl::upgrade_flat_layout(&mut layer, algorithm)
+            seads_run::upgrade_flat_layout(&mut layer, algorithm)
                 .map_err(|e| failure!("variant {:?}: {what}: {e}", variant.name))?;
-            seads_rl::merge_toml(&mut table, &layer);
+            seads_run::merge_toml(&mut table, &layer);
         }
         table.insert("seed".into(), toml::Value::Integer(seed as i64));
         let config: TrainConfig =
@@ -502,11 +502,11 @@ env_overrides = { "lightsout-cursor" = { num_skills = 30 }, "tileswap-cursor" = 
                 // Each variant changes only what its name says (SPEC §3.9, §3.10, §5.1).
                 let hac_grid = m.name.starts_with("hac-grid");
                 let algorithm = if m.name == "sac-grid" || run.variant == "sac" {
-                    seads_rl::Algorithm::Sac
+                    seads_run::Algorithm::Sac
                 } else if hac_grid || run.variant == "hac" {
-                    seads_rl::Algorithm::Hac
+                    seads_run::Algorithm::Hac
                 } else {
-                    seads_rl::Algorithm::Seads
+                    seads_run::Algorithm::Seads
                 };
                 let preset = TrainConfig::preset_for(&run.env, algorithm).unwrap();
                 let mut expected = preset.clone();
@@ -530,7 +530,7 @@ env_overrides = { "lightsout-cursor" = { num_skills = 30 }, "tileswap-cursor" = 
                         expected.sac.alpha = a.parse().unwrap();
                     }
                     "no-second-best-norm" => {
-                        expected.seads.reward.normalisation = seads_skillmodel::Normalisation::LogK;
+                        expected.seads.reward.normalisation = seads_run::Normalisation::LogK;
                     }
                     "no-novelty-bonus" => expected.seads.reward.novelty_bonus = false,
                     "no-relabelling" => {
@@ -547,11 +547,10 @@ env_overrides = { "lightsout-cursor" = { num_skills = 30 }, "tileswap-cursor" = 
                         });
                     }
                     v if v.starts_with("vic") => {
-                        expected.seads.skill_model.kind = seads_skillmodel::SkillModelKind::Vic;
+                        expected.seads.skill_model.kind = seads_run::SkillModelKind::Vic;
                         expected.seads.reward.novelty_bonus = false;
                         if v != "vic-sbn" {
-                            expected.seads.reward.normalisation =
-                                seads_skillmodel::Normalisation::LogK;
+                            expected.seads.reward.normalisation = seads_run::Normalisation::LogK;
                         }
                         if v != "vic-relabelling" {
                             expected.seads.relabel.skill_model_p = 0.0;

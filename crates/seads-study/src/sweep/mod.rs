@@ -11,7 +11,6 @@ pub mod population;
 pub mod slurm;
 pub mod state;
 pub mod task;
-pub mod train;
 
 pub use crate::error::Taken;
 pub use index::{INDEX, MANIFEST, Planned, Sweep, SweepRun};

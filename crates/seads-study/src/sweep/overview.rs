@@ -39,11 +39,11 @@ pub struct RunStatus {
 /// The environment steps the run in `run` has trained so far (from its metrics, at most its
 /// budget), or its budget when it is `done`.
 pub fn progress(run: &Path, done: bool) -> u64 {
-    let budget = seads_rl::load_config(run).map_or(0, |c| c.env_steps);
+    let budget = seads_run::load_config(run).map_or(0, |c| c.env_steps);
     if done {
         return budget;
     }
-    seads_rl::store::last_env_steps(run)
+    seads_run::store::last_env_steps(run)
         .unwrap_or(0)
         .min(budget)
 }
@@ -112,8 +112,8 @@ impl Overview {
                 seed: run.seed,
                 dir: path.display().to_string(),
                 status,
-                env_steps: seads_rl::store::last_env_steps(&path).unwrap_or(0),
-                budget: seads_rl::load_config(&path).map_or(0, |c| c.env_steps),
+                env_steps: seads_run::store::last_env_steps(&path).unwrap_or(0),
+                budget: seads_run::load_config(&path).map_or(0, |c| c.env_steps),
                 attempts: record.as_ref().map_or(0, |r| r.attempts),
                 error,
             });

@@ -1,10 +1,10 @@
 //! Populations of a sweep: its runs grouped by what their networks' shapes depend on
-//! ([`seads_rl::PopulationKey`]), each group cut into populations of at most K runs that one task
+//! ([`seads_run::PopulationKey`]), each group cut into populations of at most K runs that one task
 //! trains together (`seads sweep run --population K`, and one Slurm array task per population).
 
 use std::path::Path;
 
-use seads_rl::PopulationKey;
+use seads_run::PopulationKey;
 
 use super::index::Sweep;
 use crate::Result;
@@ -27,7 +27,7 @@ pub fn populations(
         .iter()
         .map(|&i| {
             let run = dir.join(&sweep.runs.get(i)?.dir);
-            seads_rl::load_config(&run)
+            seads_run::load_config(&run)
                 .ok()
                 .map(|c| PopulationKey::of(&c))
         })

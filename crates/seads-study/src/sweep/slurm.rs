@@ -6,7 +6,7 @@
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
-use seads_rl::ComputeDevice;
+use seads_run::ComputeDevice;
 
 use crate::error::fail;
 use crate::{Context as _, Result};
@@ -192,8 +192,8 @@ pub fn write_scripts(
     std::fs::create_dir_all(folder.join("logs"))
         .doing(|| format!("creating {}", folder.display()))?;
     let paths = (folder.join("array.sbatch"), folder.join("report.sbatch"));
-    seads_rl::store::write_atomic(&paths.0, array.as_bytes())?;
-    seads_rl::store::write_atomic(&paths.1, report.as_bytes())?;
+    seads_run::store::write_atomic(&paths.0, array.as_bytes())?;
+    seads_run::store::write_atomic(&paths.1, report.as_bytes())?;
     Ok(paths)
 }
 

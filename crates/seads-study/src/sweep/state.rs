@@ -1,6 +1,6 @@
 //! The state of one run of a sweep, read from its directory alone (never from Slurm), so that
 //! `seads sweep status` tells the same on a laptop, a login node or inside a job:
-//! - `task.lock` is locked (the run's [`seads_rl::store::RunLock`], an OS file lock) while a task or any
+//! - `task.lock` is locked (the run's [`seads_run::store::RunLock`], an OS file lock) while a task or any
 //!   other writer works on the run: a killed one releases it, so "running" can never be stale;
 //! - `task.json` records the last task's outcome: running, done or failed (with the error).
 
@@ -84,7 +84,7 @@ impl Record {
                 .map_or(0, |d| d.as_secs()),
             error,
         };
-        seads_rl::store::write_atomic(
+        seads_run::store::write_atomic(
             &run.join(RECORD),
             (serde_json::to_string_pretty(&record)? + "\n").as_bytes(),
         )?;
@@ -101,7 +101,7 @@ fn present_outputs(run: &Path) -> Vec<String> {
         .filter(|n| n.starts_with("evaluation") && n.ends_with(".json"))
         .collect();
     outputs.sort();
-    outputs.insert(0, seads_rl::store::METRICS.to_owned());
+    outputs.insert(0, seads_run::store::METRICS.to_owned());
     outputs
 }
 
@@ -124,8 +124,8 @@ pub fn check_outputs(run: &Path, record: &Record) -> std::result::Result<(), Mis
     };
     for name in listed {
         let path = run.join(&name);
-        let readable = if name == seads_rl::store::METRICS {
-            match seads_rl::store::read_json_lines::<serde_json::Value>(&path) {
+        let readable = if name == seads_run::store::METRICS {
+            match seads_run::store::read_json_lines::<serde_json::Value>(&path) {
                 Ok((lines, false)) if !lines.is_empty() => metrics_in_order(&lines),
                 Ok(_) => Err("it is empty or ends in a torn line".to_owned()),
                 Err(e) => Err(format!("{e}")),
@@ -178,12 +178,12 @@ fn metrics_in_order(lines: &[serde_json::Value]) -> std::result::Result<(), Stri
 /// Whether the run's budget (`config.toml`) lies beyond its last metrics line: raised with
 /// `train --resume --env-steps` after its task finished, so there is training left.
 fn budget_raised(run: &Path) -> bool {
-    let Ok(config) = seads_rl::load_config(run) else {
+    let Ok(config) = seads_run::load_config(run) else {
         return false;
     };
-    let Ok((lines, _)) =
-        seads_rl::store::read_json_lines::<serde_json::Value>(&run.join(seads_rl::store::METRICS))
-    else {
+    let Ok((lines, _)) = seads_run::store::read_json_lines::<serde_json::Value>(
+        &run.join(seads_run::store::METRICS),
+    ) else {
         return false;
     };
     let steps = lines
@@ -220,11 +220,11 @@ pub fn note_population_log(others: &[PathBuf], members: &str, log: &Path) -> Res
     Ok(())
 }
 
-/// The exclusive claim of a task on a run (its [`seads_rl::store::RunLock`]), held until dropped (or
+/// The exclusive claim of a task on a run (its [`seads_run::store::RunLock`]), held until dropped (or
 /// the process dies).
 #[derive(Debug)]
 pub struct Claim {
-    _lock: seads_rl::store::RunLock,
+    _lock: seads_run::store::RunLock,
 }
 
 /// How long a Slurm task or a task started by hand waits for a run that another task holds:
@@ -239,9 +239,9 @@ impl Claim {
     /// Claims `run`, waiting up to `patience` for another task to release it; [`Taken`] if it
     /// does not.
     pub fn take(run: &Path, patience: Duration) -> Result<Self> {
-        match seads_rl::store::RunLock::acquire(run, "seads sweep task", patience) {
+        match seads_run::store::RunLock::acquire(run, "seads sweep task", patience) {
             Ok(lock) => Ok(Self { _lock: lock }),
-            Err(seads_rl::RlError::Busy { .. }) => Err(Taken(run.to_path_buf()).into()),
+            Err(seads_run::RunError::Busy { .. }) => Err(Taken(run.to_path_buf()).into()),
             Err(e) => Err(e).doing(|| format!("locking {}", run.display())),
         }
     }
@@ -249,7 +249,7 @@ impl Claim {
 
 /// Whether a task holds `run` now.
 pub fn is_claimed(run: &Path) -> bool {
-    seads_rl::store::run_is_locked(run)
+    seads_run::store::run_is_locked(run)
 }
 
 /// Where a run stands.
@@ -315,7 +315,7 @@ pub fn status(run: &Path) -> Result<(Status, Option<Record>)> {
                 Err(Missing::Gone(_)) => Status::Pending,
                 Err(Missing::Unreadable(_)) => Status::Damaged,
             },
-            _ if seads_rl::store::is_copy_without_checkpoints(run) => Status::Copied,
+            _ if seads_run::store::is_copy_without_checkpoints(run) => Status::Copied,
             Some(Outcome::Failed) => Status::Failed,
             Some(Outcome::Running) | None => Status::Pending,
         }
@@ -467,13 +467,13 @@ mod tests {
         }
         // The budget of config.toml beyond the last line: pending, not done.
         std::fs::write(run.join("metrics.jsonl"), line(1, 10) + &line(2, 20)).unwrap();
-        let config = seads_rl::TrainConfig {
+        let config = seads_run::TrainConfig {
             env_steps: 20,
-            ..seads_rl::TrainConfig::preset("lightsout-cursor").unwrap()
+            ..seads_run::TrainConfig::preset("lightsout-cursor").unwrap()
         };
         std::fs::write(run.join("config.toml"), config.to_toml()).unwrap();
         assert_eq!(status(run).unwrap().0, Status::Done);
-        let raised = seads_rl::TrainConfig {
+        let raised = seads_run::TrainConfig {
             env_steps: 30,
             ..config
         };

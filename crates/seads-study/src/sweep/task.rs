@@ -59,7 +59,7 @@ impl Task {
         }
         // Training it again from scratch would replace the data it holds; nothing is recorded,
         // so the run stays "copied".
-        if work != Work::Nothing && seads_rl::store::is_copy_without_checkpoints(&run) {
+        if work != Work::Nothing && seads_run::store::is_copy_without_checkpoints(&run) {
             return Err(StudyError::Invalid(format!(
                 "{} holds a run's data but no checkpoints folder (copied in by `seads report \
                  --copy-runs`?): it is reported as it is and cannot be trained further",
@@ -78,7 +78,7 @@ impl Task {
 
     /// Claims the runs `indices` of the sweep in `dir` for one task that trains them as a
     /// population ([`Task::claim`] each, before anything is written), and checks that they can
-    /// share one ([`seads_rl::check_population`]; not for a single run): a run of other shapes is
+    /// share one ([`seads_run::check_population`]; not for a single run): a run of other shapes is
     /// [`StudyError::is_invalid`]; a run that another task (another population) holds past
     /// `patience` is [`StudyError::Taken`], and no run is claimed then.
     pub fn claim_population(
@@ -97,12 +97,12 @@ impl Task {
         let configs = tasks
             .iter()
             .map(|t| {
-                let config = seads_rl::load_config(&t.run)
+                let config = seads_run::load_config(&t.run)
                     .map_err(|e| StudyError::Invalid(e.to_string()))?;
                 Ok((t.run.display().to_string(), config))
             })
             .collect::<Result<Vec<_>>>()?;
-        seads_rl::check_population(&configs).map_err(|e| StudyError::Invalid(e.to_string()))?;
+        seads_run::check_population(&configs).map_err(|e| StudyError::Invalid(e.to_string()))?;
         Ok(tasks)
     }
 

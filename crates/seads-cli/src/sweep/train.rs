@@ -9,7 +9,7 @@ use seads_rl::{
     BoxError, ComputeDevice, Hook, InWords, Learner, Members, RlError, Run, TrainConfig,
 };
 
-use crate::provenance::{Build, Provenance};
+use seads_study::provenance::Build;
 
 /// A member's configuration for this process: its networks on `device`, one libtorch thread
 /// (the members' epochs fill the cores side by side). Neither changes a number on the CPU.
@@ -48,7 +48,7 @@ where
         }
     }
     for member in population.members() {
-        Provenance::record(member, build)?;
+        crate::train::record_provenance(member, build)?;
     }
     while !population.finished() {
         let events = population.step()?;

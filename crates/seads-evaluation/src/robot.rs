@@ -14,9 +14,11 @@ use seads_planner::{
 use seads_rl::Agent;
 use seads_uarm::UarmEnv;
 
-use crate::evaluation::{checkpoint_of, save_evaluation, task_line};
-use crate::journal::Place;
-use crate::{Result, StudyError};
+use seads_study::StudyError;
+use seads_study::evaluation::{checkpoint_of, save_evaluation, task_line};
+use seads_study::journal::Place;
+
+use crate::Result;
 
 /// A robot evaluation: re-planning on the tasks of depth 1–5 with `boards` boards per depth,
 /// each search bounded by `limits`, on the twin of `twin_seed` or on the real arm (`None`).
@@ -53,9 +55,9 @@ impl RobotEvaluation {
 
     /// What a stopped evaluation of `checkpoint` in `run` left: the tasks it finished, and its
     /// damaged journal lines.
-    pub fn finished_before(&self, run: &Path, checkpoint: &Path) -> Result<crate::Resumed> {
+    pub fn finished_before(&self, run: &Path, checkpoint: &Path) -> Result<seads_study::Resumed> {
         let (id, named) = checkpoint_of(run, checkpoint)?;
-        Place::new(run, &self.protocol(), &id, named, &self.header()).finished_before()
+        Ok(Place::new(run, &self.protocol(), &id, named, &self.header()).finished_before()?)
     }
 
     /// Evaluates the robot run in `run` at `checkpoint` in `env`, calling `each` after every
@@ -70,7 +72,7 @@ impl RobotEvaluation {
         // The robot's agent runs on the CPU, wherever it trained.
         let config = seads_rl::TrainConfig {
             device: seads_rl::ComputeDevice::Cpu,
-            ..seads_rl::load_config(run)?
+            ..seads_run::load_config(run)?
         };
         let mut agent = Agent::load_for(config, env.spec().clone(), checkpoint)?;
         let (policy, model) = agent.parts()?;
@@ -96,7 +98,7 @@ impl RobotEvaluation {
             planner: self.limits.planner(),
             ..SolveConfig::default()
         };
-        crate::evaluation::keep_another_protocols(run, &protocol, named)?;
+        seads_study::evaluation::keep_another_protocols(run, &protocol, named)?;
         let mut journal = Place::new(run, &protocol, &id, named, &self.header()).open()?;
         let mut results: BTreeMap<usize, DepthResult> = BTreeMap::new();
         let mut lines = String::new();
@@ -161,7 +163,7 @@ impl RobotEvaluation {
 
 /// A failure of the arm or the tablet is the run's, not the user's input.
 fn env_error(e: seads_embodiment::EnvError) -> StudyError {
-    StudyError::Run(seads_rl::RlError::Env(e))
+    StudyError::Run(seads_run::RunError::Env(e))
 }
 
 /// Executes again the skills a finished task's `line` executed and checks that they reach the
@@ -187,7 +189,8 @@ fn replay(
             "the twin does not repeat the stopped evaluation's {task} (it reached {reached}, the \
              journal says {}): remove the evaluation's .partial file to evaluate afresh",
             line["reached"]
-        )));
+        ))
+        .into());
     }
     Ok(())
 }

@@ -6,7 +6,7 @@
 //! `[baseline]` section beside `[hac]`. A baseline's file also held SEADS's settings at their
 //! defaults.
 
-use crate::RlError;
+use crate::RunError;
 use crate::sections::Algorithm;
 
 /// Keys of the top level that are SEADS's in the flat layout; the sectioned layout keeps them
@@ -27,14 +27,14 @@ const SEADS_KEYS: [&str; 9] = [
 const BASELINE: &str = "baseline";
 
 /// Whether `table` has any key of the flat layout.
-pub(crate) fn is_flat(table: &toml::Table) -> bool {
+pub fn is_flat(table: &toml::Table) -> bool {
     table.contains_key(BASELINE) || SEADS_KEYS.iter().any(|k| table.contains_key(*k))
 }
 
 /// Moves the flat layout's keys of `table` (a configuration, or overrides of one, of
 /// `algorithm`) into their sections: SEADS's into `[seads]`, `[baseline]` into `[sac_baseline]`
 /// or `[hac]`. Returns whether the table was flat. A key given in both layouts is an error.
-pub fn upgrade(table: &mut toml::Table, algorithm: Algorithm) -> Result<bool, RlError> {
+pub fn upgrade(table: &mut toml::Table, algorithm: Algorithm) -> Result<bool, RunError> {
     if !is_flat(table) {
         return Ok(false);
     }
@@ -47,7 +47,7 @@ pub fn upgrade(table: &mut toml::Table, algorithm: Algorithm) -> Result<bool, Rl
     move_into(table, "seads", seads)?;
     if let Some(value) = table.remove(BASELINE) {
         let toml::Value::Table(baseline) = value else {
-            return Err(RlError::Config("baseline must be a table".into()));
+            return Err(RunError::Config("baseline must be a table".into()));
         };
         let section = match algorithm {
             Algorithm::Hac => "hac",
@@ -59,7 +59,7 @@ pub fn upgrade(table: &mut toml::Table, algorithm: Algorithm) -> Result<bool, Rl
 }
 
 /// Adds `keys` to the section `name` of `table`.
-fn move_into(table: &mut toml::Table, name: &str, keys: toml::Table) -> Result<(), RlError> {
+fn move_into(table: &mut toml::Table, name: &str, keys: toml::Table) -> Result<(), RunError> {
     if keys.is_empty() {
         return Ok(());
     }
@@ -67,11 +67,11 @@ fn move_into(table: &mut toml::Table, name: &str, keys: toml::Table) -> Result<(
         .entry(name)
         .or_insert_with(|| toml::Value::Table(toml::Table::new()));
     let toml::Value::Table(section) = entry else {
-        return Err(RlError::Config(format!("{name} must be a table")));
+        return Err(RunError::Config(format!("{name} must be a table")));
     };
     for (key, value) in keys {
         if section.contains_key(&key) {
-            return Err(RlError::Config(format!(
+            return Err(RunError::Config(format!(
                 "{key} is given twice: at the top (the older, flat layout) and in [{name}]; \
                  keep the one in [{name}]"
             )));

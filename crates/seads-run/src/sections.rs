@@ -2,10 +2,10 @@
 //! `[hac]`, each with the paper's defaults and its own checks. A run's file holds the section of
 //! its algorithm only (`config.rs`).
 
-use seads_skillmodel::{RelabelKind, RewardConfig, SkillModelConfig};
+use crate::{RelabelKind, RewardConfig, SkillModelConfig};
 use serde::{Deserialize, Serialize};
 
-use crate::RlError;
+use crate::RunError;
 
 /// What a run trains.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
@@ -47,6 +47,10 @@ impl Algorithm {
     /// Every algorithm.
     pub const ALL: [Algorithm; 3] = [Algorithm::Seads, Algorithm::Sac, Algorithm::Hac];
 }
+
+/// First seed of the skill-coverage evaluation (the paper's 444555 … 444574): SEADS's
+/// [`SeadsConfig::eval_seeds`] count from it.
+pub const COVERAGE_SEED: u64 = 444_555;
 
 /// SEADS's own settings (`[seads]`, SPEC §3): skills, episode buffers, the skill model, the
 /// intrinsic reward and relabelling. Its SAC is the shared `[sac]` section.
@@ -92,8 +96,8 @@ impl Default for SeadsConfig {
 
 impl SeadsConfig {
     /// Checks every value.
-    pub fn validate(&self) -> Result<(), RlError> {
-        let bad = |m: String| Err(RlError::Config(m));
+    pub fn validate(&self) -> Result<(), RunError> {
+        let bad = |m: String| Err(RunError::Config(m));
         self.skill_model.validate()?;
         if self.num_skills == Some(0) {
             return bad("seads.num_skills must be at least 1".into());
@@ -186,8 +190,8 @@ impl Default for BaselineConfig {
 
 impl BaselineConfig {
     /// Checks every value; `section` names the section in messages.
-    pub fn validate(&self, section: &str) -> Result<(), RlError> {
-        let bad = |m: String| Err(RlError::Config(m));
+    pub fn validate(&self, section: &str) -> Result<(), RunError> {
+        let bad = |m: String| Err(RunError::Config(m));
         if self.replay_capacity == 0 || self.samples_per_epoch == 0 || self.eval_boards == 0 {
             return bad(format!(
                 "{section}.replay_capacity, {section}.samples_per_epoch and \
@@ -272,7 +276,7 @@ impl HacConfig {
     }
 
     /// Checks every value.
-    pub fn validate(&self) -> Result<(), RlError> {
+    pub fn validate(&self) -> Result<(), RunError> {
         self.training().validate("hac")?;
         check_probability("hac.subgoal_test_p", self.subgoal_test_p)?;
         for (name, v) in [
@@ -280,11 +284,13 @@ impl HacConfig {
             ("hac.alpha_high", self.alpha_high),
         ] {
             if !(v.is_finite() && v > 0.0) {
-                return Err(RlError::Config(format!("{name} must be positive, got {v}")));
+                return Err(RunError::Config(format!(
+                    "{name} must be positive, got {v}"
+                )));
             }
         }
         if self.subgoal_horizon == 0 {
-            return Err(RlError::Config(
+            return Err(RunError::Config(
                 "hac.subgoal_horizon must be at least 1".into(),
             ));
         }
@@ -292,11 +298,11 @@ impl HacConfig {
     }
 }
 
-fn check_probability(name: &str, p: f64) -> Result<(), RlError> {
+fn check_probability(name: &str, p: f64) -> Result<(), RunError> {
     if (0.0..=1.0).contains(&p) {
         Ok(())
     } else {
-        Err(RlError::Config(format!(
+        Err(RunError::Config(format!(
             "{name} must lie in [0, 1], got {p}"
         )))
     }
@@ -305,4 +311,4 @@ fn check_probability(name: &str, p: f64) -> Result<(), RlError> {
 /// The most evaluations, updates, samples or boards a configuration may ask for per epoch (or
 /// per evaluation): a million, far beyond the paper's settings (tens to thousands), far below
 /// what would never end.
-pub(crate) const MAX_PER_EPOCH: u64 = 1_000_000;
+pub const MAX_PER_EPOCH: u64 = 1_000_000;

@@ -1,11 +1,11 @@
 //! The training configuration: one TOML file per run, with a preset per environment.
 
+use crate::ComputeDevice;
 use seads_embodiment::{EnvConfig, MOVED_TO_MANIPULATOR, env_names};
-use seads_nn::ComputeDevice;
 use serde::{Deserialize, Serialize};
 
 use crate::sections::{Algorithm, BaselineConfig, HacConfig, MAX_PER_EPOCH, SeadsConfig};
-use crate::{RlError, SacConfig, flat_layout};
+use crate::{RunError, SacConfig, flat_layout};
 
 /// Everything a training run needs: the run's own settings (environment, seed, budget,
 /// evaluation and checkpoint cadence, threads, numerics, device), the soft actor-critic that
@@ -100,7 +100,7 @@ impl TrainConfig {
     /// `cores`.
     ///
     /// ```
-    /// use seads_rl::{Algorithm, TrainConfig};
+    /// use seads_run::{Algorithm, TrainConfig};
     /// let mut config = TrainConfig::default();
     /// config.use_cores(4);
     /// assert_eq!((config.threads, config.sac_threads_alone), (2, 4));
@@ -122,12 +122,12 @@ impl TrainConfig {
     }
 
     /// The preset of environment `env` (the paper's settings).
-    pub fn preset(env: &str) -> Result<Self, RlError> {
+    pub fn preset(env: &str) -> Result<Self, RunError> {
         Self::preset_for(env, Algorithm::Seads)
     }
 
     /// The preset of `algorithm` on environment `env`.
-    pub fn preset_for(env: &str, algorithm: Algorithm) -> Result<Self, RlError> {
+    pub fn preset_for(env: &str, algorithm: Algorithm) -> Result<Self, RunError> {
         let presets = match algorithm {
             Algorithm::Seads => PRESETS,
             Algorithm::Sac => SAC_PRESETS,
@@ -138,7 +138,7 @@ impl TrainConfig {
             .find(|(name, _)| *name == env)
             .map(|(_, text)| *text)
             .ok_or_else(|| {
-                RlError::Config(format!(
+                RunError::Config(format!(
                     "unknown environment {env:?}; valid environments: {}",
                     env_names().join(", ")
                 ))
@@ -169,7 +169,7 @@ impl TrainConfig {
     /// (`uarm-…`) have no preset; their runs write the whole configuration, taken as written.
     ///
     /// ```
-    /// use seads_rl::TrainConfig;
+    /// use seads_run::TrainConfig;
     /// let config = TrainConfig::from_user_toml("env = \"tileswap-reacher\"\nseed = 3", None, None)?;
     /// assert_eq!(config.seed, 3);
     /// // The rest is the environment's preset, not the generic defaults.
@@ -178,18 +178,18 @@ impl TrainConfig {
     /// // A baseline has no SEADS section.
     /// let text = "env = \"lightsout-cursor\"\nalgorithm = \"sac\"\n[seads]\nnum_skills = 30";
     /// assert!(TrainConfig::from_user_toml(text, None, None).is_err());
-    /// # Ok::<(), seads_rl::RlError>(())
+    /// # Ok::<(), seads_run::RunError>(())
     /// ```
     pub fn from_user_toml(
         text: &str,
         env: Option<&str>,
         algorithm: Option<Algorithm>,
-    ) -> Result<Self, RlError> {
+    ) -> Result<Self, RunError> {
         let mut table = parse_table(text)?;
         if !flat_layout::is_flat(&table) {
             // Fields and types first, with the user's line numbers.
             toml::from_str::<Self>(text)
-                .map_err(|e| RlError::Config(one_line_toml_error(text, &e)))?;
+                .map_err(|e| RunError::Config(one_line_toml_error(text, &e)))?;
         }
         if let Some(env) = env {
             table.insert("env".into(), toml::Value::String(env.into()));
@@ -205,14 +205,14 @@ impl TrainConfig {
         // The values the file states, before what it leaves out is filled in.
         Self::from_table(table.clone())?;
         let Some(toml::Value::String(env)) = table.get("env").cloned() else {
-            return Err(RlError::Config(format!(
+            return Err(RunError::Config(format!(
                 "the configuration names no `env` (one of {}); its preset fills in the rest",
                 env_names().join(", ")
             )));
         };
         // Environments outside the registry (the robot's) have no preset: their runs write the
         // whole configuration, which is taken as written.
-        if !env_names().contains(&env.as_str()) && env.starts_with("uarm-") {
+        if is_robot_env(&env) {
             return Self::from_table(table);
         }
         let preset = Self::preset_for(&env, algorithm)?;
@@ -229,23 +229,23 @@ impl TrainConfig {
     /// only the presets rely on: a user's file goes through [`TrainConfig::from_user_toml`]) and
     /// validates its values (not the environment: see [`TrainConfig::validate`]). The flat
     /// layout of older versions' files loads too.
-    pub fn from_toml(text: &str) -> Result<Self, RlError> {
+    pub fn from_toml(text: &str) -> Result<Self, RunError> {
         let mut table = parse_table(text)?;
         let algorithm = algorithm_of(&table)?;
         if into_sections(&mut table, algorithm)? {
             return Self::from_table(table);
         }
         let config: Self =
-            toml::from_str(text).map_err(|e| RlError::Config(one_line_toml_error(text, &e)))?;
+            toml::from_str(text).map_err(|e| RunError::Config(one_line_toml_error(text, &e)))?;
         config.validate_values()?;
         Ok(config)
     }
 
     /// A configuration from a table in the sectioned layout, its values validated.
-    fn from_table(table: toml::Table) -> Result<Self, RlError> {
-        let config: Self = table
-            .try_into()
-            .map_err(|e: toml::de::Error| RlError::Config(e.message().trim().replace('\n', " ")))?;
+    fn from_table(table: toml::Table) -> Result<Self, RunError> {
+        let config: Self = table.try_into().map_err(|e: toml::de::Error| {
+            RunError::Config(e.message().trim().replace('\n', " "))
+        })?;
         config.validate_values()?;
         Ok(config)
     }
@@ -257,9 +257,9 @@ impl TrainConfig {
     }
 
     /// Checks every value, and that the environment exists with these options.
-    pub fn validate(&self) -> Result<(), RlError> {
+    pub fn validate(&self) -> Result<(), RunError> {
         if !env_names().contains(&self.env.as_str()) {
-            return Err(RlError::Config(format!(
+            return Err(RunError::Config(format!(
                 "unknown environment {:?}; valid environments: {}",
                 self.env,
                 env_names().join(", ")
@@ -311,7 +311,7 @@ impl TrainConfig {
         &self,
         spec: &seads_embodiment::EnvSpec,
         available: u64,
-    ) -> Result<(), RlError> {
+    ) -> Result<(), RunError> {
         let need = self.memory_estimate(spec);
         if need.is_finite() && need <= available as f64 {
             return Ok(());
@@ -324,7 +324,7 @@ impl TrainConfig {
                 format!("{g:.1e}")
             }
         };
-        Err(RlError::Config(format!(
+        Err(RunError::Config(format!(
             "this configuration needs at least {} GiB, more than this machine's {} GiB \
              (lower num_skills, the hidden sizes, buffer_capacity, episodes_per_epoch, the batch \
              sizes or the baseline's replay_capacity)",
@@ -335,8 +335,8 @@ impl TrainConfig {
 
     /// Checks every value except the environment (robot environments are not in the registry;
     /// the trainer that gets one checks it).
-    pub fn validate_values(&self) -> Result<(), RlError> {
-        let bad = |m: String| Err(RlError::Config(m));
+    pub fn validate_values(&self) -> Result<(), RunError> {
+        let bad = |m: String| Err(RunError::Config(m));
         self.sac.validate()?;
         self.seads.validate()?;
         self.sac_baseline.validate("sac_baseline")?;
@@ -384,7 +384,7 @@ impl TrainConfig {
     /// The sections of the other algorithms stay at their defaults: they are not written with
     /// the run, so a change there would be lost. SAC's `updates_per_epoch` is SEADS's (the
     /// baselines set theirs in their own section).
-    fn check_other_sections(&self) -> Result<(), RlError> {
+    fn check_other_sections(&self) -> Result<(), RunError> {
         let changed = [
             (Algorithm::Seads, self.seads == SeadsConfig::default()),
             (
@@ -401,7 +401,7 @@ impl TrainConfig {
         if self.algorithm.is_baseline()
             && self.sac.updates_per_epoch != SacConfig::default().updates_per_epoch
         {
-            return Err(RlError::Config(format!(
+            return Err(RunError::Config(format!(
                 "sac.updates_per_epoch is SEADS's; the {} baseline's is {}.updates_per_epoch",
                 self.algorithm.name(),
                 self.algorithm.section()
@@ -418,6 +418,12 @@ impl TrainConfig {
             Algorithm::Seads | Algorithm::Sac => self.sac_baseline.clone(),
         }
     }
+}
+
+/// Whether `env` names one of the robot's environments (`uarm-…`), which are outside the
+/// registry of simulated environments and have no preset.
+fn is_robot_env(env: &str) -> bool {
+    !env_names().contains(&env) && env.starts_with("uarm-")
 }
 
 /// The machine's memory in bytes (`MemTotal` of `/proc/meminfo`), or `u64::MAX` where it
@@ -518,18 +524,18 @@ pub fn config_difference(
 }
 
 /// A configuration's text as a table.
-fn parse_table(text: &str) -> Result<toml::Table, RlError> {
+fn parse_table(text: &str) -> Result<toml::Table, RunError> {
     text.parse()
-        .map_err(|e| RlError::Config(one_line_toml_error(text, &e)))
+        .map_err(|e| RunError::Config(one_line_toml_error(text, &e)))
 }
 
 /// The algorithm a configuration's table names (SEADS where it names none).
-fn algorithm_of(table: &toml::Table) -> Result<Algorithm, RlError> {
+fn algorithm_of(table: &toml::Table) -> Result<Algorithm, RunError> {
     match table.get("algorithm") {
         Some(value) => value
             .clone()
             .try_into::<Algorithm>()
-            .map_err(|e| RlError::Config(format!("algorithm: {}", e.message().trim()))),
+            .map_err(|e| RunError::Config(format!("algorithm: {}", e.message().trim()))),
         None => Ok(Algorithm::Seads),
     }
 }
@@ -538,7 +544,7 @@ fn algorithm_of(table: &toml::Table) -> Result<Algorithm, RlError> {
 /// layout is upgraded (returns `true`; the sections it carried at their defaults are checked
 /// by value, [`TrainConfig::validate_values`]); a sectioned file must hold no other algorithm's
 /// section.
-fn into_sections(table: &mut toml::Table, algorithm: Algorithm) -> Result<bool, RlError> {
+fn into_sections(table: &mut toml::Table, algorithm: Algorithm) -> Result<bool, RunError> {
     if flat_layout::upgrade(table, algorithm)? {
         return Ok(true);
     }
@@ -552,8 +558,8 @@ fn into_sections(table: &mut toml::Table, algorithm: Algorithm) -> Result<bool, 
 }
 
 /// The error for a section of algorithm `other` in a configuration of `algorithm`.
-fn foreign_section(other: Algorithm, algorithm: Algorithm) -> RlError {
-    RlError::Config(format!(
+fn foreign_section(other: Algorithm, algorithm: Algorithm) -> RunError {
+    RunError::Config(format!(
         "[{}] is the section of algorithm {:?}, not of this run's {:?}; remove it",
         other.section(),
         other.name(),

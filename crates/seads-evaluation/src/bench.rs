@@ -1,6 +1,7 @@
 //! The planning benchmark of `seads plan-bench`: breadth-first search with a forward model fitted
 //! to a game's move table (LightsOut 5×5 by default), timed per depth on test boards.
 
+use seads_nn::Resolve as _;
 use std::time::Instant;
 
 use rand::SeedableRng;
@@ -11,7 +12,9 @@ use seads_rl::ComputeDevice;
 use seads_skillmodel::{SkillModelConfig, agreement_with_game, fit_to_game};
 use serde::Serialize;
 
-use crate::{Result, StudyError};
+use seads_study::StudyError;
+
+use crate::Result;
 
 /// What to time.
 #[derive(Debug, Clone)]
@@ -141,16 +144,16 @@ impl PlanBench {
     /// each depth. Empty or non-positive settings are [`StudyError::Invalid`].
     pub fn run(&self, mut on_depth: impl FnMut(&PlanBenchDepth)) -> Result<PlanBenchReport> {
         let Some(&max_depth) = self.depths.iter().max() else {
-            return Err(StudyError::invalid("--depths must name a depth"));
+            return Err(StudyError::invalid("--depths must name a depth").into());
         };
         if self.hidden.is_empty()
             || self.hidden.iter().any(|&h| h <= 0)
             || self.depths.contains(&0)
             || self.boards == 0
         {
-            return Err(StudyError::invalid(
-                "--hidden, --depths and --boards must be positive",
-            ));
+            return Err(
+                StudyError::invalid("--hidden, --depths and --boards must be positive").into(),
+            );
         }
         let game = self
             .game

@@ -8,10 +8,14 @@ use std::path::Path;
 use seads_planner::{Protocol, SearchLimits, TaskSet};
 use seads_rl::{Agent, ComputeDevice};
 
-use crate::evaluation::{
-    CheckpointEvaluation, OVER_TRAINING, evaluate_agent, over_training_protocol, read_over_training,
+use seads_study::evaluation::{
+    CheckpointEvaluation, OVER_TRAINING, over_training_protocol, read_over_training,
 };
-use crate::{Context as _, Result, StudyError};
+
+use crate::evaluation::evaluate_agent;
+use seads_study::{Context as _, StudyError};
+
+use crate::Result;
 
 /// What [`evaluate_checkpoints`] is doing, for a progress display.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -121,14 +125,15 @@ pub fn evaluate_checkpoints(
     device: ComputeDevice,
     mut progress: impl FnMut(Progress),
 ) -> Result<usize> {
-    let mut config = seads_rl::load_config(run).doing(|| format!("reading {}", run.display()))?;
+    let mut config = seads_run::load_config(run).doing(|| format!("reading {}", run.display()))?;
     config.device = device;
-    let kept = seads_rl::store::checkpoints(run).doing(|| format!("reading {}", run.display()))?;
+    let kept = seads_run::store::checkpoints(run).doing(|| format!("reading {}", run.display()))?;
     if kept.is_empty() {
         return Err(StudyError::invalid(format!(
             "{} has no checkpoint to evaluate",
             run.display()
-        )));
+        ))
+        .into());
     }
     let chosen = selection.choose(&kept).map_err(|e| {
         StudyError::invalid(format!(
@@ -165,7 +170,7 @@ pub fn evaluate_checkpoints(
                 progress(Progress::Task { depth: t.depth });
             },
         )?;
-        let env_steps = seads_rl::store::checkpoint_id(run, dir)?
+        let env_steps = seads_run::store::checkpoint_id(run, dir)?
             .env_steps
             .ok_or_else(|| {
                 StudyError::failed(format!(
@@ -180,10 +185,10 @@ pub fn evaluate_checkpoints(
             replan: *replan,
             boards: tasks.boards,
             limits,
-            evaluated_by: crate::provenance::this_binary().cloned(),
+            evaluated_by: seads_study::provenance::this_binary().cloned(),
             results,
         };
-        seads_rl::store::append_json_line(&path, &line)?;
+        seads_run::store::append_json_line(&path, &line)?;
     }
     Ok(todo.len())
 }

@@ -4,7 +4,7 @@
 //! ([`write_atomic`]), JSON Lines ([`read_json_lines`], [`append_json_line`]), the metrics
 //! ([`METRICS`], [`read_metrics_as`], [`last_env_steps`]), the checkpoints ([`checkpoints`],
 //! [`latest_checkpoint`], [`checkpoint_id`], [`is_copy_without_checkpoints`]) and the run's one
-//! writer ([`RunLock`], [`run_is_locked`]); the rest serves [`Run`](crate::Run) alone.
+//! writer ([`RunLock`], [`run_is_locked`]); the rest serves `seads-rl`'s `Run` alone.
 //!
 //! The contract (docs/ARCHITECTURE.md, "Invariants"):
 //! - every file is written to a temporary name, fsynced, renamed into place and its folder
@@ -33,7 +33,7 @@ use serde::de::DeserializeOwned;
 
 use seads_planner::CheckpointId;
 
-use crate::RlError;
+use crate::{RunError, TrainConfig};
 
 /// A line of `metrics.jsonl`: what resuming needs to know of it.
 pub trait MetricsLine: Serialize + DeserializeOwned {
@@ -48,15 +48,26 @@ pub trait MetricsLine: Serialize + DeserializeOwned {
 }
 
 /// The folder of checkpoints in a run directory.
-pub(crate) const CHECKPOINTS: &str = "checkpoints";
+pub const CHECKPOINTS: &str = "checkpoints";
 /// The file in [`CHECKPOINTS`] that names the latest complete checkpoint.
-pub(crate) const LATEST: &str = "latest";
+pub const LATEST: &str = "latest";
 /// The evaluation log of a run directory.
 pub const METRICS: &str = "metrics.jsonl";
 /// The configuration of a run directory.
-pub(crate) const CONFIG: &str = "config.toml";
+pub const CONFIG: &str = "config.toml";
 /// In every checkpoint folder: the environment and algorithm that wrote it.
-pub(crate) const ORIGIN: &str = "origin.json";
+pub const ORIGIN: &str = "origin.json";
+
+// The files of a checkpoint that its learner writes beside its networks (`seads-rl`).
+/// The episode buffer (long-term buffer; the recent episodes are its tail).
+pub const EPISODES_FILE: &str = "episodes.safetensors";
+/// The next epoch's updates, prepared while SAC updated (absent when there are none).
+pub const PREPARED_FILE: &str = "prepared.safetensors";
+/// Epoch, environment steps, time per phase and the random streams.
+pub const PROGRESS_FILE: &str = "progress.json";
+/// What the environments carry from one episode to the next (absent when they carry nothing):
+/// a JSON list of each training slot's state, then the coverage environment's.
+pub const ENVIRONMENT_FILE: &str = "environment.json";
 
 /// Where a checkpoint comes from.
 #[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
@@ -76,34 +87,34 @@ fn is_false(value: &bool) -> bool {
 
 /// Writes the origin of a checkpoint of a run with `config` into its folder `dir`, after the
 /// learner's files (whether it kept its environments' carried state is read from them).
-pub(crate) fn write_origin(dir: &Path, config: &crate::TrainConfig) -> Result<(), RlError> {
+pub fn write_origin(dir: &Path, config: &crate::TrainConfig) -> Result<(), RunError> {
     let origin = Origin {
         env: config.env.clone(),
         algorithm: config.algorithm,
-        carried_state: dir.join(crate::checkpoint::ENVIRONMENT_FILE).is_file(),
+        carried_state: dir.join(ENVIRONMENT_FILE).is_file(),
     };
     let path = dir.join(ORIGIN);
-    let text = serde_json::to_string(&origin).map_err(|e| RlError::io(&path, e))?;
-    fs::write(&path, text).map_err(|e| RlError::io(&path, e))?;
+    let text = serde_json::to_string(&origin).map_err(|e| RunError::io(&path, e))?;
+    fs::write(&path, text).map_err(|e| RunError::io(&path, e))?;
     // The whole configuration the checkpoint was trained with, which a resume compares with
     // the run's `config.toml`.
     let path = dir.join(CONFIG);
-    fs::write(&path, config.to_toml()).map_err(|e| RlError::io(&path, e))
+    fs::write(&path, config.to_toml()).map_err(|e| RunError::io(&path, e))
 }
 
 /// Refuses to resume from `checkpoint` with a `config` other than the one it was trained with
 /// (its `config.toml`), naming the first field that differs; the budget and thread counts may
 /// differ. A checkpoint written before it kept its configuration passes.
-pub(crate) fn check_config(checkpoint: &Path, config: &crate::TrainConfig) -> Result<(), RlError> {
+pub fn check_config(checkpoint: &Path, config: &crate::TrainConfig) -> Result<(), RunError> {
     let path = checkpoint.join(CONFIG);
     let Ok(text) = fs::read_to_string(&path) else {
         return Ok(());
     };
     let trained =
-        crate::TrainConfig::from_toml(&text).map_err(|e| RlError::unreadable(&path, e))?;
+        crate::TrainConfig::from_toml(&text).map_err(|e| RunError::unreadable(&path, e))?;
     match crate::config::config_difference(config, &trained) {
         None => Ok(()),
-        Some((field, now, then)) => Err(RlError::Config(format!(
+        Some((field, now, then)) => Err(RunError::Config(format!(
             "config.toml differs from the configuration that checkpoint {} was trained with: \
              `{field}` is {now}, was {then} (only env_steps, with --env-steps, and thread counts may change)",
             checkpoint.display()
@@ -113,7 +124,7 @@ pub(crate) fn check_config(checkpoint: &Path, config: &crate::TrainConfig) -> Re
 
 /// Whether the origin of `checkpoint` says that it was written with the state its environments
 /// carry (so a checkpoint without that file is damaged, not old).
-pub(crate) fn keeps_carried_state(checkpoint: &Path) -> bool {
+pub fn keeps_carried_state(checkpoint: &Path) -> bool {
     fs::read_to_string(checkpoint.join(ORIGIN))
         .ok()
         .and_then(|text| serde_json::from_str::<Origin>(&text).ok())
@@ -122,14 +133,14 @@ pub(crate) fn keeps_carried_state(checkpoint: &Path) -> bool {
 
 /// Refuses a checkpoint written by a run of another environment or algorithm than `config`'s,
 /// naming both. A checkpoint without an origin (written before it was recorded) passes.
-pub(crate) fn check_origin(checkpoint: &Path, config: &crate::TrainConfig) -> Result<(), RlError> {
+pub fn check_origin(checkpoint: &Path, config: &crate::TrainConfig) -> Result<(), RunError> {
     let path = checkpoint.join(ORIGIN);
     let Ok(text) = fs::read_to_string(&path) else {
         return Ok(());
     };
-    let origin: Origin = serde_json::from_str(&text).map_err(|e| RlError::unreadable(&path, e))?;
+    let origin: Origin = serde_json::from_str(&text).map_err(|e| RunError::unreadable(&path, e))?;
     if origin.env != config.env || origin.algorithm != config.algorithm {
-        return Err(RlError::Checkpoint {
+        return Err(RunError::Checkpoint {
             path: checkpoint.display().to_string(),
             reason: format!(
                 "it was written by a {} run on {}, not a {} run on {}",
@@ -145,19 +156,19 @@ pub(crate) fn check_origin(checkpoint: &Path, config: &crate::TrainConfig) -> Re
 
 /// Writes `bytes` to `path` atomically and durably: a temporary file in the same folder,
 /// fsynced, renamed over `path`, and the folder fsynced.
-pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<(), RlError> {
+pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<(), RunError> {
     refuse_special(path)?;
     let mut file =
-        atomic_write_file::AtomicWriteFile::open(path).map_err(|e| RlError::io(path, e))?;
-    file.write_all(bytes).map_err(|e| RlError::io(path, e))?;
-    file.commit().map_err(|e| RlError::io(path, e))
+        atomic_write_file::AtomicWriteFile::open(path).map_err(|e| RunError::io(path, e))?;
+    file.write_all(bytes).map_err(|e| RunError::io(path, e))?;
+    file.commit().map_err(|e| RunError::io(path, e))
 }
 
 /// An error where `path` exists and is not a regular file: an atomic write renames a new file over
 /// the path, which would replace a device, a FIFO or a symbolic link (not write to its target).
-fn refuse_special(path: &Path) -> Result<(), RlError> {
+fn refuse_special(path: &Path) -> Result<(), RunError> {
     match std::fs::symlink_metadata(path) {
-        Ok(meta) if !meta.file_type().is_file() => Err(RlError::io(
+        Ok(meta) if !meta.file_type().is_file() => Err(RunError::io(
             path,
             std::io::Error::new(
                 std::io::ErrorKind::InvalidInput,
@@ -178,10 +189,10 @@ pub struct AtomicFile {
 
 impl AtomicFile {
     /// Starts the file that will replace `path`.
-    pub fn open(path: &Path) -> Result<Self, RlError> {
+    pub fn open(path: &Path) -> Result<Self, RunError> {
         refuse_special(path)?;
         let file =
-            atomic_write_file::AtomicWriteFile::open(path).map_err(|e| RlError::io(path, e))?;
+            atomic_write_file::AtomicWriteFile::open(path).map_err(|e| RunError::io(path, e))?;
         Ok(Self {
             out: std::io::BufWriter::new(file),
             path: path.to_path_buf(),
@@ -189,13 +200,13 @@ impl AtomicFile {
     }
 
     /// Puts what was written in place of the path.
-    pub fn commit(self) -> Result<(), RlError> {
+    pub fn commit(self) -> Result<(), RunError> {
         let path = self.path;
         self.out
             .into_inner()
             .map_err(|e| e.into_error())
             .and_then(|file| file.commit())
-            .map_err(|e| RlError::io(&path, e))
+            .map_err(|e| RunError::io(&path, e))
     }
 }
 
@@ -210,40 +221,40 @@ impl std::io::Write for AtomicFile {
 }
 
 /// fsyncs a folder, so that the names created or renamed in it survive a power loss.
-pub(crate) fn sync_dir(dir: &Path) -> Result<(), RlError> {
+pub fn sync_dir(dir: &Path) -> Result<(), RunError> {
     fs::File::open(dir)
         .and_then(|d| d.sync_all())
-        .map_err(|e| RlError::io(dir, e))
+        .map_err(|e| RunError::io(dir, e))
 }
 
 /// Makes the folder `tmp`, filled by the caller, the folder `dest`: fsyncs its files and itself,
 /// moves an existing `dest` aside, renames, fsyncs the parent, then removes what was aside.
 /// A crash leaves either the old `dest` or the new one (and at most a hidden leftover that
 /// [`clean_leftovers`] removes).
-pub(crate) fn commit_dir(tmp: &Path, dest: &Path) -> Result<(), RlError> {
-    for entry in fs::read_dir(tmp).map_err(|e| RlError::io(tmp, e))? {
-        let path = entry.map_err(|e| RlError::io(tmp, e))?.path();
+pub fn commit_dir(tmp: &Path, dest: &Path) -> Result<(), RunError> {
+    for entry in fs::read_dir(tmp).map_err(|e| RunError::io(tmp, e))? {
+        let path = entry.map_err(|e| RunError::io(tmp, e))?.path();
         fs::File::open(&path)
             .and_then(|f| f.sync_all())
-            .map_err(|e| RlError::io(&path, e))?;
+            .map_err(|e| RunError::io(&path, e))?;
     }
     sync_dir(tmp)?;
     let parent = dest.parent().unwrap_or(Path::new("."));
     let aside = hidden_sibling(dest, "old");
     if dest.exists() {
         let _ = fs::remove_dir_all(&aside);
-        fs::rename(dest, &aside).map_err(|e| RlError::io(dest, e))?;
+        fs::rename(dest, &aside).map_err(|e| RunError::io(dest, e))?;
     }
-    fs::rename(tmp, dest).map_err(|e| RlError::io(dest, e))?;
+    fs::rename(tmp, dest).map_err(|e| RunError::io(dest, e))?;
     sync_dir(parent)?;
     if aside.exists() {
-        fs::remove_dir_all(&aside).map_err(|e| RlError::io(&aside, e))?;
+        fs::remove_dir_all(&aside).map_err(|e| RunError::io(&aside, e))?;
     }
     Ok(())
 }
 
 /// `.NAME.SUFFIX` beside `path`: where a checkpoint folder is written or set aside.
-pub(crate) fn hidden_sibling(path: &Path, suffix: &str) -> PathBuf {
+pub fn hidden_sibling(path: &Path, suffix: &str) -> PathBuf {
     let name = path
         .file_name()
         .map_or_else(Default::default, |n| n.to_string_lossy());
@@ -252,15 +263,15 @@ pub(crate) fn hidden_sibling(path: &Path, suffix: &str) -> PathBuf {
 
 /// Removes the hidden leftovers of interrupted writes in `dir` (temporary checkpoint folders,
 /// folders set aside, temporary files). Returns their names.
-pub(crate) fn clean_leftovers(dir: &Path) -> Result<Vec<String>, RlError> {
+pub fn clean_leftovers(dir: &Path) -> Result<Vec<String>, RunError> {
     let mut removed = Vec::new();
     let entries = match fs::read_dir(dir) {
         Ok(entries) => entries,
         Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok(removed),
-        Err(e) => return Err(RlError::io(dir, e)),
+        Err(e) => return Err(RunError::io(dir, e)),
     };
     for entry in entries {
-        let entry = entry.map_err(|e| RlError::io(dir, e))?;
+        let entry = entry.map_err(|e| RunError::io(dir, e))?;
         let name = entry.file_name().to_string_lossy().into_owned();
         if !name.starts_with('.') {
             continue;
@@ -271,14 +282,14 @@ pub(crate) fn clean_leftovers(dir: &Path) -> Result<Vec<String>, RlError> {
         } else {
             fs::remove_file(&path)
         };
-        result.map_err(|e| RlError::io(&path, e))?;
+        result.map_err(|e| RunError::io(&path, e))?;
         removed.push(name);
     }
     Ok(removed)
 }
 
 /// The lock file of a run directory.
-pub(crate) const RUN_LOCK: &str = "task.lock";
+pub const RUN_LOCK: &str = "task.lock";
 
 /// The right to write into a run directory, held by one process at a time: an OS file lock on
 /// `task.lock`, which the operating system releases when the process dies, so it is never stale.
@@ -291,8 +302,8 @@ pub struct RunLock {
 
 impl RunLock {
     /// Locks the run in `dir` (which must exist) for `holder` (a few words: what holds it),
-    /// waiting up to `patience` for another holder to let go; [`RlError::Busy`] if it does not.
-    pub fn acquire(dir: &Path, holder: &str, patience: Duration) -> Result<Self, RlError> {
+    /// waiting up to `patience` for another holder to let go; [`RunError::Busy`] if it does not.
+    pub fn acquire(dir: &Path, holder: &str, patience: Duration) -> Result<Self, RunError> {
         let path = dir.join(RUN_LOCK);
         let mut file = fs::File::options()
             .create(true)
@@ -300,7 +311,7 @@ impl RunLock {
             .read(true)
             .write(true)
             .open(&path)
-            .map_err(|e| RlError::io(&path, e))?;
+            .map_err(|e| RunError::io(&path, e))?;
         let start = Instant::now();
         loop {
             match file.try_lock() {
@@ -311,7 +322,7 @@ impl RunLock {
                 Err(fs::TryLockError::WouldBlock) => {
                     let named = fs::read_to_string(&path).unwrap_or_default();
                     let named = named.trim();
-                    return Err(RlError::Busy {
+                    return Err(RunError::Busy {
                         dir: dir.display().to_string(),
                         holder: if named.is_empty() {
                             "another process".into()
@@ -320,13 +331,13 @@ impl RunLock {
                         },
                     });
                 }
-                Err(fs::TryLockError::Error(e)) => return Err(RlError::io(&path, e)),
+                Err(fs::TryLockError::Error(e)) => return Err(RunError::io(&path, e)),
             }
         }
         let line = format!("pid {} ({holder})\n", std::process::id());
         file.set_len(0)
             .and_then(|()| file.write_all(line.as_bytes()))
-            .map_err(|e| RlError::io(&path, e))?;
+            .map_err(|e| RunError::io(&path, e))?;
         Ok(Self { _file: file })
     }
 }
@@ -343,14 +354,14 @@ pub fn run_is_locked(dir: &Path) -> bool {
 /// The name of the checkpoint of epoch `epoch`.
 ///
 /// ```
-/// assert_eq!(seads_rl::store::checkpoint_name(1800), "epoch-001800");
+/// assert_eq!(seads_run::store::checkpoint_name(1800), "epoch-001800");
 /// ```
 pub fn checkpoint_name(epoch: u64) -> String {
     format!("epoch-{epoch:06}")
 }
 
 /// The epoch of a checkpoint folder name (`epoch-` and digits only), or `None`.
-pub(crate) fn checkpoint_epoch(name: &str) -> Option<u64> {
+pub fn checkpoint_epoch(name: &str) -> Option<u64> {
     let digits = name.strip_prefix("epoch-")?;
     if digits.is_empty() || !digits.bytes().all(|b| b.is_ascii_digit()) {
         return None;
@@ -360,11 +371,11 @@ pub(crate) fn checkpoint_epoch(name: &str) -> Option<u64> {
 
 /// Every checkpoint folder of the run in `dir`, oldest first, as (epoch, path). Other entries
 /// (leftovers, the pointer) are not checkpoints.
-pub fn checkpoints(dir: &Path) -> Result<Vec<(u64, PathBuf)>, RlError> {
+pub fn checkpoints(dir: &Path) -> Result<Vec<(u64, PathBuf)>, RunError> {
     let root = dir.join(CHECKPOINTS);
     let mut out = Vec::new();
-    for entry in fs::read_dir(&root).map_err(|e| RlError::io(&root, e))? {
-        let entry = entry.map_err(|e| RlError::io(&root, e))?;
+    for entry in fs::read_dir(&root).map_err(|e| RunError::io(&root, e))? {
+        let entry = entry.map_err(|e| RunError::io(&root, e))?;
         let name = entry.file_name();
         if let Some(epoch) = name.to_str().and_then(checkpoint_epoch)
             && entry.path().is_dir()
@@ -378,7 +389,7 @@ pub fn checkpoints(dir: &Path) -> Result<Vec<(u64, PathBuf)>, RlError> {
 
 /// What `checkpoints/latest` holds.
 #[derive(Debug, Clone, PartialEq, Eq)]
-pub(crate) enum Latest {
+pub enum Latest {
     /// There is no pointer.
     Absent,
     /// The pointer names this checkpoint folder of the run (which may be missing).
@@ -390,7 +401,7 @@ pub(crate) enum Latest {
 
 /// Reads `checkpoints/latest`. Only a checkpoint name (`epoch-NNNNNN`) is followed, so the
 /// pointer never leads outside the run.
-pub(crate) fn read_latest(dir: &Path) -> Result<Latest, RlError> {
+pub fn read_latest(dir: &Path) -> Result<Latest, RunError> {
     let pointer = dir.join(CHECKPOINTS).join(LATEST);
     match fs::read(&pointer) {
         Ok(bytes) => Ok(match std::str::from_utf8(&bytes).map(str::trim) {
@@ -408,13 +419,13 @@ pub(crate) fn read_latest(dir: &Path) -> Result<Latest, RlError> {
             "{} is a directory, not a pointer",
             pointer.display()
         ))),
-        Err(e) => Err(RlError::io(&pointer, e)),
+        Err(e) => Err(RunError::io(&pointer, e)),
     }
 }
 
 /// The checkpoint `checkpoints/latest` names, if the pointer exists and names one of the run's
 /// checkpoints; the folder may be missing.
-pub(crate) fn latest_pointer(dir: &Path) -> Result<Option<PathBuf>, RlError> {
+pub fn latest_pointer(dir: &Path) -> Result<Option<PathBuf>, RunError> {
     Ok(match read_latest(dir)? {
         Latest::Names(path) => Some(path),
         Latest::Absent | Latest::Unusable(_) => None,
@@ -423,7 +434,7 @@ pub(crate) fn latest_pointer(dir: &Path) -> Result<Option<PathBuf>, RlError> {
 
 /// The latest checkpoint of the run in `dir`, if any: the one `latest` names, or, if that is
 /// missing, the newest checkpoint folder.
-pub fn latest_checkpoint(dir: &Path) -> Result<Option<PathBuf>, RlError> {
+pub fn latest_checkpoint(dir: &Path) -> Result<Option<PathBuf>, RunError> {
     if let Some(path) = latest_pointer(dir)?
         && path.is_dir()
     {
@@ -435,13 +446,13 @@ pub fn latest_checkpoint(dir: &Path) -> Result<Option<PathBuf>, RlError> {
 /// The lines of `dir/metrics.jsonl`, of any kind (SEADS's [`Metrics`](crate::Metrics), a
 /// baseline's [`TaskMetrics`](crate::TaskMetrics)). A last line without its newline is the trace
 /// of a crash during the append and is left out; any other line that does not parse is an error.
-pub fn read_metrics_as<M: MetricsLine>(dir: &Path) -> Result<Vec<M>, RlError> {
+pub fn read_metrics_as<M: MetricsLine>(dir: &Path) -> Result<Vec<M>, RunError> {
     Ok(read_metrics_text(dir)?.0)
 }
 
 /// Environment steps at the last evaluation in `dir/metrics.jsonl` (0 before the first),
 /// whatever the run trains: every kind of metrics line has `env_steps`.
-pub fn last_env_steps(dir: &Path) -> Result<u64, RlError> {
+pub fn last_env_steps(dir: &Path) -> Result<u64, RunError> {
     #[derive(serde::Deserialize)]
     struct Steps {
         env_steps: u64,
@@ -454,7 +465,7 @@ pub fn last_env_steps(dir: &Path) -> Result<u64, RlError> {
 /// and the environment steps of training there, from the run's metrics line of that epoch (the
 /// presets evaluate wherever they checkpoint), else from the checkpoint's progress file, else
 /// unknown.
-pub fn checkpoint_id(dir: &Path, checkpoint: &Path) -> Result<CheckpointId, RlError> {
+pub fn checkpoint_id(dir: &Path, checkpoint: &Path) -> Result<CheckpointId, RunError> {
     #[derive(serde::Deserialize)]
     struct Steps {
         #[serde(default)]
@@ -465,7 +476,7 @@ pub fn checkpoint_id(dir: &Path, checkpoint: &Path) -> Result<CheckpointId, RlEr
         .file_name()
         .and_then(|n| n.to_str())
         .and_then(checkpoint_epoch)
-        .ok_or_else(|| RlError::Checkpoint {
+        .ok_or_else(|| RunError::Checkpoint {
             path: checkpoint.display().to_string(),
             reason: "not a checkpoint folder (epoch-NNNNNN)".into(),
         })?;
@@ -477,7 +488,7 @@ pub fn checkpoint_id(dir: &Path, checkpoint: &Path) -> Result<CheckpointId, RlEr
         None
     };
     let from_progress = || {
-        let text = fs::read_to_string(checkpoint.join(crate::checkpoint::PROGRESS_FILE)).ok()?;
+        let text = fs::read_to_string(checkpoint.join(PROGRESS_FILE)).ok()?;
         let steps = serde_json::from_str::<Steps>(&text).ok()?;
         (steps.epoch == epoch).then_some(steps.env_steps)
     };
@@ -497,14 +508,14 @@ pub fn is_copy_without_checkpoints(dir: &Path) -> bool {
 }
 
 /// The whole lines of `dir/metrics.jsonl`, and whether a torn last line was left out.
-pub(crate) fn read_metrics_text<M: MetricsLine>(dir: &Path) -> Result<(Vec<M>, bool), RlError> {
+pub fn read_metrics_text<M: MetricsLine>(dir: &Path) -> Result<(Vec<M>, bool), RunError> {
     let (lines, torn): (Vec<M>, bool) = read_json_lines(&dir.join(METRICS))?;
     // Training appends one line per evaluated epoch, in order: a repeated or an earlier epoch is
     // damage, which neither resume nor a report may take as progress.
     for (i, pair) in lines.windows(2).enumerate() {
         let (before, after) = (pair[0].epoch(), pair[1].epoch());
         if after <= before {
-            return Err(RlError::Damaged {
+            return Err(RunError::Damaged {
                 dir: dir.display().to_string(),
                 reason: format!(
                     "{METRICS} line {} has epoch {after} after epoch {before}",
@@ -519,8 +530,8 @@ pub(crate) fn read_metrics_text<M: MetricsLine>(dir: &Path) -> Result<(Vec<M>, b
 /// The whole lines of a JSON Lines file, and whether a torn last line (a line without its
 /// newline: the trace of a crash during an append) was left out. Any other line that does not
 /// parse is an error naming its line number.
-pub fn read_json_lines<T: DeserializeOwned>(path: &Path) -> Result<(Vec<T>, bool), RlError> {
-    let text = fs::read_to_string(path).map_err(|e| RlError::io(path, e))?;
+pub fn read_json_lines<T: DeserializeOwned>(path: &Path) -> Result<(Vec<T>, bool), RunError> {
+    let text = fs::read_to_string(path).map_err(|e| RunError::io(path, e))?;
     let (whole, torn) = match text.rfind('\n') {
         Some(end) => (&text[..=end], !text[end + 1..].trim().is_empty()),
         None => ("", !text.trim().is_empty()),
@@ -530,7 +541,7 @@ pub fn read_json_lines<T: DeserializeOwned>(path: &Path) -> Result<(Vec<T>, bool
         .enumerate()
         .filter(|(_, l)| !l.trim().is_empty())
         .map(|(i, l)| {
-            serde_json::from_str(l).map_err(|e| RlError::Unreadable {
+            serde_json::from_str(l).map_err(|e| RunError::Unreadable {
                 path: format!("{}:{}", path.display(), i + 1),
                 source: e.into(),
             })
@@ -540,40 +551,68 @@ pub fn read_json_lines<T: DeserializeOwned>(path: &Path) -> Result<(Vec<T>, bool
 }
 
 /// Appends one line to `dir/metrics.jsonl` and fsyncs it.
-pub(crate) fn append_metrics<M: MetricsLine>(dir: &Path, metrics: &M) -> Result<(), RlError> {
+pub fn append_metrics<M: MetricsLine>(dir: &Path, metrics: &M) -> Result<(), RunError> {
     append_json_line(&dir.join(METRICS), metrics)
 }
 
 /// Appends `value` as one JSON line to `path` (created if missing) and fsyncs it. A torn last
 /// line that a crash left is cut off first, so the file only ever holds whole lines after it.
-pub fn append_json_line<T: Serialize>(path: &Path, value: &T) -> Result<(), RlError> {
-    let mut line = serde_json::to_string(value).map_err(|e| RlError::io(path, e))?;
+pub fn append_json_line<T: Serialize>(path: &Path, value: &T) -> Result<(), RunError> {
+    let mut line = serde_json::to_string(value).map_err(|e| RunError::io(path, e))?;
     line.push('\n');
     let mut file = fs::OpenOptions::new()
         .create(true)
         .append(true)
         .open(path)
-        .map_err(|e| RlError::io(path, e))?;
-    let text = fs::read_to_string(path).map_err(|e| RlError::io(path, e))?;
+        .map_err(|e| RunError::io(path, e))?;
+    let text = fs::read_to_string(path).map_err(|e| RunError::io(path, e))?;
     if !text.is_empty() && !text.ends_with('\n') {
         let keep = text.rfind('\n').map_or(0, |i| i + 1);
         file.set_len(keep as u64)
-            .map_err(|e| RlError::io(path, e))?;
+            .map_err(|e| RunError::io(path, e))?;
     }
     file.write_all(line.as_bytes())
         .and_then(|()| file.sync_data())
-        .map_err(|e| RlError::io(path, e))
+        .map_err(|e| RunError::io(path, e))
 }
 
 /// Rewrites `dir/metrics.jsonl` with exactly `metrics`.
-pub(crate) fn write_metrics<M: MetricsLine>(dir: &Path, metrics: &[M]) -> Result<(), RlError> {
+pub fn write_metrics<M: MetricsLine>(dir: &Path, metrics: &[M]) -> Result<(), RunError> {
     let path = dir.join(METRICS);
     let mut text = String::new();
     for m in metrics {
-        text += &serde_json::to_string(m).map_err(|e| RlError::io(&path, e))?;
+        text += &serde_json::to_string(m).map_err(|e| RunError::io(&path, e))?;
         text.push('\n');
     }
     write_atomic(&path, text.as_bytes())
+}
+
+/// Raises the budget of the run in `dir` to `env_steps` environment steps and records it in its
+/// config; the run continues with `seads train --resume`. A budget below the current one is a
+/// configuration error.
+pub fn raise_budget(dir: &Path, env_steps: u64) -> Result<(), RunError> {
+    let mut config = load_config(dir)?;
+    if env_steps < config.env_steps {
+        return Err(RunError::Config(format!(
+            "--env-steps {env_steps} is below the run's budget of {}; a budget can only be raised",
+            config.env_steps
+        )));
+    }
+    if env_steps > config.env_steps {
+        config.env_steps = env_steps;
+        // Checked before it is written: a run never holds a config it cannot read.
+        config.validate_values()?;
+        write_atomic(&dir.join(CONFIG), config.to_toml().as_bytes())?;
+    }
+    Ok(())
+}
+
+/// Reads and validates `dir/config.toml`.
+pub fn load_config(dir: &Path) -> Result<TrainConfig, RunError> {
+    let path = dir.join(CONFIG);
+    let text = fs::read_to_string(&path).map_err(|e| RunError::io(&path, e))?;
+    TrainConfig::from_user_toml(&text, None, None)
+        .map_err(|e| RunError::Config(format!("{}: {e}", path.display())))
 }
 
 #[cfg(test)]

@@ -1,0 +1,49 @@
+//! Running evaluations of trained runs; what they write into a run directory, and reading it
+//! back, is `seads-study`'s ([`seads_study::evaluation`], [`seads_study::journal`]), so that
+//! reports and sweeps read evaluations without libtorch.
+//!
+//! - [`evaluation`]: a trained agent planning on the evaluation protocol
+//!   ([`evaluation::run_evaluation`], resuming task by task) and a baseline's policy alone
+//!   ([`evaluation::run_policy_evaluation`]);
+//! - [`over_training`]: the kept checkpoints of a run, with and without re-planning (Fig. 3);
+//! - [`robot`]: the real uArm or its twin;
+//! - [`bench`](mod@bench): the planner's benchmark on a forward model fitted to the game.
+//!
+//! The `seads` command (`seads evaluate`, `seads uarm evaluate`, `seads bench`) is the front end;
+//! this crate never prints.
+
+pub mod bench;
+pub mod evaluation;
+pub mod over_training;
+pub mod robot;
+
+use seads_study::StudyError;
+
+/// What went wrong in an evaluation: the study's files and inputs, or the learner's networks.
+#[derive(Debug, thiserror::Error)]
+pub enum EvalError {
+    /// Reading or writing the run's files, or an input that cannot be evaluated
+    /// ([`StudyError::is_invalid`]).
+    #[error(transparent)]
+    Study(#[from] StudyError),
+    /// Loading or running the learner's networks.
+    #[error(transparent)]
+    Learning(#[from] seads_rl::RlError),
+}
+
+impl EvalError {
+    /// Whether the input was bad (a run, option or file that cannot be evaluated), not the
+    /// work.
+    pub fn is_invalid(&self) -> bool {
+        matches!(self, Self::Study(e) if e.is_invalid())
+    }
+}
+
+impl From<seads_run::RunError> for EvalError {
+    fn from(e: seads_run::RunError) -> Self {
+        Self::Study(e.into())
+    }
+}
+
+/// The result of an evaluation.
+pub type Result<T, E = EvalError> = std::result::Result<T, E>;
