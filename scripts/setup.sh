@@ -30,7 +30,7 @@ link="$root/.libtorch"
 stamp="$venv/.seads-libtorch-$torch_version"
 cuda_stamp="$stamp-cuda"
 
-# Slurm and munge for the Slurm test (root and apt-get only; otherwise the test skips).
+# Slurm and munge for the Slurm test (root and apt-get only; the test runs with SEADS_TEST_SLURM=1).
 bash "$root/scripts/slurm/install.sh"
 
 # Ready: this version installed and the link pointing into it (a link left by an older version,

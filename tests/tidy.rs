@@ -376,6 +376,35 @@ fn sources() -> Vec<(std::path::PathBuf, String)> {
     out
 }
 
+/// No test is `#[ignore]`d and no test asserts on the time a piece of work took: a test that
+/// needs what a machine may lack is built only when switched on, and a wait ends on an event
+/// (docs/ARCHITECTURE.md, "Tests and the clock").
+#[test]
+fn no_test_is_ignored_or_timed() {
+    let ignored = ["#", "[ignore"].concat();
+    let timed = ["elapsed()", " < "].concat();
+    let mut checked = 0;
+    for (path, text) in sources() {
+        checked += 1;
+        assert!(
+            !text.contains(&ignored),
+            "{} ignores a test",
+            path.display()
+        );
+        let in_tests = path.components().any(|c| c.as_os_str() == "tests");
+        let asserts_time = text.lines().collect::<Vec<_>>().windows(2).any(|w| {
+            w[0].trim_start().starts_with("assert!(") && w[1].contains(&timed)
+                || w[0].contains("assert!(") && w[0].contains(&timed)
+        });
+        assert!(
+            !(in_tests && asserts_time),
+            "{} asserts on wall time",
+            path.display()
+        );
+    }
+    assert!(checked > 100, "{checked} sources checked");
+}
+
 /// No code draws from libtorch's global generator: every random number comes from a stream of
 /// the run's seed (docs/ARCHITECTURE.md, "Determinism").
 #[test]

@@ -1,6 +1,7 @@
 //! Stamps the binary with the commit it was built from (`VERGEN_GIT_SHA`, `VERGEN_GIT_DIRTY`), which
 //! every training process records in its run's `provenance.jsonl` (src/provenance.rs); with the
-//! `cuda` feature, links libtorch's CUDA library into the binary.
+//! `cuda` feature, links libtorch's CUDA library into the binary; with `SEADS_TEST_SLURM=1`,
+//! builds the Slurm test.
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
     // The full SHA; dirty counts tracked files only. vergen reruns this script when HEAD moves;
@@ -24,6 +25,13 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     vergen_gitcl::Emitter::default()
         .add_instructions(&git)?
         .emit()?;
+    // Tests that need what a machine may lack are switched on explicitly: the Slurm test is
+    // built only with SEADS_TEST_SLURM=1 (tests/end_to_end/slurm.rs).
+    println!("cargo::rustc-check-cfg=cfg(seads_test_slurm)");
+    println!("cargo:rerun-if-env-changed=SEADS_TEST_SLURM");
+    if std::env::var("SEADS_TEST_SLURM").as_deref() == Ok("1") {
+        println!("cargo:rustc-cfg=seads_test_slurm");
+    }
     // tch registers CUDA through the static initialisers of libtorch_cuda.so, of which no symbol
     // is used: the linker's default `--as-needed` would drop it, and CUDA would then be absent.
     // Only the binaries get the flag (a build script linked with it would fail where the CUDA

@@ -6,7 +6,7 @@
 #
 #   scripts/slurm/start.sh DIR        scripts/slurm/stop.sh DIR
 #
-# Exit status: 0 started; 3 Slurm or munge is not installed, or not root (the caller skips);
+# Exit status: 0 started; 3 Slurm or munge is not installed, or not root (the test fails, saying so);
 # 1 anything else (the daemons' logs are printed). scripts/slurm/install.sh installs the packages.
 set -euo pipefail
 export PATH="$PATH:/usr/sbin:/sbin"

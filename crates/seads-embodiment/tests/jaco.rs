@@ -380,6 +380,9 @@ fn presses_agree_with_the_reference_simulation_at(substeps: usize) {
         assert!(!reference_presses.is_empty(), "{name}");
         if name == "lightsout" {
             // Measured: 99.8 %; 3 of 4 (the press in episode 12 is not registered by ours).
+            // FIXME: both thresholds are that one measurement (commit 6e914d6's physics, on the
+            // reference's recorded actions), not a tolerance derived from how far two correct
+            // simulations may drift apart; a change of rapier's version may cross them.
             assert!(fraction > 0.99, "{name}: {fraction}");
             assert!(
                 4 * reproduced >= 3 * reference_presses.len(),
@@ -389,6 +392,7 @@ fn presses_agree_with_the_reference_simulation_at(substeps: usize) {
             // Measured: 97.7 % of steps, 3 of 10 presses (none before the reference's column-by-
             // column numbering was followed). The misses come where our hand makes no contact in
             // the press step, most after the joints have drifted by 0.02–0.09 rad (docs/RESULTS.md).
+            // FIXME: as above, these thresholds are that one measurement, not a derived tolerance.
             assert!(fraction > 0.97, "{name}: {fraction}");
             assert!(reproduced >= 3, "{name}: {reference_presses:?}");
         }
@@ -560,10 +564,10 @@ fn jaco_presses_fields_and_pivots() {
     check("lightsout3d-jaco", &[1], &[6]);
 }
 
-/// Every move of every Jaco environment on several seeds (minutes): `cargo test --release -p
-/// seads-embodiment --test jaco -- --ignored`.
+/// Every move of every Jaco environment on several seeds (minutes), built only when switched on:
+/// `SEADS_TEST_JACO_FULL=1 cargo test --release -p seads-embodiment --test jaco full_sweep`.
+#[cfg(seads_test_jaco_full)]
 #[test]
-#[ignore = "full sweep, minutes; run on demand with --ignored"]
 fn jaco_produces_every_move_full_sweep() {
     // The scripted controller is simple: on the 3-D board the raised outer ring sometimes blocks
     // the hand above an inner field within the 50 steps. Measured: see the closing note.

@@ -22,10 +22,16 @@ FAR = [14, 15, 13, 12, 11, 10, 9, 8, 7, 6, 5, 4, 3, 2, 1, 0]
 
 CHILD = textwrap.dedent(
     f"""
+    import signal
     import threading
     import time
 
     import seads
+
+    # Ctrl-C raises KeyboardInterrupt even where this process was started with SIGINT ignored
+    # (a job started in the background by a non-interactive shell inherits that, and Python then
+    # installs no handler).
+    signal.signal(signal.SIGINT, signal.default_int_handler)
 
     game = seads.Game("sliding", 4)
     # A thread that ticks while it may: it goes on during the search only if the search has

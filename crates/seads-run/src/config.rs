@@ -780,96 +780,157 @@ mod tests {
         assert!(refused.to_string().contains("num_skills"), "{refused}");
     }
 
+    // Each strategy gives a value a configuration may hold most of the time (19 in 20) and one
+    // it must refuse otherwise, so that the property below sees both branches often (the test
+    // counts them: with some twenty values drawn per case, about a third of the cases hold
+    // valid values only).
     fn size() -> impl Strategy<Value = usize> {
         prop_oneof![
-            0..4usize,
-            1..5000usize,
-            (1usize << 20)..(1usize << 44),
-            Just(usize::MAX)
+            38 => 1..5000usize,
+            1 => 0..4usize,
+            1 => prop_oneof![(1usize << 20)..(1usize << 44), Just(usize::MAX)],
         ]
     }
 
-    fn layer() -> impl Strategy<Value = i64> {
+    fn small() -> impl Strategy<Value = usize> {
+        prop_oneof![38 => 1..64usize, 2 => size()]
+    }
+
+    fn layers() -> impl Strategy<Value = Vec<i64>> {
+        let layer = prop_oneof![
+            38 => 1..2048i64,
+            1 => -2..4i64,
+            1 => prop_oneof![(1i64 << 20)..(1i64 << 40), Just(i64::MAX)],
+        ];
         prop_oneof![
-            -2..4i64,
-            1..2048i64,
-            (1i64 << 20)..(1i64 << 40),
-            Just(i64::MAX)
+            38 => prop::collection::vec(layer, 1..4),
+            2 => Just(Vec::new()),
         ]
     }
 
     fn real() -> impl Strategy<Value = f64> {
         prop_oneof![
-            Just(f64::NAN),
-            Just(f64::INFINITY),
-            Just(f64::NEG_INFINITY),
-            Just(-0.0),
-            0.0..1.0f64,
-            any::<f64>()
+            38 => 1e-6..1.0f64,
+            1 => prop_oneof![Just(f64::NAN), Just(f64::INFINITY), Just(f64::NEG_INFINITY)],
+            1 => prop_oneof![Just(-0.0), Just(0.0), any::<f64>()],
         ]
     }
 
-    proptest! {
-        #![proptest_config(ProptestConfig::with_cases(300))]
-        /// Any values of the sizes and rates are checked without a panic, and what is accepted
-        /// has positive sizes, finite rates and fits into the machine's memory.
-        #[test]
-        fn any_config_values_are_checked_without_panic_and_accepted_only_if_they_fit(
-            num_skills in size(),
-            sac_hidden in prop::collection::vec(layer(), 0..4),
-            model_hidden in prop::collection::vec(layer(), 0..4),
-            (episodes, capacity, sampled) in (size(), size(), size()),
-            (sac_batch, model_batch, replay) in (size(), size(), size()),
-            (lr, alpha, gamma, p) in (real(), real(), real(), real()),
-            baseline in any::<bool>(),
-            (threads, eval_seeds, updates) in (size(), size(), size()),
-            (samples, boards) in (size(), size()),
-            (seed, env_steps) in (any::<u64>(), any::<u64>()),
-        ) {
-            let mut config = TrainConfig::preset("lightsout-cursor").unwrap();
-            config.seads.num_skills = Some(num_skills);
-            config.sac.hidden = sac_hidden;
-            config.seads.skill_model.hidden = model_hidden;
-            config.seads.episodes_per_epoch = episodes;
-            config.seads.buffer_capacity = capacity;
-            config.seads.sampled_episodes = sampled;
-            config.seads.recent_episodes = sampled.min(capacity);
-            config.sac.batch_size = sac_batch;
-            config.seads.skill_model.batch_size = model_batch;
-            config.sac.lr = lr;
-            config.sac.alpha = alpha;
-            config.sac.gamma = gamma;
-            config.seads.relabel.sac_p = p;
-            config.threads = threads;
-            config.seads.eval_seeds = eval_seeds as u64;
-            config.seed = seed;
-            config.env_steps = env_steps;
-            if baseline {
-                config = TrainConfig { algorithm: Algorithm::Sac, ..config };
-                config.sac_baseline.replay_capacity = replay;
-                config.sac_baseline.samples_per_epoch = samples;
-                config.sac_baseline.eval_boards = boards;
-            } else {
-                config.sac.updates_per_epoch = updates;
-            }
-            if config.validate().is_ok() {
-                let env = seads_embodiment::make_env(&config.env, &config.env_config).unwrap();
-                prop_assert!(config.memory_estimate(env.spec()) <= machine_memory_bytes() as f64);
-                prop_assert!(config.sac.hidden.iter().all(|&h| h > 0));
-                prop_assert!(lr.is_finite() && lr > 0.0 && alpha.is_finite() && alpha > 0.0);
-                prop_assert!((0.0..=1.0).contains(&gamma) && (0.0..=1.0).contains(&p));
-                prop_assert!(num_skills > 0 && sac_batch > 0 && episodes > 0);
-                prop_assert!(threads as u64 <= MAX_THREADS);
-                prop_assert!((eval_seeds as u64) <= MAX_PER_EPOCH);
-                prop_assert!(config.sac.updates_per_epoch as u64 <= MAX_PER_EPOCH);
-                prop_assert!(config.sac_baseline.samples_per_epoch as u64 <= MAX_PER_EPOCH);
-                prop_assert!(config.sac_baseline.eval_boards as u64 <= MAX_PER_EPOCH);
-                prop_assert!(i64::try_from(seed).is_ok() && i64::try_from(env_steps).is_ok());
-                // What is accepted is written and read back as it was.
-                let back = TrainConfig::from_toml(&config.to_toml());
-                prop_assert!(back.is_ok(), "{:?}", back.err());
-            }
-        }
+    fn signed() -> impl Strategy<Value = u64> {
+        prop_oneof![38 => 0..=i64::MAX as u64, 2 => any::<u64>()]
+    }
+
+    /// Any values of the sizes and rates are checked without a panic, and what is accepted has
+    /// positive sizes, finite rates and fits into the machine's memory, and is written and read
+    /// back as it was. The cases both accepted and refused are counted: neither branch may go
+    /// untested.
+    #[test]
+    fn any_config_values_are_checked_without_panic_and_accepted_only_if_they_fit() {
+        let cases = 300;
+        // A fixed stream: the same cases on every run and machine.
+        let rng = proptest::test_runner::TestRng::deterministic_rng(
+            proptest::test_runner::RngAlgorithm::ChaCha,
+        );
+        let config = ProptestConfig {
+            cases,
+            failure_persistence: None,
+            ..ProptestConfig::default()
+        };
+        let mut runner = proptest::test_runner::TestRunner::new_with_rng(config, rng);
+        let (accepted, refused) = (std::cell::Cell::new(0u32), std::cell::Cell::new(0u32));
+        let values = (
+            size(),
+            (layers(), layers()),
+            (size(), size(), small()),
+            (size(), size(), size()),
+            (real(), real(), real(), real()),
+            any::<bool>(),
+            (small(), size(), size()),
+            (size(), size()),
+            (signed(), signed()),
+        );
+        runner
+            .run(
+                &values,
+                |(
+                    num_skills,
+                    (sac_hidden, model_hidden),
+                    (episodes, capacity, sampled),
+                    (sac_batch, model_batch, replay),
+                    (lr, alpha, gamma, p),
+                    baseline,
+                    (threads, eval_seeds, updates),
+                    (samples, boards),
+                    (seed, env_steps),
+                )| {
+                    let mut config = TrainConfig::preset("lightsout-cursor").unwrap();
+                    config.seads.num_skills = Some(num_skills);
+                    config.sac.hidden = sac_hidden;
+                    config.seads.skill_model.hidden = model_hidden;
+                    config.seads.episodes_per_epoch = episodes;
+                    config.seads.buffer_capacity = capacity;
+                    config.seads.sampled_episodes = sampled;
+                    config.seads.recent_episodes = sampled.min(capacity);
+                    config.sac.batch_size = sac_batch;
+                    config.seads.skill_model.batch_size = model_batch;
+                    config.sac.lr = lr;
+                    config.sac.alpha = alpha;
+                    config.sac.gamma = gamma;
+                    config.seads.relabel.sac_p = p;
+                    config.threads = threads;
+                    config.seads.eval_seeds = eval_seeds as u64;
+                    config.seed = seed;
+                    config.env_steps = env_steps;
+                    if baseline {
+                        config = TrainConfig {
+                            algorithm: Algorithm::Sac,
+                            seads: SeadsConfig::default(),
+                            ..config
+                        };
+                        config.sac_baseline.replay_capacity = replay;
+                        config.sac_baseline.samples_per_epoch = samples;
+                        config.sac_baseline.eval_boards = boards;
+                    } else {
+                        config.sac.updates_per_epoch = updates;
+                    }
+                    if config.validate().is_err() {
+                        refused.set(refused.get() + 1);
+                        return Ok(());
+                    }
+                    accepted.set(accepted.get() + 1);
+                    let env = seads_embodiment::make_env(&config.env, &config.env_config).unwrap();
+                    prop_assert!(
+                        config.memory_estimate(env.spec()) <= machine_memory_bytes() as f64
+                    );
+                    prop_assert!(config.sac.hidden.iter().all(|&h| h > 0));
+                    prop_assert!(lr.is_finite() && lr > 0.0 && alpha.is_finite() && alpha > 0.0);
+                    prop_assert!((0.0..=1.0).contains(&gamma));
+                    prop_assert!(sac_batch > 0);
+                    prop_assert!(threads as u64 <= MAX_THREADS);
+                    prop_assert!(config.sac.updates_per_epoch as u64 <= MAX_PER_EPOCH);
+                    prop_assert!(config.sac_baseline.samples_per_epoch as u64 <= MAX_PER_EPOCH);
+                    prop_assert!(config.sac_baseline.eval_boards as u64 <= MAX_PER_EPOCH);
+                    prop_assert!(i64::try_from(seed).is_ok() && i64::try_from(env_steps).is_ok());
+                    if !baseline {
+                        prop_assert!(num_skills > 0 && episodes > 0);
+                        prop_assert!((0.0..=1.0).contains(&p));
+                        prop_assert!((eval_seeds as u64) <= MAX_PER_EPOCH);
+                    }
+                    // What is accepted is written and read back as it was.
+                    let back = TrainConfig::from_toml(&config.to_toml());
+                    prop_assert!(back.is_ok(), "{:?}", back.err());
+                    prop_assert_eq!(back.unwrap(), config);
+                    Ok(())
+                },
+            )
+            .unwrap();
+        assert_eq!(accepted.get() + refused.get(), cases);
+        assert!(
+            accepted.get() >= cases / 20 && refused.get() >= cases / 20,
+            "{} accepted, {} refused of {cases}: both branches need cases",
+            accepted.get(),
+            refused.get()
+        );
     }
 
     #[test]

@@ -79,6 +79,20 @@ pub fn park_at_moment(mut command: Command, point: usize) -> std::process::Child
     child
 }
 
+/// Waits until `holds`, looking again every few milliseconds, while `alive` says that what
+/// could make it hold (a process, a job) is still at work; once that has ended, `holds` must
+/// hold (else the test fails, naming `what`). There is no deadline: how long the work takes
+/// depends on the machine, and what ends it is an event, not the clock.
+pub fn wait_until(what: &str, mut holds: impl FnMut() -> bool, mut alive: impl FnMut() -> bool) {
+    while !holds() {
+        if !alive() {
+            assert!(holds(), "{what}: what it waited on ended first");
+            return;
+        }
+        std::thread::sleep(std::time::Duration::from_millis(20));
+    }
+}
+
 /// The metrics lines of the run in `run`, without what depends on the clock.
 pub fn metrics_without_clock(run: &Path) -> Vec<serde_json::Value> {
     std::fs::read_to_string(run.join("metrics.jsonl"))
@@ -225,4 +239,126 @@ pub fn data_snapshot(dir: &Path) -> Vec<(std::path::PathBuf, Vec<u8>)> {
         .into_iter()
         .filter(|(path, _)| path.file_name().is_none_or(|n| n != "task.lock"))
         .collect()
+}
+
+// Shared by the commands' tests: a tiny trained run and its evaluations.
+
+/// A tiny training configuration (small networks, small budget) written into `dir`.
+pub fn tiny_config(dir: &std::path::Path) -> std::path::PathBuf {
+    let text = std::fs::read_to_string(concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../../configs/lightsout-cursor.toml"
+    ))
+    .unwrap()
+    .replace("env_steps = 500000", "env_steps = 600")
+    .replace("hidden = [256, 256]", "hidden = [32, 32]")
+    .replace("sampled_episodes = 256", "sampled_episodes = 32")
+    .replace("recent_episodes = 256", "recent_episodes = 16")
+    .replace("eval_every = 100", "eval_every = 5")
+    .replace("checkpoint_every = 100", "checkpoint_every = 5")
+    .replace("eval_seeds = 20", "eval_seeds = 1")
+    // Tests run side by side: SAC taking a second thread would oversubscribe the cores.
+    .replace("sac_threads_alone = 2", "sac_threads_alone = 0")
+    .replace("portable_numerics = false", "portable_numerics = true");
+    let path = dir.join("tiny.toml");
+    std::fs::write(&path, text).unwrap();
+    path
+}
+
+/// A copy of the shared tiny run at `to`, for a test that writes into it.
+pub fn copy_tiny_run(to: &std::path::Path) {
+    copy_dir(&tiny_run().join("run"), to);
+}
+
+/// The stem of the files [`evaluate_two_boards_of_depths_1_2`] writes: named by every part of
+/// its protocol that departs from the standard one.
+pub const TWO_BOARDS: &str = "evaluation-replan-depths-1-2-boards-2-expanded-2000";
+
+/// `seads evaluate --json` of `run` with re-planning on 2 boards of depths 1 and 2 (searches
+/// bounded by 2,000 states); it writes [`TWO_BOARDS`]`*` into the run.
+pub fn evaluate_two_boards_of_depths_1_2(run: &str) -> serde_json::Value {
+    serde_json::from_slice(&evaluate_two_boards_of_depths_1_2_output(run).stdout).unwrap()
+}
+
+/// What [`evaluate_two_boards_of_depths_1_2`] prints, standard error included.
+pub fn evaluate_two_boards_of_depths_1_2_output(run: &str) -> std::process::Output {
+    seads_ok(&[
+        "evaluate",
+        "--run",
+        run,
+        "--depths",
+        "1-2",
+        "--boards",
+        "2",
+        "--max-expanded",
+        "2000",
+        "--replan",
+        "--json",
+    ])
+}
+
+/// One tiny trained run shared by the planning tests.
+pub fn tiny_run() -> &'static std::path::Path {
+    static RUN: std::sync::OnceLock<tempfile::TempDir> = std::sync::OnceLock::new();
+    RUN.get_or_init(|| {
+        let dir = tempfile::tempdir().unwrap();
+        let config = tiny_config(dir.path());
+        let run = dir.path().join("run");
+        seads_ok(&[
+            "train",
+            "--config",
+            config.to_str().unwrap(),
+            "--out",
+            run.to_str().unwrap(),
+            "--quiet",
+        ]);
+        dir
+    })
+    .path()
+}
+
+/// What a process did with a command line: its exit code, or `None` if it was still working
+/// after `patience` (then it is killed), and its stderr.
+pub fn run_for(args: &[String], patience: std::time::Duration) -> (Option<i32>, String) {
+    use std::io::Read as _;
+    use std::os::unix::process::ExitStatusExt;
+    let mut child = seads_command()
+        .args(args)
+        .stdout(std::process::Stdio::null())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    let start = std::time::Instant::now();
+    let status = loop {
+        if let Some(status) = child.try_wait().unwrap() {
+            break Some(status);
+        }
+        if start.elapsed() > patience {
+            let _ = child.kill();
+            let _ = child.wait();
+            break None;
+        }
+        std::thread::sleep(std::time::Duration::from_millis(20));
+    };
+    let mut stderr = String::new();
+    let _ = child.stderr.take().unwrap().read_to_string(&mut stderr);
+    if let Some(status) = status {
+        assert_eq!(status.signal(), None, "{args:?} died of a signal: {stderr}");
+    }
+    (status.and_then(|s| s.code()), stderr)
+}
+
+/// Copies the run's last checkpoint under the epoch before it, which stands in for an earlier
+/// checkpoint (a run keeps only its last); returns the last epoch and the earlier one.
+pub fn add_an_earlier_checkpoint(run: &std::path::Path) -> (u64, u64) {
+    let (last, _) = seads_rl::store::checkpoints(run).unwrap().pop().unwrap();
+    let earlier = last - 1;
+    let status = std::process::Command::new("cp")
+        .arg("-r")
+        .arg(run.join(format!("checkpoints/epoch-{last:06}")))
+        .arg(run.join(format!("checkpoints/epoch-{earlier:06}")))
+        .status()
+        .unwrap();
+    assert!(status.success());
+    (last, earlier)
 }
