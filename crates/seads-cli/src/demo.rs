@@ -106,7 +106,9 @@ pub fn run(args: RunArgs) -> Result<()> {
         );
         let lock = crate::lock_new_run(&args.out)?;
         let run = Run::create(&args.out, config).map_err(|e| match e {
-            seads_rl::RlError::Config(_) => anyhow::Error::from(BadInput(e.into())),
+            seads_rl::RlError::Run(seads_run::RunError::Config(_)) => {
+                anyhow::Error::from(BadInput(e.into()))
+            }
             other => anyhow::Error::from(other),
         })?;
         (run, lock)

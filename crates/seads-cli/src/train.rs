@@ -172,7 +172,9 @@ fn create<L: Learner>(
     // The lock first: nothing is written into a directory another command holds.
     let lock = crate::lock_new_run(out)?;
     let run = Run::create(out, config).map_err(|e| match e {
-        seads_rl::RlError::Config(_) => anyhow::Error::from(BadInput(e.into())),
+        seads_rl::RlError::Run(seads_run::RunError::Config(_)) => {
+            anyhow::Error::from(BadInput(e.into()))
+        }
         other => anyhow::Error::from(other),
     })?;
     Ok((run, lock))
@@ -196,10 +198,10 @@ pub fn resume<L: Learner>(
 ) -> Result<Run<L>> {
     // A run damaged beyond repair is bad input, as any malformed input file is.
     let run = run.map_err(|e| match e {
-        seads_rl::RlError::Damaged { .. }
+        seads_rl::RlError::Run(seads_run::RunError::Damaged { .. })
         | seads_rl::RlError::CheckpointsMissing { .. }
         | seads_rl::RlError::NoCheckpoint { .. }
-        | seads_rl::RlError::Config(_) => BadInput(e.into()).into(),
+        | seads_rl::RlError::Run(seads_run::RunError::Config(_)) => BadInput(e.into()).into(),
         other => anyhow::Error::from(other),
     });
     let run = run.with_context(|| format!("resuming {}", dir.display()))?;

@@ -84,13 +84,17 @@ pub fn find_checkpoint(dir: &Path, epoch: Option<u64>) -> Result<PathBuf, RlErro
             .into_iter()
             .find(|(ce, _)| *ce == e)
             .map(|(_, p)| p)
-            .ok_or_else(|| RlError::Checkpoint {
-                path: dir.display().to_string(),
-                reason: format!("no checkpoint of epoch {e}"),
+            .ok_or_else(|| {
+                RlError::from(seads_run::RunError::Checkpoint {
+                    path: dir.display().to_string(),
+                    reason: format!("no checkpoint of epoch {e}"),
+                })
             }),
-        None => latest_checkpoint(dir)?.ok_or_else(|| RlError::Checkpoint {
-            path: dir.display().to_string(),
-            reason: "the run has no checkpoint yet".into(),
+        None => latest_checkpoint(dir)?.ok_or_else(|| {
+            RlError::from(seads_run::RunError::Checkpoint {
+                path: dir.display().to_string(),
+                reason: "the run has no checkpoint yet".into(),
+            })
         }),
     }
 }
@@ -145,9 +149,11 @@ impl Agent {
             .file_name()
             .and_then(|n| n.to_str())
             .and_then(crate::store::checkpoint_epoch)
-            .ok_or_else(|| RlError::Checkpoint {
-                path: checkpoint.display().to_string(),
-                reason: "a checkpoint folder is named epoch-N".into(),
+            .ok_or_else(|| {
+                RlError::from(seads_run::RunError::Checkpoint {
+                    path: checkpoint.display().to_string(),
+                    reason: "a checkpoint folder is named epoch-N".into(),
+                })
             })?;
         Ok(Self {
             config,
@@ -164,8 +170,8 @@ impl Agent {
     pub fn parts(&mut self) -> Result<(&AgentPolicy, &mut ForwardModel), RlError> {
         match &mut self.model {
             Some(model) => Ok((&self.policy, model)),
-            None => Err(RlError::Config(
-                "this agent learned a VIC skill discriminator, which cannot plan".into(),
+            None => Err(RlError::config(
+                "this agent learned a VIC skill discriminator, which cannot plan",
             )),
         }
     }

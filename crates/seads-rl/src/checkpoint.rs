@@ -152,10 +152,10 @@ impl<'a> TensorFile<'a> {
     }
 
     fn corrupt(&self, reason: String) -> RlError {
-        RlError::Checkpoint {
+        RlError::from(seads_run::RunError::Checkpoint {
             path: self.path.display().to_string(),
             reason,
-        }
+        })
     }
 
     fn get(&self, name: &str) -> Result<&Tensor, RlError> {

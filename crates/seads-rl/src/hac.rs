@@ -600,10 +600,10 @@ impl Hac {
         let progress = Progress::from(read_progress::<ProgressFile>(&path)?);
         let n = self.episodes.len();
         if progress.subgoals.len() != n || progress.ended_attempts.len() != n {
-            return Err(RlError::Checkpoint {
+            return Err(RlError::from(seads_run::RunError::Checkpoint {
                 path: path.display().to_string(),
                 reason: format!("{} subgoals for {n} environments", progress.subgoals.len()),
-            });
+            }));
         }
         let observations = &mut self.observations;
         observations.iter_mut().for_each(Vec::clear);
@@ -620,10 +620,10 @@ impl Hac {
                     .iter()
                     .any(|e| e.start > e.end || e.end > steps);
             if late {
-                return Err(RlError::Checkpoint {
+                return Err(RlError::from(seads_run::RunError::Checkpoint {
                     path: path.display().to_string(),
                     reason: format!("a subgoal of environment {slot} starts after its episode"),
-                });
+                }));
             }
         }
         self.progress = progress;

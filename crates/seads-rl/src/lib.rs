@@ -95,48 +95,21 @@ pub fn set_threads(n: usize) {
 /// A boxed error kept as the source of another.
 pub type BoxError = Box<dyn std::error::Error + Send + Sync>;
 
-/// Errors of training and checkpoints.
+/// Errors of training and checkpoints. What concerns a run's data (its configuration and
+/// files) is [`RlError::Run`], with `seads-run`'s kinds: a bad configuration is
+/// `RlError::Run(RunError::Config(_))`, a busy run `RlError::Run(RunError::Busy { .. })`.
 #[derive(Debug, thiserror::Error)]
 pub enum RlError {
-    /// A configuration value that cannot be used.
-    #[error("invalid configuration: {0}")]
-    Config(String),
+    /// A run's configuration or files: a bad value, a file that cannot be read or written, a
+    /// damaged checkpoint or run directory, another writer.
+    #[error(transparent)]
+    Run(#[from] RunError),
     /// The device asked for is not there.
     #[error(transparent)]
     Device(#[from] seads_nn::DeviceError),
-    /// The environment failed.
-    #[error(transparent)]
-    Env(#[from] seads_embodiment::EnvError),
     /// The skill model failed.
     #[error(transparent)]
     SkillModel(#[from] seads_skillmodel::SkillModelError),
-    /// Reading or writing a file failed.
-    #[error("{path}")]
-    Io {
-        /// The file.
-        path: String,
-        /// What went wrong.
-        #[source]
-        source: BoxError,
-    },
-    /// A checkpoint file is missing, corrupt or from another configuration.
-    #[error("cannot load checkpoint {path}: {reason}")]
-    Checkpoint {
-        /// The file.
-        path: String,
-        /// What went wrong.
-        reason: String,
-    },
-    /// A file of the run (a checkpoint's, a JSON Lines file's line) could not be read or parsed;
-    /// `path` names it (`file:line` for a line).
-    #[error("cannot read {path}")]
-    Unreadable {
-        /// The file.
-        path: String,
-        /// What went wrong.
-        #[source]
-        source: BoxError,
-    },
     /// A run with evaluation lines has no checkpoints folder: its checkpoints were removed (a
     /// run copied without them, as `seads report --copy-runs` does). Training it again from
     /// scratch would replace the metrics it holds, so resuming refuses.
@@ -149,23 +122,6 @@ pub enum RlError {
         dir: String,
         /// Lines in its metrics file.
         lines: usize,
-    },
-    /// A run directory is damaged in a way resuming cannot repair without losing or inventing
-    /// history (its metrics file or its checkpoints were removed): resuming refuses.
-    #[error("{dir}: {reason}; resuming refuses (restore it, or train a new run)")]
-    Damaged {
-        /// The run directory.
-        dir: String,
-        /// What is damaged.
-        reason: String,
-    },
-    /// Another process writes into the run directory now.
-    #[error("{dir} is in use by {holder}: one writer at a time")]
-    Busy {
-        /// The run directory.
-        dir: String,
-        /// Who holds it, as its lock file names it.
-        holder: String,
     },
     /// A member of a population failed.
     #[error("{dir}")]
@@ -189,35 +145,34 @@ pub enum RlError {
     },
 }
 
-/// A run's data errors keep their kind: a bad configuration is [`RlError::Config`], a busy run
-/// [`RlError::Busy`], and so on.
-impl From<RunError> for RlError {
-    fn from(e: RunError) -> Self {
-        match e {
-            RunError::Config(message) => RlError::Config(message),
-            RunError::Env(e) => RlError::Env(e),
-            RunError::Io { path, source } => RlError::Io { path, source },
-            RunError::Checkpoint { path, reason } => RlError::Checkpoint { path, reason },
-            RunError::Unreadable { path, source } => RlError::Unreadable { path, source },
-            RunError::Damaged { dir, reason } => RlError::Damaged { dir, reason },
-            RunError::Busy { dir, holder } => RlError::Busy { dir, holder },
-        }
+/// The environment failed: a run's environment, as `seads-run` reports it.
+impl From<seads_embodiment::EnvError> for RlError {
+    fn from(e: seads_embodiment::EnvError) -> Self {
+        RlError::Run(RunError::Env(e))
     }
 }
 
 impl RlError {
+    /// A configuration value that cannot be used ([`RunError::Config`]).
+    pub fn config(message: impl Into<String>) -> Self {
+        RlError::Run(RunError::Config(message.into()))
+    }
+
+    /// A checkpoint that is missing, corrupt or from another configuration
+    /// ([`RunError::Checkpoint`]).
+    pub fn checkpoint(path: impl Into<String>, reason: impl Into<String>) -> Self {
+        RlError::Run(RunError::Checkpoint {
+            path: path.into(),
+            reason: reason.into(),
+        })
+    }
+
     fn io(path: &Path, e: impl Into<BoxError>) -> Self {
-        RlError::Io {
-            path: path.display().to_string(),
-            source: e.into(),
-        }
+        RlError::Run(RunError::io(path, e))
     }
 
     fn unreadable(path: &Path, e: impl Into<BoxError>) -> Self {
-        RlError::Unreadable {
-            path: path.display().to_string(),
-            source: e.into(),
-        }
+        RlError::Run(RunError::unreadable(path, e))
     }
 }
 

@@ -54,8 +54,8 @@ impl Learner for Trainer {
         _: &seads_embodiment::EnvSpec,
         _: &std::path::Path,
     ) -> Result<Box<dyn crate::TaskPolicy>, RlError> {
-        Err(RlError::Config(
-            "a SEADS run has skills and a forward model, not a task policy; plan with it".into(),
+        Err(RlError::config(
+            "a SEADS run has skills and a forward model, not a task policy; plan with it",
         ))
     }
 }

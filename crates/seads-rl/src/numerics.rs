@@ -11,7 +11,7 @@ pub(crate) fn check(portable: bool) -> Result<(), crate::RlError> {
             .iter()
             .map(|(n, v)| format!("{n}={v}"))
             .collect();
-        return Err(crate::RlError::Config(format!(
+        return Err(crate::RlError::config(format!(
             "portable_numerics needs {} in the environment before libtorch starts \
              (the seads binary sets them itself)",
             env.join(" ")

@@ -97,9 +97,11 @@ impl Replay {
     }
 
     pub(crate) fn load(&mut self, path: &Path) -> Result<(), RlError> {
-        let bad = |reason: String| RlError::Checkpoint {
-            path: path.display().to_string(),
-            reason,
+        let bad = |reason: String| {
+            RlError::from(seads_run::RunError::Checkpoint {
+                path: path.display().to_string(),
+                reason,
+            })
         };
         let named = Tensor::read_safetensors(path).map_err(|e| RlError::unreadable(path, e))?;
         let get = |name: &str| -> Result<&Tensor, RlError> {
@@ -175,6 +177,9 @@ mod tests {
         back.load(&path).unwrap();
         assert_eq!(back, replay);
         let mut other = Replay::new(3, 3, 1);
-        assert!(matches!(other.load(&path), Err(RlError::Checkpoint { .. })));
+        assert!(matches!(
+            other.load(&path),
+            Err(RlError::Run(seads_run::RunError::Checkpoint { .. }))
+        ));
     }
 }

@@ -51,7 +51,7 @@ impl<L: Learner> Run<L> {
 
     fn check_free(dir: &Path) -> Result<(), RlError> {
         if dir.join(CONFIG).exists() {
-            return Err(RlError::Config(format!(
+            return Err(RlError::config(format!(
                 "{} already holds a run; resume it with --resume or choose another directory",
                 dir.display()
             )));
@@ -59,7 +59,7 @@ impl<L: Learner> Run<L> {
         // What is left of a run whose config was removed is never trained over.
         let checkpoints = fs::read_dir(dir.join(CHECKPOINTS)).is_ok_and(|mut d| d.next().is_some());
         if dir.join(METRICS).exists() || checkpoints {
-            return Err(RlError::Config(format!(
+            return Err(RlError::config(format!(
                 "{} holds a run's metrics or checkpoints but no config.toml: restore its \
                  config.toml to resume it, or choose another directory",
                 dir.display()
@@ -114,9 +114,11 @@ impl<L: Learner> Run<L> {
         } else {
             Vec::new()
         };
-        let damaged = |reason: String| RlError::Damaged {
-            dir: dir.display().to_string(),
-            reason,
+        let damaged = |reason: String| {
+            RlError::from(seads_run::RunError::Damaged {
+                dir: dir.display().to_string(),
+                reason,
+            })
         };
         // A directory planned by a sweep holds only its config: the run starts here. One whose
         // metrics are gone but whose checkpoints remain has lost its history.
@@ -213,10 +215,10 @@ impl<L: Learner> Run<L> {
                     tried,
                     source: Box::new(newest),
                 },
-                None => RlError::Checkpoint {
+                None => RlError::from(seads_run::RunError::Checkpoint {
                     path: dir.join(CHECKPOINTS).display().to_string(),
                     reason: "the latest checkpoint is missing and no other exists".into(),
-                },
+                }),
             });
         }
         // Evaluations after the checkpoint are redone; a run with no checkpoint starts afresh.

@@ -54,10 +54,10 @@ impl StackedSac {
             .iter()
             .map(|m| m.parts())
             .collect::<Option<Vec<_>>>()
-            .ok_or_else(|| RlError::Config("only Gaussian SAC actors can be stacked".into()))?;
+            .ok_or_else(|| RlError::config("only Gaussian SAC actors can be stacked"))?;
         let first = parts
             .first()
-            .ok_or_else(|| RlError::Config("nothing to stack".into()))?;
+            .ok_or_else(|| RlError::config("nothing to stack"))?;
         let actor_layout = parameter_layout(first.actor_vs);
         let critic_layout = parameter_layout(first.critic_vs);
         for (member, p) in members.iter().zip(&parts) {
@@ -67,10 +67,9 @@ impl StackedSac {
                 || !p.scale.equal(first.scale)
                 || !p.bias.equal(first.bias)
             {
-                return Err(RlError::Config(
+                return Err(RlError::config(
                     "stacked SAC agents must have networks of the same shapes and the same \
-                     action box"
-                        .into(),
+                     action box",
                 ));
             }
         }
@@ -85,7 +84,7 @@ impl StackedSac {
         let actor = StackedAdam::stack(&actor_opts, &actor_layout, device);
         let critic = StackedAdam::stack(&critic_opts, &critic_layout, device);
         let target = StackedParameters::stack(&targets, &critic_layout, device, false);
-        let missing = || RlError::Config("a SAC agent without its networks".into());
+        let missing = || RlError::config("a SAC agent without its networks");
         let mlp = |params: &StackedParameters, name: &str| {
             StackedMlp::new(params, name).ok_or_else(missing)
         };
@@ -146,10 +145,9 @@ impl StackedSac {
                     || w.minibatches.iter().any(|b| b.rewards.len() != rows)
             });
         if uneven {
-            return Err(RlError::Config(
+            return Err(RlError::config(
                 "the members of a stacked population must take as many SAC steps on minibatches \
-                 of as many transitions (sac.updates_per_epoch, sac.batch_size)"
-                    .into(),
+                 of as many transitions (sac.updates_per_epoch, sac.batch_size)",
             ));
         }
         if updates == 0 {

@@ -55,7 +55,7 @@ impl StackedPopulation {
                     ),
                 ] {
                     if x != y {
-                        return Err(RlError::Config(format!(
+                        return Err(RlError::config(format!(
                             "{} cannot train in one stacked population with {}: {field} differs \
                              ({y} against {x})",
                             member.dir().display(),

@@ -232,14 +232,14 @@ impl TaskEpisodes {
         mut observed: impl FnMut(usize, &[f32]),
     ) -> Result<(), RlError> {
         if progress.open.len() != self.envs.len() {
-            return Err(RlError::Checkpoint {
+            return Err(RlError::from(seads_run::RunError::Checkpoint {
                 path: path.display().to_string(),
                 reason: format!(
                     "{} open episodes for {} environments",
                     progress.open.len(),
                     self.envs.len()
                 ),
-            });
+            }));
         }
         let mut obs = vec![0.0; self.spec.obs_dim];
         for (slot, open) in progress.open.iter().enumerate() {

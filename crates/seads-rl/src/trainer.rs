@@ -450,14 +450,14 @@ impl Trainer {
             Ok(text) => text,
             Err(e) if e.kind() == std::io::ErrorKind::NotFound => {
                 if crate::store::keeps_carried_state(dir) {
-                    return Err(RlError::Checkpoint {
+                    return Err(RlError::from(seads_run::RunError::Checkpoint {
                         path: dir.display().to_string(),
                         reason: format!(
                             "{} is missing, though the checkpoint was written with the state its \
                              environments carry (origin.json)",
                             checkpoint::ENVIRONMENT_FILE
                         ),
-                    });
+                    }));
                 }
                 self.carried_missing = self.carried_states().iter().any(Option::is_some);
                 return Ok(());
@@ -468,13 +468,13 @@ impl Trainer {
             serde_json::from_str(&text).map_err(|e| RlError::unreadable(&path, e))?;
         let count = self.envs.len() + 1;
         if states.len() != count {
-            return Err(RlError::Checkpoint {
+            return Err(RlError::from(seads_run::RunError::Checkpoint {
                 path: path.display().to_string(),
                 reason: format!(
                     "it holds {} environment states where the run has {count} environments",
                     states.len()
                 ),
-            });
+            }));
         }
         for (env, state) in self.all_envs().zip(states) {
             if let Some(state) = state {

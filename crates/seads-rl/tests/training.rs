@@ -222,7 +222,7 @@ fn resume_continues_from_the_last_checkpoint() {
     // Creating again in the same directory is refused.
     assert!(matches!(
         Run::<Trainer>::create(&path, common::small(11, 2500)),
-        Err(RlError::Config(m)) if m.contains("already holds a run")
+        Err(RlError::Run(seads_rl::RunError::Config(m))) if m.contains("already holds a run")
     ));
     let mut resumed = Run::<Trainer>::resume(&path).unwrap();
     assert_eq!(

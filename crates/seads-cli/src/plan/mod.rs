@@ -121,9 +121,9 @@ pub fn load_agent(run: &Path, checkpoint: Option<u64>, device: ComputeDevice) ->
     seads_rl::find_checkpoint(run, checkpoint)
         .and_then(|path| Agent::load_checkpoint(config, &path))
         .map_err(|e| match e {
-            seads_rl::RlError::Checkpoint { .. }
-            | seads_rl::RlError::Unreadable { .. }
-            | seads_rl::RlError::Config(_)
+            seads_rl::RlError::Run(seads_run::RunError::Checkpoint { .. })
+            | seads_rl::RlError::Run(seads_run::RunError::Unreadable { .. })
+            | seads_rl::RlError::Run(seads_run::RunError::Config(_))
             | seads_rl::RlError::SkillModel(_) => anyhow::Error::from(BadInput(e.into())),
             other => anyhow::Error::from(other),
         })

@@ -54,9 +54,11 @@ where
         let events = population.step()?;
         for (member, event) in population.members().iter().zip(events) {
             if let Some(metrics) = event.as_ref().and_then(|e| e.metrics.as_ref()) {
-                on_metrics(member, metrics).map_err(|source| RlError::Io {
-                    path: member.dir().display().to_string(),
-                    source,
+                on_metrics(member, metrics).map_err(|source| {
+                    RlError::from(seads_run::RunError::Io {
+                        path: member.dir().display().to_string(),
+                        source,
+                    })
                 })?;
             }
         }
