@@ -11,6 +11,16 @@
 //!
 //! The `seads` command (`seads evaluate`, `seads uarm evaluate`, `seads bench`) is the front end;
 //! this crate never prints.
+//!
+//! ```
+//! use seads_evaluation::over_training::Selection;
+//!
+//! // `seads evaluate --checkpoints 2`: every second kept checkpoint, and always the last.
+//! let kept: Vec<(u64, ())> = [100, 200, 300, 400].map(|epoch| (epoch, ())).to_vec();
+//! let chosen = "2".parse::<Selection>()?.choose(&kept)?;
+//! assert_eq!(chosen.iter().map(|c| c.0).collect::<Vec<_>>(), [100, 300, 400]);
+//! # Ok::<(), String>(())
+//! ```
 
 pub mod bench;
 pub mod evaluation;
