@@ -21,7 +21,11 @@ pub struct TrainArgs {
     /// What to train: `seads`, or a baseline with the task reward: flat SAC (`sac`, SPEC §5.1;
     /// presets `configs/sac-*.toml`) or two-level HAC (`hac`, SPEC §5.2; presets
     /// `configs/hac-*.toml`). Default: the config's, else seads.
-    #[arg(long, value_parser = ["seads", "sac", "hac"], conflicts_with = "resume")]
+    #[arg(
+        long,
+        value_parser = clap::builder::PossibleValuesParser::new(Algorithm::names()),
+        conflicts_with = "resume"
+    )]
     algorithm: Option<String>,
     /// Run directory to create (config.toml, metrics.jsonl, provenance.jsonl, checkpoints/).
     #[arg(long, required_unless_present = "resume")]
@@ -82,13 +86,9 @@ fn config(args: &TrainArgs) -> Result<TrainConfig> {
     Ok(config)
 }
 
-/// The algorithm named on the command line (clap checked the name).
+/// The algorithm named on the command line (clap checked the name), SEADS where none is.
 fn algorithm(name: Option<&str>) -> Algorithm {
-    match name {
-        Some("sac") => Algorithm::Sac,
-        Some("hac") => Algorithm::Hac,
-        _ => Algorithm::Seads,
-    }
+    name.and_then(Algorithm::named).unwrap_or_default()
 }
 
 /// Runs `seads train`.

@@ -128,12 +128,7 @@ impl TrainConfig {
 
     /// The preset of `algorithm` on environment `env`.
     pub fn preset_for(env: &str, algorithm: Algorithm) -> Result<Self, RunError> {
-        let presets = match algorithm {
-            Algorithm::Seads => PRESETS,
-            Algorithm::Sac => SAC_PRESETS,
-            Algorithm::Hac => HAC_PRESETS,
-        };
-        let text = presets
+        let text = Self::presets_of(algorithm)
             .iter()
             .find(|(name, _)| *name == env)
             .map(|(_, text)| *text)
@@ -144,6 +139,15 @@ impl TrainConfig {
                 ))
             })?;
         Self::from_toml(text)
+    }
+
+    /// Every preset of `algorithm`, as `(environment, TOML text)`.
+    pub fn presets_of(algorithm: Algorithm) -> &'static [(&'static str, &'static str)] {
+        match algorithm {
+            Algorithm::Seads => PRESETS,
+            Algorithm::Sac => SAC_PRESETS,
+            Algorithm::Hac => HAC_PRESETS,
+        }
     }
 
     /// Every SEADS preset, as `(environment, TOML text)`.

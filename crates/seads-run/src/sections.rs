@@ -46,6 +46,22 @@ impl Algorithm {
 
     /// Every algorithm.
     pub const ALL: [Algorithm; 3] = [Algorithm::Seads, Algorithm::Sac, Algorithm::Hac];
+
+    /// The algorithm of this name ([`Algorithm::name`]), if there is one.
+    ///
+    /// ```
+    /// use seads_run::Algorithm;
+    /// assert_eq!(Algorithm::named("hac"), Some(Algorithm::Hac));
+    /// assert_eq!(Algorithm::named("diayn"), None);
+    /// ```
+    pub fn named(name: &str) -> Option<Self> {
+        Self::ALL.into_iter().find(|a| a.name() == name)
+    }
+
+    /// The names of every algorithm, for help texts and errors.
+    pub fn names() -> Vec<&'static str> {
+        Self::ALL.into_iter().map(Self::name).collect()
+    }
 }
 
 /// First seed of the skill-coverage evaluation (the paper's 444555 … 444574): SEADS's

@@ -236,7 +236,7 @@ impl Manifest {
     }
 
     /// The preset of `env` with the study's, the variant's and the environment's overrides.
-    /// A layer that sets `algorithm = "sac"` or `"hac"` starts from that baseline's preset.
+    /// A layer that sets `algorithm` (as `"sac"`) starts from that algorithm's preset.
     fn config(&self, env: &str, variant: &Variant, seed: u64) -> Result<TrainConfig> {
         let env_layer = variant.env_overrides.get(env);
         let named = [Some(&self.overrides), Some(&variant.overrides), env_layer]
@@ -244,12 +244,17 @@ impl Manifest {
             .flatten()
             .filter_map(|layer| layer.get("algorithm").and_then(|v| v.as_str()))
             .next_back();
-        let (presets, algorithm) = match named {
-            Some("sac") => (TrainConfig::sac_presets(), Algorithm::Sac),
-            Some("hac") => (TrainConfig::hac_presets(), Algorithm::Hac),
-            _ => (TrainConfig::presets(), Algorithm::Seads),
+        let algorithm = match named {
+            Some(name) => Algorithm::named(name).ok_or_else(|| {
+                failure!(
+                    "variant {:?}: unknown algorithm {name:?} (one of {})",
+                    variant.name,
+                    Algorithm::names().join(", ")
+                )
+            })?,
+            None => Algorithm::Seads,
         };
-        let preset = presets
+        let preset = TrainConfig::presets_of(algorithm)
             .iter()
             .find(|(name, _)| *name == env)
             .map(|(_, text)| *text)
@@ -410,6 +415,13 @@ env_overrides = { "lightsout-cursor" = { num_skills = 30 }, "tileswap-cursor" = 
                     "{ num_skills = 15 }, \"lightsout-reacher\" = {}",
                 ),
                 "does not train",
+            ),
+            (
+                SMALL.replace(
+                    "overrides = { env_steps = 1000 }",
+                    "overrides = { env_steps = 1000, algorithm = \"diayn\" }",
+                ),
+                "unknown algorithm \"diayn\" (one of seads, sac, hac)",
             ),
         ];
         for (text, expected) in cases {
