@@ -9,9 +9,11 @@
 # 1. installs libtorch (scripts/setup.sh) and freezes the studies' binaries from their clean
 #    commits (scripts/freeze.sh; ~10 minutes for the first, less for each other);
 # 2. lays out each study's sweep under $SEADS_SWEEPS (default /root/seads-sweeps): `seads sweep
-#    plan` of the manifest the committed sweep was planned from (the study's manifest at its
-#    commit where none is committed yet) by the study's frozen binary, then the runs committed
-#    under docs/results/ laid over it (a finished run's files as they were; the others train);
+#    plan` of the manifest the committed sweep was planned from, as it was at $LAYOUT (the study's
+#    manifest at its commit where none was committed then) by the study's frozen binary, then the
+#    runs committed under docs/results/ laid over it (a finished run's files as they are, but its
+#    config.toml, which stays the one the frozen binary planned: the committed one is in today's
+#    layout, which the frozen binaries do not read; the others train);
 # 3. writes the chains into $SEADS_SWEEPS (atomically: a running chain keeps its own copy) and
 #    starts each that is not running, detached (setsid, nohup): two cores, one chain each, the
 #    second running its studies one after another.
@@ -44,6 +46,9 @@ STUDIES=(
   "board-size 948442b 948442b experiments/board-size.toml docs/results/board-size-948442b/runs/board-size"
   "arms-jaco 73dac45 73dac45 experiments/arms-jaco.toml docs/results/arms-jaco/runs/arms-jaco"
 )
+# The last commit whose committed manifests and run configurations were in the layout the frozen
+# binaries read: `seads migrate` rewrote them in the next.
+LAYOUT=951086a
 # The binaries the studies run, frozen from these clean commits (a58a2c4 evaluates the Reacher
 # runs); a chain runs no other.
 FROZEN=(90d8a6b a58a2c4 a634bb8 948442b 73dac45)
@@ -73,15 +78,14 @@ prepare() {
     rm -rf "$sweep.new"
     # Planned from the manifest the committed sweep was planned from (for a sweep not committed
     # yet, the study's manifest as it was at its commit), then the committed runs laid over it.
-    if [[ -f $root/$committed/manifest.toml ]]; then
-      cp "$root/$committed/manifest.toml" "$SEADS_SWEEPS/$name.manifest.toml"
-    else
+    if ! git -C "$root" show "$LAYOUT:$committed/manifest.toml" \
+      > "$SEADS_SWEEPS/$name.manifest.toml" 2> /dev/null; then
       git -C "$root" show "$at:$manifest" > "$SEADS_SWEEPS/$name.manifest.toml"
     fi
     "$SEADS_FROZEN/$binary/bin/seads" sweep plan "$SEADS_SWEEPS/$name.manifest.toml" \
       --out "$sweep.new" > /dev/null
     if [[ -d $root/$committed/runs ]]; then
-      cp -a "$root/$committed/runs/." "$sweep.new/runs/"
+      tar -C "$root/$committed/runs" --exclude=config.toml -cf - . | tar -C "$sweep.new/runs" -xf -
     fi
     mv "$sweep.new" "$sweep"
   done

@@ -17,6 +17,7 @@ mod envs;
 mod episodes;
 mod games;
 mod kernels;
+mod migrate;
 mod numbers;
 mod paths;
 
@@ -87,6 +88,9 @@ enum Command {
     Replay(episodes::ReplayArgs),
     /// Tables, Mann–Whitney tests and figures over sweeps and runs (the paper's Table 1 and more).
     Report(report::ReportArgs),
+    /// Rewrite runs' configurations, study manifests and evaluation files of older versions'
+    /// layouts into today's (once: every other command reads today's layout only).
+    Migrate(migrate::MigrateArgs),
     /// Studies over seeds and variants: plan from a manifest, run here or on Slurm, status.
     #[command(subcommand)]
     Sweep(sweep::SweepCommand),
@@ -334,6 +338,7 @@ fn main() -> ExitCode {
         Command::Replay(args) => episodes::replay(args),
         Command::Sweep(cmd) => sweep::run(cmd),
         Command::Report(args) => report::report(args),
+        Command::Migrate(args) => migrate::migrate(args),
         Command::Uarm(uarm::UarmCommand::Calibrate(args)) => uarm::calibrate(args),
         Command::Uarm(uarm::UarmCommand::Train(args)) => uarm::train(args),
         Command::Uarm(uarm::UarmCommand::Evaluate(args)) => uarm::evaluate_run(args),

@@ -69,9 +69,6 @@ fn config(args: &TrainArgs) -> Result<TrainConfig> {
             .map_err(|e| BadInput(e.into()))?,
         (None, None) => unreachable!("clap requires --env or --config"),
     };
-    if let Some(name) = &args.algorithm {
-        config.algorithm = algorithm(Some(name));
-    }
     if let Some(seed) = args.seed {
         config.seed = seed;
     }
@@ -111,7 +108,7 @@ pub fn train(args: TrainArgs) -> Result<()> {
             let config = crate::run_config(dir)?;
             crate::kernels::use_kernels(config.portable_numerics)?;
             seads_rl::with_learner(
-                config.algorithm,
+                config.algorithm(),
                 Resume {
                     dir,
                     device,
@@ -124,7 +121,7 @@ pub fn train(args: TrainArgs) -> Result<()> {
             crate::kernels::use_kernels(config.portable_numerics)?;
             let out = args.out.as_ref().expect("clap requires --out");
             seads_rl::with_learner(
-                config.algorithm,
+                config.algorithm(),
                 Create {
                     out,
                     config,

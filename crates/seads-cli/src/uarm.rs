@@ -360,15 +360,17 @@ fn robot_config(env: &UarmEnv, args: &UarmTrainArgs) -> Result<TrainConfig> {
     config.env_steps = args.env_steps.unwrap_or(DEFAULT_ENV_STEPS);
     config.seed = args.seed;
     config.sac.alpha = 0.1;
-    if args.action_space == ActionSpace::Absolute {
-        config.seads.episodes_per_epoch = 4;
-    }
     let training = &args.training;
-    if let Some(n) = training.updates_per_epoch {
-        config.sac.updates_per_epoch = n as usize;
-    }
-    if let Some(n) = training.episodes_per_epoch {
-        config.seads.episodes_per_epoch = n as usize;
+    if let Some(seads) = config.seads_mut() {
+        if args.action_space == ActionSpace::Absolute {
+            seads.episodes_per_epoch = 4;
+        }
+        if let Some(n) = training.updates_per_epoch {
+            seads.updates_per_epoch = n as usize;
+        }
+        if let Some(n) = training.episodes_per_epoch {
+            seads.episodes_per_epoch = n as usize;
+        }
     }
     if let Some(alpha) = training.alpha {
         config.sac.alpha = alpha;

@@ -14,7 +14,7 @@ use crate::EnvError;
 /// manipulator's options type reads when the environment is built
 /// ([`EnvConfig::manipulator_options`]).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-#[serde(try_from = "Stated")]
+#[serde(deny_unknown_fields, default)]
 pub struct EnvConfig {
     /// Board side length; only `lightsout-cursor` accepts sizes other than the game's default
     /// (odd, 5 to 13, as spaced boards).
@@ -110,93 +110,6 @@ impl EnvConfig {
 #[serde(deny_unknown_fields)]
 pub struct NoOptions {}
 
-/// What a configuration states, in the current layout or in the older one that kept the Jaco's
-/// `physics_substeps` beside the board options (committed Jaco runs' files); read into
-/// [`EnvConfig`], which writes the current layout only. A key left out takes
-/// [`EnvConfig::default`]'s value; an unknown key is an error that lists the current layout's
-/// keys only.
-#[derive(Deserialize)]
-struct Stated {
-    #[serde(default)]
-    board_size: Option<usize>,
-    #[serde(default)]
-    spacing: Option<f64>,
-    #[serde(default = "train")]
-    reset_split: Split,
-    #[serde(default = "max_solution_depth")]
-    max_solution_depth: usize,
-    #[serde(default = "random_solution_depth")]
-    random_solution_depth: bool,
-    #[serde(default)]
-    step_limit: Option<usize>,
-    #[serde(default)]
-    manipulator: serde_json::Map<String, serde_json::Value>,
-    /// Every other key: the older layout's `physics_substeps`, or a mistake.
-    #[serde(flatten)]
-    other: serde_json::Map<String, serde_json::Value>,
-}
-
-/// Keys that the older layout kept beside the board options and the current one keeps in
-/// `manipulator` (the Jaco's `physics_substeps`, in committed Jaco runs' files): such a file
-/// still loads, the key moved into `manipulator`.
-pub const MOVED_TO_MANIPULATOR: [&str; 1] = ["physics_substeps"];
-
-/// The keys of the current layout, as an unknown key's error lists them.
-const KEYS: [&str; 7] = [
-    "board_size",
-    "spacing",
-    "reset_split",
-    "max_solution_depth",
-    "random_solution_depth",
-    "step_limit",
-    "manipulator",
-];
-
-fn train() -> Split {
-    EnvConfig::default().reset_split
-}
-
-fn max_solution_depth() -> usize {
-    EnvConfig::default().max_solution_depth
-}
-
-fn random_solution_depth() -> bool {
-    EnvConfig::default().random_solution_depth
-}
-
-impl TryFrom<Stated> for EnvConfig {
-    type Error = String;
-
-    fn try_from(stated: Stated) -> Result<Self, String> {
-        let mut manipulator = stated.manipulator;
-        for (key, value) in stated.other {
-            if !MOVED_TO_MANIPULATOR.contains(&key.as_str()) {
-                let expected: Vec<String> = KEYS.iter().map(|k| format!("`{k}`")).collect();
-                return Err(format!(
-                    "unknown field `{key}`, expected one of {}",
-                    expected.join(", ")
-                ));
-            }
-            if manipulator.contains_key(&key) {
-                return Err(format!(
-                    "{key} is given twice: beside the board options (the older layout) and in \
-                     `manipulator`; keep the one in `manipulator`"
-                ));
-            }
-            manipulator.insert(key, value);
-        }
-        Ok(Self {
-            board_size: stated.board_size,
-            spacing: stated.spacing,
-            reset_split: stated.reset_split,
-            max_solution_depth: stated.max_solution_depth,
-            random_solution_depth: stated.random_solution_depth,
-            step_limit: stated.step_limit,
-            manipulator,
-        })
-    }
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -221,18 +134,10 @@ mod tests {
     }
 
     #[test]
-    fn the_older_layouts_key_moves_into_the_manipulators_options() {
-        let old = parse("physics_substeps = 25").unwrap();
-        let new = parse("[manipulator]\nphysics_substeps = 25").unwrap();
-        assert_eq!(old, new);
-        let twice = parse("physics_substeps = 25\n[manipulator]\nphysics_substeps = 10");
-        let err = twice.unwrap_err().to_string();
-        assert!(err.contains("given twice"), "{err}");
-        let unknown = parse("substeps = 25").unwrap_err().to_string();
-        assert!(unknown.contains("unknown field `substeps`"), "{unknown}");
-        // The older layout's key is read, not offered.
-        assert!(unknown.contains("`manipulator`"), "{unknown}");
-        assert!(!unknown.contains("physics_substeps"), "{unknown}");
+    fn a_manipulators_option_beside_the_board_options_is_an_unknown_field() {
+        let err = parse("physics_substeps = 25").unwrap_err().to_string();
+        assert!(err.contains("unknown field `physics_substeps`"), "{err}");
+        assert!(err.contains("`manipulator`"), "{err}");
     }
 
     #[test]
@@ -248,7 +153,15 @@ mod tests {
         let written: toml::Table = toml::from_str(&toml::to_string(&full).unwrap()).unwrap();
         let mut keys: Vec<&str> = written.keys().map(String::as_str).collect();
         keys.sort_unstable();
-        let mut listed = KEYS.to_vec();
+        let mut listed = vec![
+            "board_size",
+            "spacing",
+            "reset_split",
+            "max_solution_depth",
+            "random_solution_depth",
+            "step_limit",
+            "manipulator",
+        ];
         listed.sort_unstable();
         assert_eq!(keys, listed);
     }

@@ -66,7 +66,7 @@ mod task;
 mod wrapper;
 
 pub use board::BoardState;
-pub use config::{EnvConfig, MOVED_TO_MANIPULATOR, NoOptions};
+pub use config::{EnvConfig, NoOptions};
 pub use cursor::Cursor;
 pub use embodied::{Embodied, Environment, Manipulator, Touch};
 pub use error::EnvError;

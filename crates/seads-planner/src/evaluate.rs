@@ -329,9 +329,9 @@ pub struct Evaluator {
 #[derive(Debug, Clone, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct EvaluationRecord {
-    /// The checkpoint (`None` in files written before evaluations recorded it).
+    /// The checkpoint (`None` in files of versions that did not record it).
     pub checkpoint: Option<CheckpointId>,
-    /// The protocol (`None` in files written before evaluations recorded it).
+    /// The protocol (`None` in files of versions that did not record it).
     pub protocol: Option<Protocol>,
     /// The binaries that solved its tasks, in the order they began (more than one where a
     /// stopped evaluation was resumed by another); empty in files written before evaluations
@@ -342,27 +342,11 @@ pub struct EvaluationRecord {
     pub results: Vec<DepthResult>,
 }
 
-/// The two shapes of an evaluation file: today's record, and the bare list of per-depth
-/// results that files had before they recorded their checkpoint and protocol.
-#[derive(Deserialize)]
-#[serde(untagged)]
-enum Stored {
-    Record(EvaluationRecord),
-    Bare(Vec<DepthResult>),
-}
-
 impl EvaluationRecord {
-    /// Parses an evaluation file of either shape.
+    /// Parses an evaluation file (today's shape only: `seads migrate` rewrites the bare lists of
+    /// per-depth results that older versions wrote).
     pub fn from_json(text: &str) -> Result<Self, serde_json::Error> {
-        Ok(match serde_json::from_str(text)? {
-            Stored::Record(record) => record,
-            Stored::Bare(results) => Self {
-                checkpoint: None,
-                protocol: None,
-                evaluated_by: Vec::new(),
-                results,
-            },
-        })
+        serde_json::from_str(text)
     }
 
     /// The file's text (pretty JSON).
@@ -435,11 +419,9 @@ mod tests {
             ..record.protocol.clone().unwrap()
         };
         assert!(!back.made_with(&other));
+        // The older bare list is read no more.
         let old = serde_json::to_string(&vec![DepthResult::new(2)]).unwrap();
-        let old = EvaluationRecord::from_json(&old).unwrap();
-        assert_eq!((old.checkpoint, old.protocol), (None, None));
-        assert!(old.evaluated_by.is_empty());
-        assert_eq!(old.results[0].depth, 2);
+        assert!(EvaluationRecord::from_json(&old).is_err());
         assert!(EvaluationRecord::from_json("{\"results\": 3}").is_err());
     }
 }

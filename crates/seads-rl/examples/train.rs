@@ -16,12 +16,11 @@ fn run(steps: u64, dir: &Path) -> Result<f64, RlError> {
     let mut config = TrainConfig::preset("lightsout-cursor")?;
     config.env_steps = steps;
     config.sac.hidden = vec![64, 64];
-    config.seads.skill_model.hidden = vec![64, 64];
-    (
-        config.eval_every,
-        config.checkpoint_every,
-        config.seads.eval_seeds,
-    ) = (10, 10, 4);
+    (config.eval_every, config.checkpoint_every) = (10, 10);
+    if let Some(seads) = config.seads_mut() {
+        seads.skill_model.hidden = vec![64, 64];
+        seads.eval_seeds = 4;
+    }
     let mut run = Run::<Trainer>::create(dir, config)?;
     while !run.finished() {
         let event = run.step()?;

@@ -125,7 +125,8 @@ impl Agent {
         // network size) would evaluate another agent than the one trained, so it is refused as
         // a resume refuses it.
         crate::store::check_config(checkpoint, &config)?;
-        let k = config.seads.num_skills.unwrap_or(spec.num_skills);
+        let seads = config.seads_section()?;
+        let k = seads.num_skills.unwrap_or(spec.num_skills);
         let device = config.device.resolve()?;
         let mut sac = Sac::new(
             spec.obs_dim + k,
@@ -136,10 +137,10 @@ impl Agent {
             0,
         );
         sac.load(checkpoint, true)?;
-        let model = match config.seads.skill_model.kind {
+        let model = match seads.skill_model.kind {
             SkillModelKind::Forward => {
                 let mut model =
-                    ForwardModel::new(spec.symbolic_len, k, &config.seads.skill_model, device, 0);
+                    ForwardModel::new(spec.symbolic_len, k, &seads.skill_model, device, 0);
                 model.load(checkpoint, false)?;
                 Some(model)
             }
@@ -186,7 +187,7 @@ pub fn load_policy(
     crate::store::check_origin(checkpoint, config)?;
     let spec = make_env(&config.env, &config.env_config)?.spec().clone();
     crate::with_learner(
-        config.algorithm,
+        config.algorithm(),
         LoadPolicy {
             config,
             spec: &spec,

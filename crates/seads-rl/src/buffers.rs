@@ -11,12 +11,14 @@ use seads_games::SymbolicState;
 use seads_skillmodel::{SkillModel, SkillTransition, episode_rewards, minimum_reward, relabel};
 
 use crate::episode::policy_input;
-use crate::{Episode, TrainConfig, TransitionBatch};
+use crate::{Episode, SeadsConfig, TrainConfig, TransitionBatch};
 
 /// The episode buffers with what an update needs to draw from them: the long-term buffer is the
 /// last `buffer_capacity` episodes, the short-term list its last `recent_episodes`.
 pub(crate) struct Buffers<'a> {
     pub(crate) config: &'a TrainConfig,
+    /// The run's SEADS section (of `config`).
+    pub(crate) seads: &'a SeadsConfig,
     pub(crate) k: usize,
     pub(crate) episodes: &'a mut VecDeque<Episode>,
     pub(crate) rng: &'a mut ChaCha8Rng,
@@ -55,13 +57,13 @@ pub type RelabelObserver = dyn FnMut(&Relabelling<'_>) + Send;
 impl Buffers<'_> {
     /// Updates start once the buffer holds `sampled_episodes` episodes.
     pub(crate) fn ready(&self) -> bool {
-        self.episodes.len() >= self.config.seads.sampled_episodes
+        self.episodes.len() >= self.seads.sampled_episodes
     }
 
     /// Appends new episodes, dropping the oldest beyond the capacity.
     pub(crate) fn push(&mut self, new: Vec<Episode>) {
         for episode in new {
-            if self.episodes.len() == self.config.seads.buffer_capacity {
+            if self.episodes.len() == self.seads.buffer_capacity {
                 self.episodes.pop_front();
             }
             self.episodes.push_back(episode);
@@ -72,14 +74,14 @@ impl Buffers<'_> {
     /// buffer (all of it if it holds exactly that many), followed by the recent episodes.
     fn update_batch(&mut self) -> Vec<usize> {
         let n = self.episodes.len();
-        let mut batch: Vec<usize> = if n == self.config.seads.sampled_episodes {
+        let mut batch: Vec<usize> = if n == self.seads.sampled_episodes {
             (0..n).collect()
         } else {
-            (0..self.config.seads.sampled_episodes)
+            (0..self.seads.sampled_episodes)
                 .map(|_| self.rng.random_range(0..n))
                 .collect()
         };
-        batch.extend(n.saturating_sub(self.config.seads.recent_episodes)..n);
+        batch.extend(n.saturating_sub(self.seads.recent_episodes)..n);
         batch
     }
 
@@ -94,7 +96,7 @@ impl Buffers<'_> {
         let mut clipped = Vec::with_capacity(scores.len());
         let mut rewards = Vec::with_capacity(scores.len());
         for row in scores.chunks(self.k) {
-            let (c, r) = episode_rewards(row, likelihoods, &self.config.seads.reward);
+            let (c, r) = episode_rewards(row, likelihoods, &self.seads.reward);
             clipped.extend(c);
             rewards.extend(r);
         }
@@ -125,12 +127,7 @@ impl Buffers<'_> {
             .flat_map(|&e| clipped[e * k..(e + 1) * k].iter().copied())
             .collect();
         let chosen_labels: Vec<usize> = chosen.iter().map(|&e| labels[eligible[e]]).collect();
-        let new = relabel(
-            self.config.seads.relabel.kind,
-            &chosen_clipped,
-            k,
-            &chosen_labels,
-        );
+        let new = relabel(self.seads.relabel.kind, &chosen_clipped, k, &chosen_labels);
         if let Some(observer) = self.observer.as_mut() {
             observer(&Relabelling {
                 batch: which,
@@ -151,7 +148,7 @@ impl Buffers<'_> {
     pub(crate) fn skill_model_batch(&mut self, model: &dyn SkillModel) -> Vec<SkillTransition> {
         let batch = self.update_batch();
         let eligible: Vec<usize> = (0..batch.len()).collect();
-        let (clipped, _) = if self.config.seads.relabel.skill_model_p > 0.0 {
+        let (clipped, _) = if self.seads.relabel.skill_model_p > 0.0 {
             self.score(model, &batch)
         } else {
             Default::default()
@@ -161,7 +158,7 @@ impl Buffers<'_> {
             &batch,
             &eligible,
             &clipped,
-            self.config.seads.relabel.skill_model_p,
+            self.seads.relabel.skill_model_p,
         );
         batch
             .iter()
@@ -183,7 +180,7 @@ impl Buffers<'_> {
         model: &dyn SkillModel,
         spec: &EnvSpec,
     ) -> (Vec<TransitionBatch>, f32) {
-        let config = self.config;
+        let (config, seads) = (self.config, self.seads);
         let batch = self.update_batch();
         // Only board-changing episodes need scores: the others get the minimum reward and are
         // never relabelled.
@@ -197,7 +194,7 @@ impl Buffers<'_> {
             &batch,
             &eligible,
             &clipped,
-            config.seads.relabel.sac_p,
+            seads.relabel.sac_p,
         );
         let mut finals = vec![minimum_reward(self.k); batch.len()];
         for (e, &j) in eligible.iter().enumerate() {
@@ -209,7 +206,7 @@ impl Buffers<'_> {
             .enumerate()
             .flat_map(|(j, &i)| (0..self.episodes[i].len(a)).map(move |t| (j, t)))
             .collect();
-        let minibatches = (0..config.sac.updates_per_epoch)
+        let minibatches = (0..seads.updates_per_epoch)
             .map(|_| {
                 let picks: Vec<(usize, usize)> = (0..config.sac.batch_size)
                     .map(|_| transitions[self.rng.random_range(0..transitions.len())])
@@ -325,10 +322,11 @@ mod tests {
 
     fn config(sampled: usize, recent: usize, capacity: usize) -> TrainConfig {
         let mut config = TrainConfig::default();
-        config.seads.sampled_episodes = sampled;
-        config.seads.recent_episodes = recent;
-        config.seads.buffer_capacity = capacity;
-        config.seads.relabel.sac_p = 1.0;
+        let seads = config.seads_mut().unwrap();
+        seads.sampled_episodes = sampled;
+        seads.recent_episodes = recent;
+        seads.buffer_capacity = capacity;
+        seads.relabel.sac_p = 1.0;
         config
     }
 
@@ -340,6 +338,7 @@ mod tests {
     ) -> Buffers<'a> {
         Buffers {
             config,
+            seads: config.seads().unwrap(),
             k: 2,
             episodes,
             rng,
@@ -405,7 +404,7 @@ mod tests {
     fn only_board_changing_episodes_are_scored_and_relabelled() {
         let mut config = config(2, 1, 8);
         config.sac.batch_size = 64;
-        config.sac.updates_per_epoch = 1;
+        config.seads_mut().unwrap().updates_per_epoch = 1;
         let mut episodes: VecDeque<Episode> =
             [episode(0, 2, 10.0, Some(0)), episode(1, 1, 20.0, None)].into();
         let mut rng = ChaCha8Rng::seed_from_u64(0);

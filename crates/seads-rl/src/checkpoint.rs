@@ -30,7 +30,7 @@ pub fn resume_only_files() -> Vec<&'static str> {
 
 /// Writes the episodes as a table: one row per episode in `lengths`, `skills`, `moves` (−1: no
 /// move), `z0` and `zt` (the symbolic states' 64-bit words, [`SymbolicState::WORDS`] a row;
-/// tables of three-word states, written before states grew to 256 bits, still load), and the steps of all
+/// `seads migrate` widens the three-word tables of older versions), and the steps of all
 /// episodes concatenated in `obs` (T + 1 rows each) and `actions` (T rows each).
 pub fn save_episodes(
     path: &Path,
@@ -85,14 +85,8 @@ pub fn load_episodes(
     );
     let (z0, zt) = (file.ints("z0")?, file.ints("zt")?);
     let n = lengths.len();
-    // Rows of three words were written before states grew to four.
-    let width = z0.len().checked_div(n).unwrap_or(SymbolicState::WORDS);
-    if skills.len() != n
-        || moves.len() != n
-        || !(width == 3 || width == SymbolicState::WORDS)
-        || z0.len() != width * n
-        || zt.len() != width * n
-    {
+    let width = SymbolicState::WORDS;
+    if skills.len() != n || moves.len() != n || z0.len() != width * n || zt.len() != width * n {
         return Err(mismatch());
     }
     let state = |words: &[i64], i: usize| {
@@ -273,10 +267,11 @@ impl Prepared {
 mod tests {
     use super::*;
 
-    /// Episode tables written before symbolic states grew from three words to four (every
-    /// checkpoint of the committed studies' runs) load to the same episodes.
+    /// Episode tables read back as written; a table whose states have three words (as before
+    /// symbolic states grew to four; `seads migrate` widens them) or any other number but four
+    /// is refused.
     #[test]
-    fn episode_tables_of_three_word_states_still_load() {
+    fn episode_tables_read_back_and_other_widths_are_refused() {
         let mut z = SymbolicState::ZERO;
         for bit in [0, 70, 150, 191] {
             z.set(bit, true);
@@ -304,7 +299,7 @@ mod tests {
         let now = dir.path().join("now.safetensors");
         save_episodes(&now, &episodes, 3).unwrap();
         assert_eq!(load_episodes(&now, 4, 3, 3).unwrap(), episodes);
-        // The same table with three words a state, as the older code wrote it.
+        // The same table with three words a state, as older versions wrote it.
         let old = dir.path().join("old.safetensors");
         let tensors: Vec<(String, Tensor)> = Tensor::read_safetensors(&now)
             .unwrap()
@@ -319,8 +314,7 @@ mod tests {
             })
             .collect();
         Tensor::write_safetensors(&tensors, &old).unwrap();
-        assert_eq!(load_episodes(&old, 4, 3, 3).unwrap(), episodes);
-        // A table of any other width is refused.
+        assert!(load_episodes(&old, 4, 3, 3).is_err());
         let short = dir.path().join("short.safetensors");
         let tensors: Vec<(String, Tensor)> = tensors
             .into_iter()

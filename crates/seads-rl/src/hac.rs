@@ -80,7 +80,8 @@ use crate::task_episodes::{
 };
 use crate::task_policy::TaskPolicy;
 use crate::{
-    Moment, Purpose, RlError, Sac, SacConfig, TaskMetrics, TrainConfig, derived_seed, task_success,
+    HacConfig, Moment, Purpose, RlError, Sac, SacConfig, TaskMetrics, TrainConfig, derived_seed,
+    task_success,
 };
 
 /// File prefix of the high level's networks in a checkpoint ([`crate::sac::checkpoint_files`]).
@@ -202,6 +203,8 @@ impl From<&Progress> for ProgressFile {
 /// A two-level HAC agent in training on the task reward.
 pub struct Hac {
     config: TrainConfig,
+    /// The configuration's HAC section.
+    hac: HacConfig,
     spec: EnvSpec,
     episodes: TaskEpisodes,
     /// Every observation of each environment's open episode, row-major (steps + 1 rows).
@@ -240,18 +243,29 @@ fn game_goal(spec: &EnvSpec) -> Result<SymbolicState, RlError> {
     Ok(game.goal())
 }
 
+/// The run's HAC section: another algorithm's configuration is an error.
+fn hac_section(config: &TrainConfig) -> Result<&HacConfig, RlError> {
+    config.learner.hac().ok_or_else(|| {
+        RlError::config(format!(
+            "a {} run has no [hac] section: it is no HAC run",
+            config.algorithm().name()
+        ))
+    })
+}
+
 /// The two levels' networks for `config` on an environment of `spec`.
 fn levels(config: &TrainConfig, spec: &EnvSpec) -> Result<(Sac, Sac), RlError> {
+    let hac = hac_section(config)?;
     let device = config.device.resolve()?;
     let d = spec.symbolic_len;
     let high_config = SacConfig {
-        alpha: config.hac.alpha_high,
+        alpha: hac.alpha_high,
         ..config.sac.clone()
     };
     let high = Sac::relaxed_bernoulli(
         spec.obs_dim + d,
         d,
-        config.hac.temperature,
+        hac.temperature,
         &high_config,
         device,
         derived_seed(config.seed, Purpose::SacInit, 1),
@@ -268,14 +282,15 @@ fn levels(config: &TrainConfig, spec: &EnvSpec) -> Result<(Sac, Sac), RlError> {
 }
 
 impl Hac {
-    /// A fresh agent for `config` (validated; `config.algorithm` is not checked here).
+    /// A fresh agent for `config` (validated; `config.algorithm()` is not checked here).
     pub fn new(config: TrainConfig) -> Result<Self, RlError> {
         let (episodes, shared) = TaskEpisodes::new(&config)?;
         let spec = episodes.spec().clone();
         let (high, low) = levels(&config, &spec)?;
         let d = spec.symbolic_len;
         let goal = game_goal(&spec)?;
-        let capacity = config.hac.replay_capacity;
+        let hac = hac_section(&config)?.clone();
+        let capacity = hac.replay_capacity;
         let n = episodes.len();
         let progress = Progress {
             shared,
@@ -292,6 +307,7 @@ impl Hac {
             scratch: [Vec::new(), Vec::new()],
             low_replay: Replay::new(capacity, spec.obs_dim + d, spec.action_dim),
             config,
+            hac,
             spec,
             episodes,
             high,
@@ -358,7 +374,7 @@ impl Hac {
             &self.low,
             &self.spec,
             self.goal,
-            self.config.hac.subgoal_horizon,
+            self.hac.subgoal_horizon,
         )
     }
 
@@ -376,7 +392,7 @@ impl Hac {
         );
         let streams = &mut self.progress.shared.streams;
         let action = self.high.act(&input, Some(&mut streams.collect));
-        let testing = streams.collect.random::<f64>() < self.config.hac.subgoal_test_p;
+        let testing = streams.collect.random::<f64>() < self.hac.subgoal_test_p;
         self.progress.subgoals[slot] = Some(Attempt {
             subgoal: threshold(&action),
             testing,
@@ -440,8 +456,7 @@ impl Hac {
                 reward: attempt.reward + step.reward,
                 ..attempt
             };
-            let over =
-                reached || steps - attempt.start >= self.config.hac.subgoal_horizon || step.done;
+            let over = reached || steps - attempt.start >= self.hac.subgoal_horizon || step.done;
             if over {
                 self.end_attempt(slot, &attempt, reached, step.done);
             } else {
@@ -455,10 +470,7 @@ impl Hac {
         self.progress.shared.collected(self.episodes.len(), start);
 
         let start = Instant::now();
-        let due = updates_due(
-            self.progress.shared.epoch,
-            self.config.hac.updates_per_epoch,
-        );
+        let due = updates_due(self.progress.shared.epoch, self.hac.updates_per_epoch);
         let batch_size = self.config.sac.batch_size;
         let mut losses = LossMean::default();
         for _ in 0..due {
@@ -697,7 +709,7 @@ impl HacPolicy<'static> {
         Ok(Self {
             levels: Levels::Owned(Box::new((high, low))),
             symbolic: SymbolicSlice::of(spec, game_goal(spec)?),
-            horizon: config.hac.subgoal_horizon,
+            horizon: hac_section(config)?.subgoal_horizon,
             subgoal: None,
             input: Vec::new(),
         })
@@ -756,7 +768,7 @@ impl Learner for Hac {
         Ok(stats)
     }
     fn metrics(&mut self, stats: &TaskEpochStats, wall_s: f64) -> Result<TaskMetrics, RlError> {
-        let results = self.task_success(self.config.hac.eval_boards)?;
+        let results = self.task_success(self.hac.eval_boards)?;
         let p = &mut self.progress;
         let mut line = crate::task_sac::task_metrics(&results, &p.shared, wall_s, stats);
         let (attempts, reached) = (p.attempts - p.reported.0, p.reached - p.reported.1);
@@ -805,8 +817,10 @@ mod tests {
             TrainConfig::preset_for("lightsout-cursor", crate::Algorithm::Hac).unwrap();
         config.sac.hidden = vec![16];
         config.sac.batch_size = 16;
-        config.hac.subgoal_horizon = 4;
-        config.hac.subgoal_test_p = test_p;
+        let crate::LearnerConfig::Hac { hac } = &mut config.learner else {
+            unreachable!("HAC's preset")
+        };
+        (hac.subgoal_horizon, hac.subgoal_test_p) = (4, test_p);
         config.portable_numerics = true;
         config
     }

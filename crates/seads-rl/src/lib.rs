@@ -18,9 +18,10 @@
 //! // The paper's LightsOutCursor settings, shrunk so that the example runs in seconds.
 //! let mut config = TrainConfig::preset("lightsout-cursor")?;
 //! config.sac.hidden = vec![32, 32];
-//! config.seads.skill_model.hidden = vec![32, 32];
-//! (config.seads.sampled_episodes, config.seads.recent_episodes) = (32, 16);
-//! config.seads.eval_seeds = 2;
+//! let seads = config.seads_mut().expect("SEADS's preset has a [seads] section");
+//! seads.skill_model.hidden = vec![32, 32];
+//! (seads.sampled_episodes, seads.recent_episodes) = (32, 16);
+//! seads.eval_seeds = 2;
 //! let mut trainer = Trainer::new(config)?;
 //! for _ in 0..3 {
 //!     let stats = trainer.run_epoch()?; // collect 32 episodes, relabel, update the model and SAC
@@ -81,10 +82,10 @@ pub use trainer::{COVERAGE_SEED, EpochStats, Trainer};
 // A run's data (configuration, directory, metrics lines) is `seads-run`'s, re-exported here for
 // the learners and their users.
 pub use seads_run::{
-    Algorithm, BaselineConfig, ComputeDevice, DeviceError, HacConfig, Metrics, PopulationKey,
-    RelabelConfig, RunError, SacConfig, SeadsConfig, TaskMetrics, TaskTimings, Timings,
-    TrainConfig, check_population, load_config, machine_memory_bytes, merge_toml, raise_budget,
-    read_metrics, store, upgrade_flat_layout,
+    Algorithm, BaselineConfig, ComputeDevice, DeviceError, HacConfig, LearnerConfig, Metrics,
+    PopulationKey, RelabelConfig, RunError, SacConfig, SeadsConfig, TaskMetrics, TaskTimings,
+    Timings, TrainConfig, check_population, load_config, machine_memory_bytes, merge_toml,
+    raise_budget, read_metrics, store,
 };
 
 /// Sets the number of libtorch intra-op threads of the process.

@@ -147,7 +147,7 @@ impl StackedSac {
         if uneven {
             return Err(RlError::config(
                 "the members of a stacked population must take as many SAC steps on minibatches \
-                 of as many transitions (sac.updates_per_epoch, sac.batch_size)",
+                 of as many transitions (seads.updates_per_epoch, sac.batch_size)",
             ));
         }
         if updates == 0 {
@@ -291,7 +291,6 @@ mod tests {
                 gamma: [0.99, 0.9, 0.95][k],
                 tau: [0.005, 0.05, 0.5][k],
                 batch_size: 8,
-                updates_per_epoch: 3,
             })
             .collect();
         let agents = |device| -> Vec<Sac> {

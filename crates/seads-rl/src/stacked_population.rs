@@ -33,7 +33,7 @@ pub struct StackedPopulation {
 
 impl StackedPopulation {
     /// A population of `members` (checked with [`check_population`](crate::check_population),
-    /// and sharing `sac.batch_size` and `sac.updates_per_epoch`, the shapes of a stacked step)
+    /// and sharing `sac.batch_size` and `seads.updates_per_epoch`, the shapes of a stacked step)
     /// whose CPU work runs on up to `threads` threads and whose SAC agents are stacked on
     /// `device`. The members' own agents should be on the CPU, where they collect.
     pub fn new(
@@ -43,16 +43,18 @@ impl StackedPopulation {
     ) -> Result<Self, RlError> {
         check_members(&members)?;
         if let Some((first, rest)) = members.split_first() {
-            let a = &first.trainer().config().sac;
+            // SAC's minibatch size and SEADS's SAC steps per epoch.
+            let shape = |run: &Run<Trainer>| {
+                let config = run.trainer().config();
+                let steps = config.seads().map_or(0, |s| s.updates_per_epoch);
+                (config.sac.batch_size, steps)
+            };
+            let a = shape(first);
             for member in rest {
-                let b = &member.trainer().config().sac;
+                let b = shape(member);
                 for (field, x, y) in [
-                    ("sac.batch_size", a.batch_size, b.batch_size),
-                    (
-                        "sac.updates_per_epoch",
-                        a.updates_per_epoch,
-                        b.updates_per_epoch,
-                    ),
+                    ("sac.batch_size", a.0, b.0),
+                    ("seads.updates_per_epoch", a.1, b.1),
                 ] {
                     if x != y {
                         return Err(RlError::config(format!(

@@ -155,7 +155,7 @@ impl TaskEpisodes {
             ..config.env_config.clone()
         };
         let max_depth = train.max_solution_depth;
-        let envs = (0..config.baseline_training().samples_per_epoch)
+        let envs = (0..config.baseline_training()?.samples_per_epoch)
             .map(|_| Ok(TaskEnv::new(make_env(&config.env, &train)?, max_depth)?))
             .collect::<Result<Vec<_>, RlError>>()?;
         let spec = envs[0].spec().clone();

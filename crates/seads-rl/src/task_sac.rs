@@ -27,6 +27,7 @@ use std::time::Instant;
 
 use seads_planner::{DepthResult, TaskSet};
 
+use crate::BaselineConfig;
 use crate::learner::Learner;
 use crate::replay::Replay;
 use crate::task_episodes::{
@@ -68,6 +69,8 @@ pub(crate) fn task_metrics(
 /// A flat SAC agent in training on the task reward.
 pub struct TaskSac {
     config: TrainConfig,
+    /// How it collects and learns (the configuration's `[sac_baseline]`).
+    training: BaselineConfig,
     episodes: TaskEpisodes,
     /// The current observation of each environment.
     obs: Vec<Vec<f32>>,
@@ -80,8 +83,9 @@ pub struct TaskSac {
 }
 
 impl TaskSac {
-    /// A fresh agent for `config` (validated; `config.algorithm` is not checked here).
+    /// A fresh agent for `config` (validated; `config.algorithm()` is not checked here).
     pub fn new(config: TrainConfig) -> Result<Self, RlError> {
+        let training = config.baseline_training()?;
         let (episodes, progress) = TaskEpisodes::new(&config)?;
         let spec = episodes.spec();
         let sac = Sac::new(
@@ -92,15 +96,12 @@ impl TaskSac {
             config.device.resolve()?,
             derived_seed(config.seed, Purpose::SacInit, 0),
         );
-        let replay = Replay::new(
-            config.sac_baseline.replay_capacity,
-            spec.obs_dim,
-            spec.action_dim,
-        );
+        let replay = Replay::new(training.replay_capacity, spec.obs_dim, spec.action_dim);
         let mut agent = Self {
             obs: vec![Vec::new(); episodes.len()],
             next_obs: vec![0.0; spec.obs_dim],
             config,
+            training,
             episodes,
             sac,
             replay,
@@ -175,10 +176,7 @@ impl TaskSac {
         let start = Instant::now();
         let mut losses = LossMean::default();
         if self.replay.len() >= self.config.sac.batch_size {
-            for _ in 0..updates_due(
-                self.progress.epoch,
-                self.config.sac_baseline.updates_per_epoch,
-            ) {
+            for _ in 0..updates_due(self.progress.epoch, self.training.updates_per_epoch) {
                 let streams = &mut self.progress.streams;
                 let batch = self
                     .replay
@@ -251,7 +249,7 @@ impl Learner for TaskSac {
         Ok(stats)
     }
     fn metrics(&mut self, stats: &TaskEpochStats, wall_s: f64) -> Result<TaskMetrics, RlError> {
-        let results = self.task_success(self.config.sac_baseline.eval_boards)?;
+        let results = self.task_success(self.training.eval_boards)?;
         Ok(task_metrics(&results, &self.progress, wall_s, stats))
     }
     fn save(&self, dir: &Path) -> Result<(), RlError> {

@@ -20,7 +20,7 @@ use crate::checkpoint::{self, Prepared};
 use crate::episode::{run_episodes, skill_coverage};
 use crate::seeds::{Purpose, derived_seed, stream, train_env_seed};
 use crate::stacked::SacWork;
-use crate::{Episode, Moment, RlError, Sac, SacLosses, TrainConfig, TransitionBatch};
+use crate::{Episode, Moment, RlError, Sac, SacLosses, SeadsConfig, TrainConfig, TransitionBatch};
 use seads_skillmodel::BuildSkillModel as _;
 
 pub use seads_run::COVERAGE_SEED;
@@ -69,6 +69,8 @@ struct Progress {
 /// A SEADS agent in training.
 pub struct Trainer {
     config: TrainConfig,
+    /// The configuration's SEADS section.
+    seads: SeadsConfig,
     spec: EnvSpec,
     k: usize,
     envs: Vec<Box<dyn Environment>>,
@@ -113,14 +115,15 @@ impl Trainer {
         eval_env: Box<dyn Environment>,
     ) -> Result<Self, RlError> {
         config.validate_values()?;
+        let seads = config.seads_section()?.clone();
         crate::numerics::check(config.portable_numerics)?;
         if config.threads > 0 {
             tch::set_num_threads(config.threads as i32);
         }
         let spec = template.spec().clone();
-        let k = config.seads.num_skills.unwrap_or(spec.num_skills);
+        let k = seads.num_skills.unwrap_or(spec.num_skills);
         // Seeded before every epoch (`train_env_seed`).
-        let envs = (0..config.seads.episodes_per_epoch)
+        let envs = (0..seads.episodes_per_epoch)
             .map(|_| template.box_clone())
             .collect();
         let device = config.device.resolve()?;
@@ -132,7 +135,7 @@ impl Trainer {
             device,
             derived_seed(config.seed, Purpose::SacInit, 0),
         );
-        let model = config.seads.skill_model.build(
+        let model = seads.skill_model.build(
             spec.symbolic_len,
             k,
             device,
@@ -152,6 +155,7 @@ impl Trainer {
         };
         Ok(Self {
             config,
+            seads,
             spec,
             k,
             envs,
@@ -325,6 +329,7 @@ impl Trainer {
         let prepare = Prepare {
             buffers: Buffers {
                 config: &self.config,
+                seads: &self.seads,
                 k: self.k,
                 episodes: &mut self.episodes,
                 rng: &mut self.progress.streams.sample,
@@ -385,7 +390,7 @@ impl Trainer {
     /// test-split resets, averaged over the evaluation seeds.
     pub fn skill_coverage(&mut self) -> Result<f64, RlError> {
         let start = Instant::now();
-        let seeds: Vec<u64> = (0..self.config.seads.eval_seeds)
+        let seeds: Vec<u64> = (0..self.seads.eval_seeds)
             .map(|i| COVERAGE_SEED + i)
             .collect();
         let per_seed = skill_coverage(self.eval_env.as_ref(), &self.sac, self.k, &seeds)?;
@@ -618,7 +623,7 @@ impl Prepare<'_> {
         self.timings.relabel += start.elapsed().as_secs_f64();
 
         let start = Instant::now();
-        let config = &self.buffers.config.seads.skill_model;
+        let config = &self.buffers.seads.skill_model;
         let mut loss = 0.0;
         for _ in 0..config.updates_per_epoch {
             let minibatch: Vec<SkillTransition> = (0..config.batch_size)

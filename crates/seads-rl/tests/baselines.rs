@@ -20,15 +20,16 @@ fn small_of(algorithm: Algorithm, seed: u64, steps: u64) -> TrainConfig {
     config.env_steps = steps;
     config.sac.hidden = vec![32, 32];
     config.sac.batch_size = 32;
-    config.sac_baseline.eval_boards = 2;
+    if let Some(training) = config.learner.sac_baseline_mut() {
+        training.eval_boards = 2;
+    }
     config.eval_every = 20;
     config.checkpoint_every = 20;
     config.portable_numerics = true;
     // Subgoals of 7 steps in episodes of 10·S: checkpoints fall inside subgoal attempts.
     if algorithm == Algorithm::Hac {
-        config.sac_baseline = Default::default();
-        config.hac.eval_boards = 2;
-        config.hac.subgoal_horizon = 7;
+        config.learner.hac_mut().unwrap().eval_boards = 2;
+        config.learner.hac_mut().unwrap().subgoal_horizon = 7;
     }
     config
 }
@@ -188,7 +189,7 @@ fn presets_carry_the_seeds_best_settings() {
     for (env, n, alpha) in best {
         let c = TrainConfig::preset_for(env, Algorithm::Sac).unwrap();
         c.validate().unwrap();
-        assert_eq!(c.algorithm, Algorithm::Sac);
+        assert_eq!(c.algorithm(), Algorithm::Sac);
         assert_eq!(c.env, env);
         assert_eq!(c.sac.hidden, [512, 512, 512]);
         assert_eq!(
@@ -196,14 +197,17 @@ fn presets_carry_the_seeds_best_settings() {
             (256, 3e-4, 0.99, 0.005)
         );
         assert_eq!(
-            (c.sac_baseline.updates_per_epoch, c.sac.alpha),
+            (
+                c.learner.sac_baseline().unwrap().updates_per_epoch,
+                c.sac.alpha
+            ),
             (n, alpha),
             "{env}"
         );
         assert_eq!(
             (
-                c.sac_baseline.replay_capacity,
-                c.sac_baseline.samples_per_epoch
+                c.learner.sac_baseline().unwrap().replay_capacity,
+                c.learner.sac_baseline().unwrap().samples_per_epoch
             ),
             (1_000_000, 8)
         );
@@ -216,8 +220,8 @@ fn presets_carry_the_seeds_best_settings() {
     }
 }
 
-/// A config.toml holds the section of its algorithm only, defaults included, and reads back
-/// equal.
+/// A config.toml states its algorithm and holds that algorithm's section only, defaults
+/// included, and reads back equal.
 #[test]
 fn configs_round_trip_through_toml() {
     let sac = TrainConfig::preset_for("tileswap-cursor", Algorithm::Sac).unwrap();
@@ -238,9 +242,11 @@ fn configs_round_trip_through_toml() {
         "{text}"
     );
     assert!(
-        !text.contains("baseline") && !text.contains("[hac]") && !text.contains("algorithm"),
+        !text.contains("baseline") && !text.contains("[hac]"),
         "{text}"
     );
+    // Every config states its algorithm, SEADS's too.
+    assert!(text.contains("algorithm = \"seads\""), "{text}");
     assert_eq!(TrainConfig::from_toml(&text).unwrap(), seads);
 }
 
@@ -269,28 +275,32 @@ fn hac_presets_carry_the_seeds_best_settings() {
         let a = TrainConfig::preset_for(sliding, Algorithm::Hac).unwrap();
         let b = TrainConfig::preset_for(tileswap, Algorithm::Hac).unwrap();
         assert_eq!(
-            (a.hac.temperature, a.sac.alpha),
-            (b.hac.temperature, b.sac.alpha)
+            (a.learner.hac().unwrap().temperature, a.sac.alpha),
+            (b.learner.hac().unwrap().temperature, b.sac.alpha)
         );
     }
     for (env, temperature, alpha_low, alpha_high) in best {
         let c = TrainConfig::preset_for(env, Algorithm::Hac).unwrap();
         c.validate().unwrap();
-        assert_eq!((c.algorithm, c.env.as_str()), (Algorithm::Hac, env));
+        assert_eq!((c.algorithm(), c.env.as_str()), (Algorithm::Hac, env));
         assert_eq!(c.sac.hidden, [512, 512]);
         assert_eq!((c.sac.lr, c.sac.gamma, c.sac.tau), (3e-4, 0.99, 0.005));
         assert_eq!(
-            (c.hac.temperature, c.sac.alpha, c.hac.alpha_high),
+            (
+                c.learner.hac().unwrap().temperature,
+                c.sac.alpha,
+                c.learner.hac().unwrap().alpha_high
+            ),
             (temperature, alpha_low, alpha_high),
             "{env}"
         );
         // A subgoal gets the steps of one skill: T_max = 10 (Cursor) or 50.
         let horizon = if env.ends_with("cursor") { 10 } else { 50 };
-        assert_eq!(c.hac.subgoal_horizon, horizon);
+        assert_eq!(c.learner.hac().unwrap().subgoal_horizon, horizon);
         let sac = TrainConfig::preset_for(env, Algorithm::Sac).unwrap();
         assert_eq!(
-            c.hac.training(),
-            sac.sac_baseline,
+            c.learner.hac().unwrap().training(),
+            sac.learner.sac_baseline().unwrap().clone(),
             "{env}: N and the buffer as for SAC"
         );
         assert_eq!(c.env_steps, sac.env_steps);
@@ -301,7 +311,7 @@ fn hac_presets_carry_the_seeds_best_settings() {
 #[test]
 fn hac_configs_round_trip_through_toml() {
     let mut hac = TrainConfig::preset_for("lightsout-cursor", Algorithm::Hac).unwrap();
-    hac.hac = Default::default();
+    hac.learner = seads_rl::LearnerConfig::of(Algorithm::Hac);
     let text = hac.to_toml();
     assert!(
         text.contains("[hac]") && text.contains("replay_capacity = 1000000"),
@@ -359,22 +369,23 @@ fn bad_baseline_settings_are_refused() {
         "[sac_baseline]\nsamples_per_epoch = 4",
         "[sac_baseline] is the section",
     );
+    // SAC's steps per epoch are each learner's own (`sac_baseline.updates_per_epoch`).
     refused(
         "algorithm = \"sac\"\n[sac]\nupdates_per_epoch = 4",
-        "sac.updates_per_epoch is SEADS's",
+        "unknown field `updates_per_epoch`",
     );
-    // The flat layout of older files: the same settings in the wrong place are refused too.
+    // The flat layout of older files is read no more (`seads migrate` rewrites it).
     refused(
-        "algorithm = \"sac\"\n[baseline]\nupdates_per_epoch = 0.0",
-        "sac_baseline.updates_per_epoch must be positive",
+        "algorithm = \"sac\"\n[baseline]\nupdates_per_epoch = 0.5",
+        "unknown field `baseline`",
     );
     refused(
         "algorithm = \"sac\"\nnum_skills = 30",
-        "[seads] is the section",
+        "unknown field `num_skills`",
     );
     refused(
         "algorithm = \"hac\"\n[relabel]\nsac_p = 0.0",
-        "[seads] is the section",
+        "unknown field `relabel`",
     );
 }
 

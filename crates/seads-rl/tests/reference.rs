@@ -48,7 +48,6 @@ fn one_update_matches_pytorch() {
         tau: 0.005,
         alpha: 0.1,
         batch_size: 5,
-        updates_per_epoch: 1,
     };
     let mut sac = Sac::new(7, &[-1.0, -2.0], &[1.0, 3.0], &config, Device::Cpu, 0);
     // A fresh optimiser state from our own save, the networks from PyTorch.

@@ -1,23 +1,21 @@
-//! The training configuration: one TOML file per run, with a preset per environment.
+//! The training configuration: one TOML file per run, with a preset per environment and
+//! algorithm.
 
 use crate::ComputeDevice;
-use seads_embodiment::{EnvConfig, MOVED_TO_MANIPULATOR, env_names};
+use seads_embodiment::{EnvConfig, env_names};
 use serde::{Deserialize, Serialize};
 
-use crate::sections::{Algorithm, BaselineConfig, HacConfig, MAX_PER_EPOCH, SeadsConfig};
-use crate::{RunError, SacConfig, flat_layout};
+use crate::sections::{Algorithm, BaselineConfig, LearnerConfig, SeadsConfig};
+use crate::{RunError, SacConfig};
 
 /// Everything a training run needs: the run's own settings (environment, seed, budget,
-/// evaluation and checkpoint cadence, threads, numerics, device), the soft actor-critic that
-/// every algorithm trains (`[sac]`; HAC's low level), and the section of the run's algorithm:
-/// `[seads]`, `[sac_baseline]` or `[hac]`. A file holds only its algorithm's section; the other
-/// sections stay at their defaults in memory, and changing one is an error. `Default` is the
-/// LightsOutCursor preset of the paper.
-#[derive(Debug, Clone, PartialEq, Deserialize)]
-#[serde(deny_unknown_fields, default)]
+/// evaluation and checkpoint cadence, threads, numerics, device), the soft actor-critic's
+/// networks and optimiser that every algorithm trains (`[sac]`; HAC's low level), and its
+/// learner: `algorithm` and that algorithm's section only (`[seads]`, `[sac_baseline]` or
+/// `[hac]`, [`LearnerConfig`]). `Default` is the LightsOutCursor preset of the paper.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(default)]
 pub struct TrainConfig {
-    /// What to train: SEADS (the default) or a baseline.
-    pub algorithm: Algorithm,
     /// Environment name (see `seads envs`).
     pub env: String,
     /// Environment options; the reset split is always "train" for training.
@@ -50,26 +48,18 @@ pub struct TrainConfig {
     /// Where the networks run: `cpu` (the default) or `cuda`, `cuda:N`. Only the CPU is
     /// bit-exact from the seed; a checkpoint from either loads on the other. Left out of the
     /// written config when `cpu`, and set per command by `--device` (resuming may change it).
+    #[serde(skip_serializing_if = "ComputeDevice::is_cpu")]
     pub device: ComputeDevice,
-    /// Soft actor-critic, for every algorithm (`updates_per_epoch` is SEADS's; the baselines
-    /// set theirs in their own section).
+    /// The soft actor-critic's networks and optimiser, for every algorithm.
     pub sac: SacConfig,
-    /// SEADS's section (`algorithm = "seads"`).
-    pub seads: SeadsConfig,
-    /// The SAC baseline's section (`algorithm = "sac"`).
-    pub sac_baseline: BaselineConfig,
-    /// The HAC baseline's section (`algorithm = "hac"`).
-    pub hac: HacConfig,
-}
-
-fn is_seads(algorithm: &Algorithm) -> bool {
-    *algorithm == Algorithm::Seads
+    /// What to train (`algorithm`, SEADS where a file names none) and its section.
+    #[serde(flatten)]
+    pub learner: LearnerConfig,
 }
 
 impl Default for TrainConfig {
     fn default() -> Self {
         Self {
-            algorithm: Algorithm::Seads,
             env: "lightsout-cursor".into(),
             env_config: EnvConfig::default(),
             seed: 1,
@@ -81,9 +71,7 @@ impl Default for TrainConfig {
             portable_numerics: false,
             device: ComputeDevice::Cpu,
             sac: SacConfig::default(),
-            seads: SeadsConfig::default(),
-            sac_baseline: BaselineConfig::default(),
-            hac: HacConfig::default(),
+            learner: LearnerConfig::default(),
         }
     }
 }
@@ -106,19 +94,53 @@ impl TrainConfig {
     /// assert_eq!((config.threads, config.sac_threads_alone), (2, 4));
     /// config.use_cores(1);
     /// assert_eq!((config.threads, config.sac_threads_alone), (1, 0));
-    /// let mut baseline = TrainConfig { algorithm: Algorithm::Sac, ..TrainConfig::default() };
+    /// let mut baseline = TrainConfig::default().with_algorithm(Algorithm::Sac);
     /// baseline.use_cores(4);
     /// assert_eq!((baseline.threads, baseline.sac_threads_alone), (4, 0));
     /// ```
     pub fn use_cores(&mut self, cores: usize) {
         let cores = cores.max(1);
-        if self.algorithm != Algorithm::Seads {
+        if self.algorithm() != Algorithm::Seads {
             self.threads = cores;
             self.sac_threads_alone = 0;
             return;
         }
         self.threads = (cores / 2).max(1);
         self.sac_threads_alone = if cores >= 2 { cores } else { 0 };
+    }
+
+    /// Which algorithm the run trains.
+    pub fn algorithm(&self) -> Algorithm {
+        self.learner.algorithm()
+    }
+
+    /// SEADS's section, if the run trains SEADS.
+    pub fn seads(&self) -> Option<&SeadsConfig> {
+        self.learner.seads()
+    }
+
+    /// SEADS's section, for a learner that must be SEADS: another algorithm's configuration is
+    /// an error.
+    pub fn seads_section(&self) -> Result<&SeadsConfig, RunError> {
+        self.seads().ok_or_else(|| {
+            RunError::Config(format!(
+                "a {} run has no [seads] section: it is no SEADS run",
+                self.algorithm().name()
+            ))
+        })
+    }
+
+    /// SEADS's section to change, if the run trains SEADS.
+    pub fn seads_mut(&mut self) -> Option<&mut SeadsConfig> {
+        self.learner.seads_mut()
+    }
+
+    /// These settings with `algorithm` and its section's defaults in place of the learner.
+    pub fn with_algorithm(self, algorithm: Algorithm) -> Self {
+        Self {
+            learner: LearnerConfig::of(algorithm),
+            ..self
+        }
     }
 
     /// The preset of environment `env` (the paper's settings).
@@ -167,10 +189,10 @@ impl TrainConfig {
 
     /// A configuration a user wrote (a `--config` file, a run's `config.toml`): it must name its
     /// `env` (or `env` is given here), and what it leaves out comes from that environment's
-    /// preset of its `algorithm` (or the given one), never from generic defaults. Unknown
-    /// fields, bad values and another algorithm's section are errors naming the line or the
-    /// field. A file in the flat layout of older versions loads too. The robot's environments
-    /// (`uarm-…`) have no preset; their runs write the whole configuration, taken as written.
+    /// preset of its `algorithm` (or the given one; SEADS where none is named), never from
+    /// generic defaults. Unknown fields, bad values and another algorithm's section are errors
+    /// naming the line or the field. The robot's environments (`uarm-…`) have no preset; their
+    /// runs write the whole configuration, taken as written.
     ///
     /// ```
     /// use seads_run::TrainConfig;
@@ -190,22 +212,27 @@ impl TrainConfig {
         algorithm: Option<Algorithm>,
     ) -> Result<Self, RunError> {
         let mut table = parse_table(text)?;
-        if !flat_layout::is_flat(&table) {
-            // Fields and types first, with the user's line numbers.
-            toml::from_str::<Self>(text)
-                .map_err(|e| RunError::Config(one_line_toml_error(text, &e)))?;
+        let stated = algorithm_of(&table)?;
+        // Fields and types first, with the user's line numbers (the algorithm in force named
+        // ahead of the text where the text names none).
+        if stated.is_none() || algorithm.is_none_or(|a| Some(a) == stated) {
+            let named = algorithm.or(stated).unwrap_or_default();
+            let prefix = match stated {
+                Some(_) => String::new(),
+                None => format!("algorithm = \"{}\"\n", named.name()),
+            };
+            check_sections(&table, named)?;
+            toml::from_str::<Self>(&format!("{prefix}{text}"))
+                .map_err(|e| RunError::Config(one_line_toml_error(text, &e, prefix.len())))?;
         }
         if let Some(env) = env {
             table.insert("env".into(), toml::Value::String(env.into()));
         }
-        if let Some(algorithm) = algorithm {
-            table.insert(
-                "algorithm".into(),
-                toml::Value::String(algorithm.name().into()),
-            );
-        }
-        let algorithm = algorithm_of(&table)?;
-        into_sections(&mut table, algorithm)?;
+        let algorithm = algorithm.or(stated).unwrap_or_default();
+        table.insert(
+            "algorithm".into(),
+            toml::Value::String(algorithm.name().into()),
+        );
         // The values the file states, before what it leaves out is filled in.
         Self::from_table(table.clone())?;
         let Some(toml::Value::String(env)) = table.get("env").cloned() else {
@@ -224,31 +251,28 @@ impl TrainConfig {
             .to_toml()
             .parse()
             .expect("a serialised preset parses");
-        forget_what_the_older_layout_states(&mut merged, &table);
         merge_toml(&mut merged, &table);
         Self::from_table(merged)
     }
 
     /// Parses a complete TOML configuration (fields left out take the generic defaults, which
     /// only the presets rely on: a user's file goes through [`TrainConfig::from_user_toml`]) and
-    /// validates its values (not the environment: see [`TrainConfig::validate`]). The flat
-    /// layout of older versions' files loads too.
+    /// validates its values (not the environment: see [`TrainConfig::validate`]).
     pub fn from_toml(text: &str) -> Result<Self, RunError> {
-        let mut table = parse_table(text)?;
-        let algorithm = algorithm_of(&table)?;
-        if into_sections(&mut table, algorithm)? {
-            return Self::from_table(table);
-        }
-        let config: Self =
-            toml::from_str(text).map_err(|e| RunError::Config(one_line_toml_error(text, &e)))?;
-        config.validate_values()?;
-        Ok(config)
+        Self::from_table(parse_table(text)?)
     }
 
-    /// A configuration from a table in the sectioned layout, its values validated.
-    fn from_table(table: toml::Table) -> Result<Self, RunError> {
+    /// A configuration from a parsed TOML table (SEADS where it names no `algorithm`; fields left
+    /// out take the generic defaults), its values validated.
+    pub fn from_table(mut table: toml::Table) -> Result<Self, RunError> {
+        let algorithm = algorithm_of(&table)?.unwrap_or_default();
+        table.insert(
+            "algorithm".into(),
+            toml::Value::String(algorithm.name().into()),
+        );
+        check_sections(&table, algorithm)?;
         let config: Self = table.try_into().map_err(|e: toml::de::Error| {
-            RunError::Config(e.message().trim().replace('\n', " "))
+            RunError::Config(older_layout_hint(e.message().trim().replace('\n', " ")))
         })?;
         config.validate_values()?;
         Ok(config)
@@ -276,15 +300,13 @@ impl TrainConfig {
 
     /// Bytes a run of this configuration holds at least (a lower bound, so that a refusal is
     /// never wrong), estimated from the environment's sizes before anything is allocated: the
-    /// networks with gradients and Adam's two moments (critics twice, with targets), one
-    /// update's activations, the episode buffer and an epoch's episodes, relabelling's cost
-    /// matrix and the baselines' replay buffer. In `f64`, so that no size overflows.
+    /// networks with gradients and Adam's two moments (critics twice, with targets) and one
+    /// update's activations; for SEADS the skill model, the episode buffer, an epoch's episodes
+    /// and relabelling's cost matrix; for a baseline its replay buffer. In `f64`, so that no
+    /// size overflows.
     pub fn memory_estimate(&self, spec: &seads_embodiment::EnvSpec) -> f64 {
         let f = |v: usize| v as f64;
-        let seads = &self.seads;
-        let skills = f(seads.num_skills.unwrap_or(spec.num_skills));
         let (obs, act, board) = (f(spec.obs_dim), f(spec.action_dim), f(spec.symbolic_len));
-        let steps = f(spec.step_limit.unwrap_or(1).max(1));
         // Weights of a multilayer perceptron from `input` through `hidden` to `output`.
         let mlp = |input: f64, hidden: &[i64], output: f64| {
             let mut sizes = vec![input];
@@ -293,20 +315,28 @@ impl TrainConfig {
             sizes.windows(2).map(|w| (w[0] + 1.0) * w[1]).sum::<f64>()
         };
         let width = |hidden: &[i64]| hidden.iter().map(|&h| h.max(0) as f64).sum::<f64>();
+        let sac_activations = f(self.sac.batch_size) * width(&self.sac.hidden) * 3.0;
+        let Some(seads) = self.seads() else {
+            // A baseline: its networks see at least the observation.
+            let actor = mlp(obs, &self.sac.hidden, 2.0 * act);
+            let critic = mlp(obs + act, &self.sac.hidden, 1.0);
+            let replay = self
+                .learner
+                .baseline_training()
+                .map_or(0.0, |b| f(b.replay_capacity));
+            return 4.0 * (4.0 * actor + 10.0 * critic + sac_activations + replay * (obs + act));
+        };
+        let skills = f(seads.num_skills.unwrap_or(spec.num_skills));
+        let steps = f(spec.step_limit.unwrap_or(1).max(1));
         let actor = mlp(obs + skills, &self.sac.hidden, 2.0 * act);
         let critic = mlp(obs + skills + act, &self.sac.hidden, 1.0);
         let forward_model = mlp(board + skills, &seads.skill_model.hidden, board);
         let weights = 4.0 * actor + 10.0 * critic + 4.0 * forward_model;
-        let activations = f(self.sac.batch_size) * width(&self.sac.hidden) * 3.0
-            + f(seads.skill_model.batch_size) * width(&seads.skill_model.hidden);
+        let activations =
+            sac_activations + f(seads.skill_model.batch_size) * width(&seads.skill_model.hidden);
         let episodes = (f(seads.buffer_capacity) + f(seads.episodes_per_epoch)) * steps;
-        let transitions = if self.algorithm.is_baseline() {
-            f(self.baseline_training().replay_capacity)
-        } else {
-            0.0
-        };
         let relabelling = 2.0 * f(seads.sampled_episodes) * skills;
-        4.0 * (weights + activations + (episodes + transitions) * (obs + act) + relabelling)
+        4.0 * (weights + activations + episodes * (obs + act) + relabelling)
     }
 
     /// Refuses a configuration whose [`memory_estimate`](Self::memory_estimate) exceeds
@@ -342,27 +372,15 @@ impl TrainConfig {
     pub fn validate_values(&self) -> Result<(), RunError> {
         let bad = |m: String| Err(RunError::Config(m));
         self.sac.validate()?;
-        self.seads.validate()?;
-        self.sac_baseline.validate("sac_baseline")?;
-        self.hac.validate()?;
-        // Counts that set a loop's length or a pool's size: beyond these a run would spawn more
-        // threads than a machine has, or never finish an epoch.
-        let caps: [(&str, u64, u64); 3] = [
-            ("threads", self.threads as u64, MAX_THREADS),
-            (
-                "sac_threads_alone",
-                self.sac_threads_alone as u64,
-                MAX_THREADS,
-            ),
-            (
-                "sac.updates_per_epoch",
-                self.sac.updates_per_epoch as u64,
-                MAX_PER_EPOCH,
-            ),
-        ];
-        for (name, value, most) in caps {
-            if value > most {
-                return bad(format!("{name} must be at most {most}, got {value}"));
+        self.learner.validate()?;
+        // Counts that set a pool's size: beyond these a run would spawn more threads than a
+        // machine has.
+        for (name, value) in [
+            ("threads", self.threads),
+            ("sac_threads_alone", self.sac_threads_alone),
+        ] {
+            if value as u64 > MAX_THREADS {
+                return bad(format!("{name} must be at most {MAX_THREADS}, got {value}"));
             }
         }
         // TOML integers are 64-bit signed: a larger value would be written into config.toml but
@@ -382,45 +400,18 @@ impl TrainConfig {
         if self.env_steps == 0 {
             return bad("env_steps must be at least 1".into());
         }
-        self.check_other_sections()
-    }
-
-    /// The sections of the other algorithms stay at their defaults: they are not written with
-    /// the run, so a change there would be lost. SAC's `updates_per_epoch` is SEADS's (the
-    /// baselines set theirs in their own section).
-    fn check_other_sections(&self) -> Result<(), RunError> {
-        let changed = [
-            (Algorithm::Seads, self.seads == SeadsConfig::default()),
-            (
-                Algorithm::Sac,
-                self.sac_baseline == BaselineConfig::default(),
-            ),
-            (Algorithm::Hac, self.hac == HacConfig::default()),
-        ]
-        .into_iter()
-        .find(|&(a, default)| a != self.algorithm && !default);
-        if let Some((other, _)) = changed {
-            return Err(foreign_section(other, self.algorithm));
-        }
-        if self.algorithm.is_baseline()
-            && self.sac.updates_per_epoch != SacConfig::default().updates_per_epoch
-        {
-            return Err(RunError::Config(format!(
-                "sac.updates_per_epoch is SEADS's; the {} baseline's is {}.updates_per_epoch",
-                self.algorithm.name(),
-                self.algorithm.section()
-            )));
-        }
         Ok(())
     }
 
-    /// How a baseline collects and learns: `[sac_baseline]`, or HAC's share of `[hac]` (SEADS:
-    /// the SAC baseline's defaults, unused).
-    pub fn baseline_training(&self) -> BaselineConfig {
-        match self.algorithm {
-            Algorithm::Hac => self.hac.training(),
-            Algorithm::Seads | Algorithm::Sac => self.sac_baseline.clone(),
-        }
+    /// How a baseline collects and learns (`[sac_baseline]`, or HAC's share of `[hac]`), for a
+    /// learner that must be a baseline: SEADS's configuration is an error.
+    pub fn baseline_training(&self) -> Result<BaselineConfig, RunError> {
+        self.learner.baseline_training().ok_or_else(|| {
+            RunError::Config(format!(
+                "a {} run is no task-reward baseline",
+                self.algorithm().name()
+            ))
+        })
     }
 }
 
@@ -441,25 +432,6 @@ pub fn machine_memory_bytes() -> u64 {
             kib.checked_mul(1024)
         })
         .unwrap_or(u64::MAX)
-}
-
-/// Removes from `preset` each manipulator option that `stated` gives in the older layout of
-/// `[env_config]` (beside the board options), so that the file's value replaces the preset's
-/// when `stated` is laid over it, as in the current layout.
-fn forget_what_the_older_layout_states(preset: &mut toml::Table, stated: &toml::Table) {
-    let Some(toml::Value::Table(stated)) = stated.get("env_config") else {
-        return;
-    };
-    let Some(toml::Value::Table(env_config)) = preset.get_mut("env_config") else {
-        return;
-    };
-    if let Some(toml::Value::Table(manipulator)) = env_config.get_mut("manipulator") {
-        for key in MOVED_TO_MANIPULATOR {
-            if stated.contains_key(key) {
-                manipulator.remove(key);
-            }
-        }
-    }
 }
 
 /// Lays `layer` over `base`: a key of `layer` replaces `base`'s, except that two tables merge,
@@ -530,101 +502,61 @@ pub fn config_difference(
 /// A configuration's text as a table.
 fn parse_table(text: &str) -> Result<toml::Table, RunError> {
     text.parse()
-        .map_err(|e| RunError::Config(one_line_toml_error(text, &e)))
+        .map_err(|e| RunError::Config(one_line_toml_error(text, &e, 0)))
 }
 
-/// The algorithm a configuration's table names (SEADS where it names none).
-fn algorithm_of(table: &toml::Table) -> Result<Algorithm, RunError> {
-    match table.get("algorithm") {
-        Some(value) => value
-            .clone()
-            .try_into::<Algorithm>()
-            .map_err(|e| RunError::Config(format!("algorithm: {}", e.message().trim()))),
-        None => Ok(Algorithm::Seads),
-    }
+/// The algorithm a configuration's table names, if it names one.
+fn algorithm_of(table: &toml::Table) -> Result<Option<Algorithm>, RunError> {
+    table
+        .get("algorithm")
+        .map(|value| {
+            value.clone().try_into::<Algorithm>().map_err(|e| {
+                RunError::Config(format!(
+                    "algorithm: {} (one of {})",
+                    e.message().trim(),
+                    Algorithm::names().join(", ")
+                ))
+            })
+        })
+        .transpose()
 }
 
-/// Brings `table` (a configuration of `algorithm`) into the sectioned layout: a file of the flat
-/// layout is upgraded (returns `true`; the sections it carried at their defaults are checked
-/// by value, [`TrainConfig::validate_values`]); a sectioned file must hold no other algorithm's
-/// section.
-fn into_sections(table: &mut toml::Table, algorithm: Algorithm) -> Result<bool, RunError> {
-    if flat_layout::upgrade(table, algorithm)? {
-        return Ok(true);
-    }
+/// Refuses a section of another algorithm than `algorithm` in `table`, naming both.
+fn check_sections(table: &toml::Table, algorithm: Algorithm) -> Result<(), RunError> {
     match Algorithm::ALL
         .into_iter()
         .find(|&other| other != algorithm && table.contains_key(other.section()))
     {
-        Some(other) => Err(foreign_section(other, algorithm)),
-        None => Ok(false),
+        Some(other) => Err(RunError::Config(format!(
+            "[{}] is the section of algorithm {:?}, not of this run's {:?}; remove it",
+            other.section(),
+            other.name(),
+            algorithm.name()
+        ))),
+        None => Ok(()),
     }
 }
 
-/// The error for a section of algorithm `other` in a configuration of `algorithm`.
-fn foreign_section(other: Algorithm, algorithm: Algorithm) -> RunError {
-    RunError::Config(format!(
-        "[{}] is the section of algorithm {:?}, not of this run's {:?}; remove it",
-        other.section(),
-        other.name(),
-        algorithm.name()
-    ))
-}
-
-/// What [`TrainConfig`] writes: its fields, with the section of its algorithm only.
-#[derive(Serialize)]
-struct Written<'a> {
-    #[serde(skip_serializing_if = "is_seads")]
-    algorithm: Algorithm,
-    env: &'a str,
-    env_config: &'a EnvConfig,
-    seed: u64,
-    env_steps: u64,
-    eval_every: u64,
-    checkpoint_every: u64,
-    threads: usize,
-    sac_threads_alone: usize,
-    portable_numerics: bool,
-    #[serde(skip_serializing_if = "Option::is_none")]
-    device: Option<&'a ComputeDevice>,
-    sac: &'a SacConfig,
-    #[serde(skip_serializing_if = "Option::is_none")]
-    seads: Option<&'a SeadsConfig>,
-    #[serde(skip_serializing_if = "Option::is_none")]
-    sac_baseline: Option<&'a BaselineConfig>,
-    #[serde(skip_serializing_if = "Option::is_none")]
-    hac: Option<&'a HacConfig>,
-}
-
-impl Serialize for TrainConfig {
-    fn serialize<S: serde::Serializer>(&self, serializer: S) -> Result<S::Ok, S::Error> {
-        let a = self.algorithm;
-        Written {
-            algorithm: a,
-            env: &self.env,
-            env_config: &self.env_config,
-            seed: self.seed,
-            env_steps: self.env_steps,
-            eval_every: self.eval_every,
-            checkpoint_every: self.checkpoint_every,
-            threads: self.threads,
-            sac_threads_alone: self.sac_threads_alone,
-            portable_numerics: self.portable_numerics,
-            device: (self.device != ComputeDevice::Cpu).then_some(&self.device),
-            sac: &self.sac,
-            seads: (a == Algorithm::Seads).then_some(&self.seads),
-            sac_baseline: (a == Algorithm::Sac).then_some(&self.sac_baseline),
-            hac: (a == Algorithm::Hac).then_some(&self.hac),
-        }
-        .serialize(serializer)
+/// `message`, with a pointer to `seads migrate` where it names an unknown field: the older
+/// layouts' keys are unknown to today's.
+fn older_layout_hint(message: String) -> String {
+    if message.contains("unknown field") {
+        format!("{message} (a file of an older version? `seads migrate` rewrites it)")
+    } else {
+        message
     }
 }
 
-fn one_line_toml_error(text: &str, e: &toml::de::Error) -> String {
-    let message = e.message().trim().replace('\n', " ");
-    match e.span() {
+/// A TOML error in one line, with the line and column of `text` where it has a span; the span is
+/// of a text that had `shift` bytes ahead of `text`.
+fn one_line_toml_error(text: &str, e: &toml::de::Error, shift: usize) -> String {
+    let message = older_layout_hint(e.message().trim().replace('\n', " "));
+    match e
+        .span()
+        .filter(|span| span.start >= shift && span != &(0..0))
+    {
         Some(span) => {
-            let before = &text[..span.start.min(text.len())];
+            let before = &text[..(span.start - shift).min(text.len())];
             let line = before.matches('\n').count() + 1;
             let column = before.len() - before.rfind('\n').map_or(0, |i| i + 1) + 1;
             format!("line {line}, column {column}: {message}")
@@ -636,6 +568,7 @@ fn one_line_toml_error(text: &str, e: &toml::de::Error) -> String {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::MAX_PER_EPOCH;
     use proptest::prelude::*;
 
     /// The device is written only when it is not the CPU, so the presets and every CPU run's
@@ -681,41 +614,70 @@ mod tests {
         assert_eq!(jaco, 9);
     }
 
-    /// A Jaco run's file in the older layout (`physics_substeps` beside the board options, as
-    /// the committed Jaco runs' `config.toml`) loads over the preset, which states the option in
-    /// `[env_config.manipulator]`, and its own value is the one taken.
+    /// A written configuration holds `algorithm` and its algorithm's section only, and reads
+    /// back as it was; every preset of every algorithm does.
     #[test]
-    fn a_jaco_file_in_the_older_layout_loads_with_its_own_value() {
-        let older = |substeps: u64| {
-            format!(
-                "env = \"lightsout-jaco\"\n[env_config]\nmax_solution_depth = 5\nphysics_substeps = {substeps}\n"
-            )
-        };
-        for substeps in [25, 10] {
-            let config = TrainConfig::from_user_toml(&older(substeps), None, None).unwrap();
-            assert_eq!(
-                config.env_config.manipulator.get("physics_substeps"),
-                Some(&serde_json::Value::from(substeps))
-            );
-            let mut current = TrainConfig::preset("lightsout-jaco").unwrap();
-            current
-                .env_config
-                .manipulator
-                .insert("physics_substeps".into(), substeps.into());
-            assert_eq!(config, current);
+    fn a_written_config_holds_its_algorithms_section_only() {
+        let mut presets = 0;
+        for algorithm in Algorithm::ALL {
+            for (env, _) in TrainConfig::presets_of(algorithm) {
+                let config = TrainConfig::preset_for(env, algorithm).unwrap();
+                assert_eq!(config.algorithm(), algorithm);
+                let text = config.to_toml();
+                let table: toml::Table = text.parse().unwrap();
+                let sections: Vec<&str> = Algorithm::ALL
+                    .into_iter()
+                    .map(Algorithm::section)
+                    .filter(|s| table.contains_key(*s))
+                    .collect();
+                assert_eq!(sections, [algorithm.section()], "{env}: {text}");
+                assert_eq!(
+                    table.get("algorithm").and_then(|a| a.as_str()),
+                    Some(algorithm.name())
+                );
+                assert_eq!(TrainConfig::from_toml(&text).unwrap(), config);
+                presets += 1;
+            }
         }
-        let committed =
-            "../../docs/results/jaco/runs/arms/runs/lightsout-jaco/seads/seed-1/config.toml";
-        let text = std::fs::read_to_string(committed).unwrap();
-        assert!(text.contains("\nphysics_substeps = 25"), "{text}");
-        TrainConfig::from_user_toml(&text, None, None).unwrap();
-        // Both layouts in one file are still refused.
-        let twice = format!(
-            "{}[env_config.manipulator]\nphysics_substeps = 25\n",
-            older(25)
+        assert_eq!(presets, 36);
+    }
+
+    /// Another algorithm's section, the older flat layout and `[sac] updates_per_epoch` are
+    /// refused, each in one line naming the field; a type error names the user's line.
+    #[test]
+    fn misplaced_settings_are_refused_in_one_line() {
+        let refused = |text: &str| {
+            let e = TrainConfig::from_user_toml(text, None, None)
+                .unwrap_err()
+                .to_string();
+            assert!(!e.contains('\n'), "{e}");
+            e
+        };
+        let e = refused("env = \"lightsout-cursor\"\n[hac]\ntemperature = 0.5");
+        assert!(
+            e.contains("[hac] is the section of algorithm \"hac\", not of this run's \"seads\""),
+            "{e}"
         );
-        let err = TrainConfig::from_user_toml(&twice, None, None).unwrap_err();
-        assert!(err.to_string().contains("given twice"), "{err}");
+        let e = refused("env = \"lightsout-cursor\"\nnum_skills = 30");
+        assert!(e.contains("unknown field `num_skills`"), "{e}");
+        let e = refused("env = \"lightsout-cursor\"\n[sac]\nupdates_per_epoch = 4");
+        assert!(e.contains("unknown field `updates_per_epoch`"), "{e}");
+        let e = refused("env = \"lightsout-jaco\"\n[env_config]\nphysics_substeps = 25");
+        assert!(e.contains("unknown field `physics_substeps`"), "{e}");
+        // The user's own line and column, though the algorithm was named ahead of the text.
+        let e = refused("env = \"lightsout-cursor\"\n\n[sac]\nlr = \"fast\"");
+        assert!(
+            e.starts_with("invalid configuration: line 4, column 6:"),
+            "{e}"
+        );
+        // The command line's algorithm chooses the section a file may hold.
+        let sac = TrainConfig::from_user_toml(
+            "env = \"lightsout-cursor\"\n[sac_baseline]\neval_boards = 3",
+            None,
+            Some(Algorithm::Sac),
+        )
+        .unwrap();
+        assert_eq!(sac.learner.sac_baseline().unwrap().eval_boards, 3);
     }
 
     #[test]
@@ -868,35 +830,37 @@ mod tests {
                     (seed, env_steps),
                 )| {
                     let mut config = TrainConfig::preset("lightsout-cursor").unwrap();
-                    config.seads.num_skills = Some(num_skills);
                     config.sac.hidden = sac_hidden;
-                    config.seads.skill_model.hidden = model_hidden;
-                    config.seads.episodes_per_epoch = episodes;
-                    config.seads.buffer_capacity = capacity;
-                    config.seads.sampled_episodes = sampled;
-                    config.seads.recent_episodes = sampled.min(capacity);
                     config.sac.batch_size = sac_batch;
-                    config.seads.skill_model.batch_size = model_batch;
                     config.sac.lr = lr;
                     config.sac.alpha = alpha;
                     config.sac.gamma = gamma;
-                    config.seads.relabel.sac_p = p;
                     config.threads = threads;
-                    config.seads.eval_seeds = eval_seeds as u64;
                     config.seed = seed;
                     config.env_steps = env_steps;
-                    if baseline {
-                        config = TrainConfig {
-                            algorithm: Algorithm::Sac,
-                            seads: SeadsConfig::default(),
-                            ..config
-                        };
-                        config.sac_baseline.replay_capacity = replay;
-                        config.sac_baseline.samples_per_epoch = samples;
-                        config.sac_baseline.eval_boards = boards;
+                    config.learner = if baseline {
+                        LearnerConfig::Sac {
+                            sac_baseline: BaselineConfig {
+                                replay_capacity: replay,
+                                samples_per_epoch: samples,
+                                eval_boards: boards,
+                                ..BaselineConfig::default()
+                            },
+                        }
                     } else {
-                        config.sac.updates_per_epoch = updates;
-                    }
+                        let mut seads = config.seads().unwrap().clone();
+                        seads.num_skills = Some(num_skills);
+                        seads.skill_model.hidden = model_hidden;
+                        seads.episodes_per_epoch = episodes;
+                        seads.buffer_capacity = capacity;
+                        seads.sampled_episodes = sampled;
+                        seads.recent_episodes = sampled.min(capacity);
+                        seads.skill_model.batch_size = model_batch;
+                        seads.relabel.sac_p = p;
+                        seads.eval_seeds = eval_seeds as u64;
+                        seads.updates_per_epoch = updates;
+                        LearnerConfig::Seads { seads }
+                    };
                     if config.validate().is_err() {
                         refused.set(refused.get() + 1);
                         return Ok(());
@@ -911,14 +875,15 @@ mod tests {
                     prop_assert!((0.0..=1.0).contains(&gamma));
                     prop_assert!(sac_batch > 0);
                     prop_assert!(threads as u64 <= MAX_THREADS);
-                    prop_assert!(config.sac.updates_per_epoch as u64 <= MAX_PER_EPOCH);
-                    prop_assert!(config.sac_baseline.samples_per_epoch as u64 <= MAX_PER_EPOCH);
-                    prop_assert!(config.sac_baseline.eval_boards as u64 <= MAX_PER_EPOCH);
                     prop_assert!(i64::try_from(seed).is_ok() && i64::try_from(env_steps).is_ok());
-                    if !baseline {
+                    if baseline {
+                        prop_assert!(samples as u64 <= MAX_PER_EPOCH);
+                        prop_assert!(boards as u64 <= MAX_PER_EPOCH);
+                    } else {
                         prop_assert!(num_skills > 0 && episodes > 0);
                         prop_assert!((0.0..=1.0).contains(&p));
                         prop_assert!((eval_seeds as u64) <= MAX_PER_EPOCH);
+                        prop_assert!(updates as u64 <= MAX_PER_EPOCH);
                     }
                     // What is accepted is written and read back as it was.
                     let back = TrainConfig::from_toml(&config.to_toml());
@@ -945,7 +910,7 @@ mod tests {
         b.threads = 4;
         b.sac_threads_alone = 0;
         assert_eq!(config_difference(&a, &b), None);
-        b.seads.skill_model.lr = 0.5;
+        b.seads_mut().unwrap().skill_model.lr = 0.5;
         let (field, now, then) = config_difference(&b, &a).unwrap();
         assert_eq!(field, "seads.skill_model.lr");
         assert_eq!((now.as_str(), then.as_str()), ("0.5", "0.001"));

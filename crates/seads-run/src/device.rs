@@ -41,6 +41,11 @@ pub enum DeviceError {
 }
 
 impl ComputeDevice {
+    /// Whether this is the processor.
+    pub fn is_cpu(&self) -> bool {
+        *self == Self::Cpu
+    }
+
     /// Whether this is a GPU.
     pub fn is_cuda(self) -> bool {
         matches!(self, Self::Cuda(_))

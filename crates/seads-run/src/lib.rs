@@ -3,7 +3,8 @@
 //! (reports, sweeps, the command line's status and plots).
 //!
 //! - [`TrainConfig`]: a run's configuration (`config.toml`): its settings, its environment and
-//!   the section of its algorithm ([`SeadsConfig`], [`BaselineConfig`], [`HacConfig`]), with
+//!   its learner ([`LearnerConfig`]: the algorithm and its section only, [`SeadsConfig`],
+//!   [`BaselineConfig`] or [`HacConfig`]), with
 //!   [`SacConfig`] and the skill model's settings ([`SkillModelConfig`]); the shipped presets of
 //!   `configs/`; validated on load.
 //! - [`store`]: the run directory: atomic writes, JSON Lines, `metrics.jsonl`, checkpoints'
@@ -22,7 +23,6 @@
 
 mod config;
 mod device;
-mod flat_layout;
 mod metrics;
 mod population;
 mod sac;
@@ -32,12 +32,12 @@ pub mod store;
 
 pub use config::{TrainConfig, config_difference, machine_memory_bytes, merge_toml};
 pub use device::{ComputeDevice, DeviceError};
-pub use flat_layout::upgrade as upgrade_flat_layout;
 pub use metrics::{Metrics, TaskMetrics, TaskTimings, Timings, read_metrics};
 pub use population::{PopulationKey, check_population};
 pub use sac::SacConfig;
 pub use sections::{
-    Algorithm, BaselineConfig, COVERAGE_SEED, HacConfig, MAX_PER_EPOCH, RelabelConfig, SeadsConfig,
+    Algorithm, BaselineConfig, COVERAGE_SEED, HacConfig, LearnerConfig, MAX_PER_EPOCH,
+    RelabelConfig, SeadsConfig,
 };
 pub use skill_model::{Normalisation, RelabelKind, RewardConfig, SkillModelConfig, SkillModelKind};
 pub use store::{load_config, raise_budget};

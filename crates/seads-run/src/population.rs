@@ -29,17 +29,20 @@ impl PopulationKey {
     fn fields(c: &TrainConfig) -> [(&'static str, String); 8] {
         let env_config = serde_json::to_string(&c.env_config).unwrap_or_default();
         [
-            ("algorithm", c.algorithm.name().to_owned()),
+            ("algorithm", c.algorithm().name().to_owned()),
             ("env", c.env.clone()),
             ("env_config", env_config),
-            ("num_skills", format!("{:?}", c.seads.num_skills)),
+            (
+                "num_skills",
+                c.seads()
+                    .map_or(String::new(), |s| format!("{:?}", s.num_skills)),
+            ),
             ("sac.hidden", format!("{:?}", c.sac.hidden)),
             (
                 "skill_model",
-                format!(
-                    "{:?} {:?}",
-                    c.seads.skill_model.kind, c.seads.skill_model.hidden
-                ),
+                c.seads().map_or(String::new(), |s| {
+                    format!("{:?} {:?}", s.skill_model.kind, s.skill_model.hidden)
+                }),
             ),
             ("portable_numerics", c.portable_numerics.to_string()),
             ("device", c.device.to_string()),
@@ -74,7 +77,8 @@ mod tests {
     fn seeds_and_rates_share_a_key_shapes_and_environments_do_not() {
         let a = TrainConfig::preset("lightsout-cursor").unwrap();
         let mut b = a.clone();
-        (b.seed, b.sac.lr, b.seads.relabel.sac_p) = (7, 1e-3, 0.0);
+        (b.seed, b.sac.lr) = (7, 1e-3);
+        b.seads_mut().unwrap().relabel.sac_p = 0.0;
         assert_eq!(PopulationKey::of(&a), PopulationKey::of(&b));
         assert_eq!(PopulationKey::mismatch(&a, &b), None);
         b.sac.hidden = vec![128, 128];

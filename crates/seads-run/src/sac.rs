@@ -20,10 +20,9 @@ pub struct SacConfig {
     pub tau: f64,
     /// Fixed entropy temperature α.
     pub alpha: f64,
-    /// Transitions per gradient step.
+    /// Transitions per gradient step (how many steps an epoch takes is the learner's: its
+    /// section's `updates_per_epoch`).
     pub batch_size: usize,
-    /// Gradient steps per epoch.
-    pub updates_per_epoch: usize,
 }
 
 impl Default for SacConfig {
@@ -35,7 +34,6 @@ impl Default for SacConfig {
             tau: 0.005,
             alpha: 0.1,
             batch_size: 128,
-            updates_per_epoch: 16,
         }
     }
 }

@@ -1,6 +1,6 @@
 //! The algorithms and their sections of a run's configuration: `[seads]`, `[sac_baseline]` and
-//! `[hac]`, each with the paper's defaults and its own checks. A run's file holds the section of
-//! its algorithm only (`config.rs`).
+//! `[hac]`, each with the paper's defaults and its own checks. A run's configuration holds its
+//! algorithm's section only: [`LearnerConfig`] is one of them, tagged by `algorithm`.
 
 use crate::{RelabelKind, RewardConfig, SkillModelConfig};
 use serde::{Deserialize, Serialize};
@@ -64,12 +64,137 @@ impl Algorithm {
     }
 }
 
+/// The learner of a run and its section: `algorithm = "seads"` reads `[seads]`, `"sac"`
+/// `[sac_baseline]`, `"hac"` `[hac]`; a section left out takes its defaults (the paper's), and any
+/// other section is an unknown field. Flattened into [`TrainConfig`](crate::TrainConfig).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(tag = "algorithm", rename_all = "lowercase", deny_unknown_fields)]
+pub enum LearnerConfig {
+    /// SEADS.
+    Seads {
+        /// Its section.
+        #[serde(default)]
+        seads: SeadsConfig,
+    },
+    /// The flat SAC baseline.
+    Sac {
+        /// Its section.
+        #[serde(default)]
+        sac_baseline: BaselineConfig,
+    },
+    /// The two-level HAC baseline.
+    Hac {
+        /// Its section.
+        #[serde(default)]
+        hac: HacConfig,
+    },
+}
+
+impl Default for LearnerConfig {
+    fn default() -> Self {
+        Self::of(Algorithm::Seads)
+    }
+}
+
+impl LearnerConfig {
+    /// `algorithm` with its section's defaults.
+    pub fn of(algorithm: Algorithm) -> Self {
+        match algorithm {
+            Algorithm::Seads => Self::Seads {
+                seads: SeadsConfig::default(),
+            },
+            Algorithm::Sac => Self::Sac {
+                sac_baseline: BaselineConfig::default(),
+            },
+            Algorithm::Hac => Self::Hac {
+                hac: HacConfig::default(),
+            },
+        }
+    }
+
+    /// Which algorithm it is.
+    pub fn algorithm(&self) -> Algorithm {
+        match self {
+            Self::Seads { .. } => Algorithm::Seads,
+            Self::Sac { .. } => Algorithm::Sac,
+            Self::Hac { .. } => Algorithm::Hac,
+        }
+    }
+
+    /// Checks every value of the section.
+    pub fn validate(&self) -> Result<(), RunError> {
+        match self {
+            Self::Seads { seads } => seads.validate(),
+            Self::Sac { sac_baseline } => sac_baseline.validate("sac_baseline"),
+            Self::Hac { hac } => hac.validate(),
+        }
+    }
+
+    /// SEADS's section, if the learner is SEADS.
+    pub fn seads(&self) -> Option<&SeadsConfig> {
+        match self {
+            Self::Seads { seads } => Some(seads),
+            _ => None,
+        }
+    }
+
+    /// SEADS's section to change, if the learner is SEADS.
+    pub fn seads_mut(&mut self) -> Option<&mut SeadsConfig> {
+        match self {
+            Self::Seads { seads } => Some(seads),
+            _ => None,
+        }
+    }
+
+    /// The SAC baseline's section, if the learner is the SAC baseline.
+    pub fn sac_baseline(&self) -> Option<&BaselineConfig> {
+        match self {
+            Self::Sac { sac_baseline } => Some(sac_baseline),
+            _ => None,
+        }
+    }
+
+    /// The SAC baseline's section to change, if the learner is the SAC baseline.
+    pub fn sac_baseline_mut(&mut self) -> Option<&mut BaselineConfig> {
+        match self {
+            Self::Sac { sac_baseline } => Some(sac_baseline),
+            _ => None,
+        }
+    }
+
+    /// HAC's section, if the learner is HAC.
+    pub fn hac(&self) -> Option<&HacConfig> {
+        match self {
+            Self::Hac { hac } => Some(hac),
+            _ => None,
+        }
+    }
+
+    /// HAC's section to change, if the learner is HAC.
+    pub fn hac_mut(&mut self) -> Option<&mut HacConfig> {
+        match self {
+            Self::Hac { hac } => Some(hac),
+            _ => None,
+        }
+    }
+
+    /// How a task-reward baseline collects and learns: `[sac_baseline]`, or HAC's share of
+    /// `[hac]`; `None` for SEADS.
+    pub fn baseline_training(&self) -> Option<BaselineConfig> {
+        match self {
+            Self::Seads { .. } => None,
+            Self::Sac { sac_baseline } => Some(sac_baseline.clone()),
+            Self::Hac { hac } => Some(hac.training()),
+        }
+    }
+}
+
 /// First seed of the skill-coverage evaluation (the paper's 444555 … 444574): SEADS's
 /// [`SeadsConfig::eval_seeds`] count from it.
 pub const COVERAGE_SEED: u64 = 444_555;
 
-/// SEADS's own settings (`[seads]`, SPEC §3): skills, episode buffers, the skill model, the
-/// intrinsic reward and relabelling. Its SAC is the shared `[sac]` section.
+/// SEADS's own settings (`[seads]`, SPEC §3): skills, episode buffers, SAC's gradient steps, the
+/// skill model, the intrinsic reward and relabelling. Its SAC's networks are the `[sac]` section.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields, default)]
 pub struct SeadsConfig {
@@ -86,6 +211,8 @@ pub struct SeadsConfig {
     pub sampled_episodes: usize,
     /// Number of evaluation seeds (444555, 444556, …) for skill coverage.
     pub eval_seeds: u64,
+    /// SAC's gradient steps per epoch (the skill model's are `skill_model.updates_per_epoch`).
+    pub updates_per_epoch: usize,
     /// Forward model (or VIC discriminator).
     pub skill_model: SkillModelConfig,
     /// Intrinsic reward.
@@ -103,6 +230,7 @@ impl Default for SeadsConfig {
             recent_episodes: 256,
             sampled_episodes: 256,
             eval_seeds: 20,
+            updates_per_epoch: 16,
             skill_model: SkillModelConfig::default(),
             reward: RewardConfig::default(),
             relabel: RelabelConfig::default(),
@@ -121,11 +249,15 @@ impl SeadsConfig {
         if self.eval_seeds == 0 {
             return bad("seads.eval_seeds must be at least 1".into());
         }
-        if self.eval_seeds > MAX_PER_EPOCH {
-            return bad(format!(
-                "seads.eval_seeds must be at most {MAX_PER_EPOCH}, got {}",
-                self.eval_seeds
-            ));
+        for (name, value) in [
+            ("eval_seeds", self.eval_seeds),
+            ("updates_per_epoch", self.updates_per_epoch as u64),
+        ] {
+            if value > MAX_PER_EPOCH {
+                return bad(format!(
+                    "seads.{name} must be at most {MAX_PER_EPOCH}, got {value}"
+                ));
+            }
         }
         for (name, value) in [
             ("episodes_per_epoch", self.episodes_per_epoch),

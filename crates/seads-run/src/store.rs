@@ -90,7 +90,7 @@ fn is_false(value: &bool) -> bool {
 pub fn write_origin(dir: &Path, config: &crate::TrainConfig) -> Result<(), RunError> {
     let origin = Origin {
         env: config.env.clone(),
-        algorithm: config.algorithm,
+        algorithm: config.algorithm(),
         carried_state: dir.join(ENVIRONMENT_FILE).is_file(),
     };
     let path = dir.join(ORIGIN);
@@ -139,14 +139,14 @@ pub fn check_origin(checkpoint: &Path, config: &crate::TrainConfig) -> Result<()
         return Ok(());
     };
     let origin: Origin = serde_json::from_str(&text).map_err(|e| RunError::unreadable(&path, e))?;
-    if origin.env != config.env || origin.algorithm != config.algorithm {
+    if origin.env != config.env || origin.algorithm != config.algorithm() {
         return Err(RunError::Checkpoint {
             path: checkpoint.display().to_string(),
             reason: format!(
                 "it was written by a {} run on {}, not a {} run on {}",
                 origin.algorithm.name(),
                 origin.env,
-                config.algorithm.name(),
+                config.algorithm().name(),
                 config.env
             ),
         });

@@ -25,7 +25,7 @@ fn every_preset_file_is_embedded_under_its_name() {
         );
         let config = TrainConfig::from_toml(&text).unwrap();
         assert_eq!(
-            (config.env.as_str(), config.algorithm.name()),
+            (config.env.as_str(), config.algorithm().name()),
             (env, algorithm),
             "{name}"
         );

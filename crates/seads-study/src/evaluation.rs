@@ -115,7 +115,11 @@ pub fn read_evaluation(path: &Path) -> Result<Option<EvaluationRecord>> {
         Err(e) => return Err(e).doing(|| format!("reading {}", path.display())),
     };
     EvaluationRecord::from_json(&text).map(Some).map_err(|e| {
-        StudyError::invalid(format!("{}: not an evaluation file: {e}", path.display()))
+        StudyError::invalid(format!(
+            "{}: not an evaluation file of today's layout (`seads migrate` rewrites older ones): \
+             {e}",
+            path.display()
+        ))
     })
 }
 

@@ -152,10 +152,11 @@ fn bad_baseline_settings_are_bad_input() {
             "[sac_baseline]\nupdates_per_epoch = 0.5\n",
             "[sac_baseline] is the section",
         ),
-        // A file of the older, flat layout is read the same way.
+        // A file of the older, flat layout is refused, pointing to `seads migrate`.
         (
             "algorithm = \"sac\"\nnum_skills = 30\n",
-            "[seads] is the section",
+            "unknown field `num_skills`, expected `sac_baseline` (a file of an older version? \
+             `seads migrate` rewrites it)",
         ),
     ] {
         let config = dir.path().join("bad.toml");

@@ -18,19 +18,15 @@ seeds = [1, 2, 3]
 
 [overrides]
 env_steps = 800
-episodes_per_epoch = 8
-sampled_episodes = 32
-recent_episodes = 16
 eval_every = 4
 checkpoint_every = 5
-eval_seeds = 1
 portable_numerics = true
 # A member's SAC takes one libtorch thread; at these tiny widths a second thread changes the
 # bits (at the presets' sizes it does not: seads-rl's tests/training.rs), so the solo runs take
 # one too.
 sac_threads_alone = 0
 sac = { hidden = [32, 32] }
-skill_model = { hidden = [32, 32] }
+seads = { episodes_per_epoch = 8, sampled_episodes = 32, recent_episodes = 16, eval_seeds = 1, skill_model = { hidden = [32, 32] } }
 
 [evaluation]
 every = 0

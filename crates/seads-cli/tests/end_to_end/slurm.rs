@@ -18,14 +18,11 @@ seeds = [1, 2]
 
 [overrides]
 env_steps = 1500
-sampled_episodes = 32
-recent_episodes = 16
 eval_every = 5
 checkpoint_every = 5
-eval_seeds = 1
 portable_numerics = true
 sac = { hidden = [32, 32] }
-skill_model = { hidden = [32, 32] }
+seads = { sampled_episodes = 32, recent_episodes = 16, eval_seeds = 1, skill_model = { hidden = [32, 32] } }
 
 [evaluation]
 boards = 1
@@ -37,7 +34,7 @@ name = "seads"
 
 [[variant]]
 name = "no-relabelling"
-overrides = { relabel = { skill_model_p = 0.0, sac_p = 0.0 } }
+overrides = { seads = { relabel = { skill_model_p = 0.0, sac_p = 0.0 } } }
 "#;
 
 fn scripts() -> PathBuf {

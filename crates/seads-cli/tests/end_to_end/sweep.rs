@@ -15,14 +15,11 @@ seeds = [1, 2]
 
 [overrides]
 env_steps = 600
-sampled_episodes = 32
-recent_episodes = 16
 eval_every = 5
 checkpoint_every = 5
-eval_seeds = 1
 portable_numerics = true
 sac = { hidden = [32, 32] }
-skill_model = { hidden = [32, 32] }
+seads = { sampled_episodes = 32, recent_episodes = 16, eval_seeds = 1, skill_model = { hidden = [32, 32] } }
 
 [evaluation]
 every = 2
@@ -36,7 +33,7 @@ name = "seads"
 
 [[variant]]
 name = "no-relabelling"
-overrides = { relabel = { skill_model_p = 0.0, sac_p = 0.0 } }
+overrides = { seads = { relabel = { skill_model_p = 0.0, sac_p = 0.0 } } }
 "#;
 
 fn write_manifest(dir: &Path, text: &str) -> PathBuf {
@@ -48,7 +45,7 @@ fn write_manifest(dir: &Path, text: &str) -> PathBuf {
 /// `MANIFEST` with SEADS alone (two seeds) and no evaluation over training.
 fn seads_only_without_evaluation_over_training() -> String {
     MANIFEST.replace("every = 2", "every = 0").replace(
-        "\n[[variant]]\nname = \"no-relabelling\"\noverrides = { relabel = { skill_model_p = 0.0, sac_p = 0.0 } }\n",
+        "\n[[variant]]\nname = \"no-relabelling\"\noverrides = { seads = { relabel = { skill_model_p = 0.0, sac_p = 0.0 } } }\n",
         "",
     )
 }

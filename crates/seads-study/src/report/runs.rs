@@ -90,7 +90,7 @@ impl RunData {
 
     /// Environment steps at the last evaluation (0 before the first).
     pub fn env_steps(&self) -> u64 {
-        match self.config.algorithm {
+        match self.config.algorithm() {
             Algorithm::Seads => self.metrics.last().map_or(0, |m| m.env_steps),
             Algorithm::Sac | Algorithm::Hac => self.task_metrics.last().map_or(0, |m| m.env_steps),
         }
@@ -105,7 +105,7 @@ impl RunData {
         let config = seads_run::load_config(dir)?;
         let skills = crate::run_skills(&config)?;
         let mut damage = Vec::new();
-        let (metrics, task_metrics) = match config.algorithm {
+        let (metrics, task_metrics) = match config.algorithm() {
             Algorithm::Seads => (metrics_or_damage::<Metrics>(dir, &mut damage), Vec::new()),
             Algorithm::Sac | Algorithm::Hac => (
                 Vec::new(),
@@ -113,7 +113,7 @@ impl RunData {
             ),
         };
         // The last epoch of training: an evaluation of the end of training names it.
-        let last_epoch = match config.algorithm {
+        let last_epoch = match config.algorithm() {
             Algorithm::Seads => metrics.last().map(|m| m.epoch),
             Algorithm::Sac | Algorithm::Hac => task_metrics.last().map(|m| m.epoch),
         };

@@ -28,7 +28,7 @@ struct Spent {
 
 /// What the run's last metrics line says, if it has one.
 fn spent(run: &RunData) -> Option<Spent> {
-    match run.config.algorithm {
+    match run.config.algorithm() {
         Algorithm::Seads => run.metrics.last().map(|m| {
             let t = &m.timings;
             Spent {

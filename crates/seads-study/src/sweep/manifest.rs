@@ -276,31 +276,17 @@ impl Manifest {
                     );
                 }
             }
-            // A manifest of an older version overrides in the flat layout.
-            let mut layer = layer.clone();
-            seads_run::upgrade_flat_layout(&mut layer, algorithm)
-                .map_err(|e| failure!("variant {:?}: {what}: {e}", variant.name))?;
-            seads_run::merge_toml(&mut table, &layer);
+            seads_run::merge_toml(&mut table, layer);
         }
         table.insert("seed".into(), toml::Value::Integer(seed as i64));
-        let config: TrainConfig =
-            toml::Value::Table(table)
-                .try_into()
-                .map_err(|e: toml::de::Error| {
-                    failure!(
-                        "variant {:?} on {env}: {}",
-                        variant.name,
-                        e.message().trim().replace('\n', " ")
-                    )
-                })?;
-        config
-            .validate()
+        let config = TrainConfig::from_table(table)
+            .and_then(|config| config.validate().map(|()| config))
             .map_err(|e| failure!("variant {:?} on {env}: {e}", variant.name))?;
         Ok(config)
     }
 }
 
-/// Writes `layer` over `base`, table by table (a nested table is merged, any other value set).
+/// Whether `name` may name a study or a variant (a folder's name).
 fn is_name(name: &str) -> bool {
     !name.is_empty()
         && name
@@ -323,11 +309,11 @@ name = "seads"
 
 [[variant]]
 name = "no-relabelling"
-overrides = { relabel = { skill_model_p = 0.0, sac_p = 0.0 } }
+overrides = { seads = { relabel = { skill_model_p = 0.0, sac_p = 0.0 } } }
 
 [[variant]]
 name = "more-skills"
-env_overrides = { "lightsout-cursor" = { num_skills = 30 }, "tileswap-cursor" = { num_skills = 15 } }
+env_overrides = { "lightsout-cursor" = { seads = { num_skills = 30 } }, "tileswap-cursor" = { seads = { num_skills = 15 } } }
 "#;
 
     #[test]
@@ -350,19 +336,25 @@ env_overrides = { "lightsout-cursor" = { num_skills = 30 }, "tileswap-cursor" = 
             assert_eq!(run.config.sac, preset.sac);
             match run.variant.as_str() {
                 "no-relabelling" => {
-                    assert_eq!(run.config.seads.relabel.sac_p, 0.0);
-                    assert_eq!(run.config.seads.relabel.skill_model_p, 0.0);
-                    assert_eq!(run.config.seads.relabel.kind, preset.seads.relabel.kind);
+                    assert_eq!(run.config.seads().unwrap().relabel.sac_p, 0.0);
+                    assert_eq!(run.config.seads().unwrap().relabel.skill_model_p, 0.0);
+                    assert_eq!(
+                        run.config.seads().unwrap().relabel.kind,
+                        preset.seads().unwrap().relabel.kind
+                    );
                 }
                 "more-skills" => assert_eq!(
-                    run.config.seads.num_skills,
+                    run.config.seads().unwrap().num_skills,
                     Some(if run.env == "lightsout-cursor" {
                         30
                     } else {
                         15
                     })
                 ),
-                _ => assert_eq!(run.config.seads.relabel, preset.seads.relabel),
+                _ => assert_eq!(
+                    run.config.seads().unwrap().relabel,
+                    preset.seads().unwrap().relabel
+                ),
             }
         }
     }
@@ -411,8 +403,8 @@ env_overrides = { "lightsout-cursor" = { num_skills = 30 }, "tileswap-cursor" = 
             ),
             (
                 SMALL.replace(
-                    "{ num_skills = 15 }",
-                    "{ num_skills = 15 }, \"lightsout-reacher\" = {}",
+                    "{ seads = { num_skills = 15 } } }",
+                    "{ seads = { num_skills = 15 } }, \"lightsout-reacher\" = {} }",
                 ),
                 "does not train",
             ),
@@ -431,8 +423,8 @@ env_overrides = { "lightsout-cursor" = { num_skills = 30 }, "tileswap-cursor" = 
         }
     }
 
-    /// Every manifest of `experiments/` and every study's committed copy (whichever layout its
-    /// overrides were written in) expands into valid runs.
+    /// Every manifest of `experiments/` and every study's committed copy (in today's layout:
+    /// `seads migrate` rewrote the older ones) expands into valid runs.
     #[test]
     fn every_shipped_and_committed_manifest_expands() {
         let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../..");
@@ -530,43 +522,57 @@ env_overrides = { "lightsout-cursor" = { num_skills = 30 }, "tileswap-cursor" = 
                         // t<tau_RB>-l<alpha_low>-h<alpha_high>.
                         let (t, rest) = v[1..].split_once("-l").unwrap();
                         let (low, high) = rest.split_once("-h").unwrap();
-                        expected.hac.temperature = t.parse().unwrap();
+                        let seads_run::LearnerConfig::Hac { hac } = &mut expected.learner else {
+                            panic!("HAC's preset")
+                        };
+                        hac.temperature = t.parse().unwrap();
+                        hac.alpha_high = high.parse().unwrap();
                         expected.sac.alpha = low.parse().unwrap();
-                        expected.hac.alpha_high = high.parse().unwrap();
                     }
                     v if m.name == "sac-grid" => {
                         // n<N>-a<alpha>, N with "_" for ".".
                         let (n, a) = v[1..].split_once("-a").unwrap();
-                        expected.sac_baseline.updates_per_epoch =
-                            n.replace('_', ".").parse().unwrap();
+                        let seads_run::LearnerConfig::Sac { sac_baseline } = &mut expected.learner
+                        else {
+                            panic!("SAC's preset")
+                        };
+                        sac_baseline.updates_per_epoch = n.replace('_', ".").parse().unwrap();
                         expected.sac.alpha = a.parse().unwrap();
                     }
                     "no-second-best-norm" => {
-                        expected.seads.reward.normalisation = seads_run::Normalisation::LogK;
+                        expected.seads_mut().unwrap().reward.normalisation =
+                            seads_run::Normalisation::LogK;
                     }
-                    "no-novelty-bonus" => expected.seads.reward.novelty_bonus = false,
+                    "no-novelty-bonus" => {
+                        expected.seads_mut().unwrap().reward.novelty_bonus = false
+                    }
                     "no-relabelling" => {
-                        expected.seads.relabel.skill_model_p = 0.0;
-                        expected.seads.relabel.sac_p = 0.0;
+                        expected.seads_mut().unwrap().relabel.skill_model_p = 0.0;
+                        expected.seads_mut().unwrap().relabel.sac_p = 0.0;
                     }
-                    "no-forward-model-relabelling" => expected.seads.relabel.skill_model_p = 0.0,
-                    "no-sac-relabelling" => expected.seads.relabel.sac_p = 0.0,
+                    "no-forward-model-relabelling" => {
+                        expected.seads_mut().unwrap().relabel.skill_model_p = 0.0
+                    }
+                    "no-sac-relabelling" => expected.seads_mut().unwrap().relabel.sac_p = 0.0,
                     "more-skills" => {
-                        expected.seads.num_skills = Some(if run.env.starts_with("lightsout") {
-                            30
-                        } else {
-                            15
-                        });
+                        expected.seads_mut().unwrap().num_skills =
+                            Some(if run.env.starts_with("lightsout") {
+                                30
+                            } else {
+                                15
+                            });
                     }
                     v if v.starts_with("vic") => {
-                        expected.seads.skill_model.kind = seads_run::SkillModelKind::Vic;
-                        expected.seads.reward.novelty_bonus = false;
+                        expected.seads_mut().unwrap().skill_model.kind =
+                            seads_run::SkillModelKind::Vic;
+                        expected.seads_mut().unwrap().reward.novelty_bonus = false;
                         if v != "vic-sbn" {
-                            expected.seads.reward.normalisation = seads_run::Normalisation::LogK;
+                            expected.seads_mut().unwrap().reward.normalisation =
+                                seads_run::Normalisation::LogK;
                         }
                         if v != "vic-relabelling" {
-                            expected.seads.relabel.skill_model_p = 0.0;
-                            expected.seads.relabel.sac_p = 0.0;
+                            expected.seads_mut().unwrap().relabel.skill_model_p = 0.0;
+                            expected.seads_mut().unwrap().relabel.sac_p = 0.0;
                         }
                     }
                     v if v.starts_with("size-") => expected.env_config = c.env_config.clone(),
