@@ -32,7 +32,7 @@ pub mod store;
 
 pub use config::{TrainConfig, config_difference, machine_memory_bytes, merge_toml};
 pub use device::{ComputeDevice, DeviceError};
-pub use metrics::{Metrics, TaskMetrics, TaskTimings, Timings, read_metrics};
+pub use metrics::{Metrics, MetricsRecord, TaskMetrics, TaskTimings, Timings, read_metrics};
 pub use population::{PopulationKey, check_population};
 pub use sac::SacConfig;
 pub use sections::{

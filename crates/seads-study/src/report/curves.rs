@@ -121,13 +121,13 @@ fn curves(group: &Group<'_>) -> Vec<Curve> {
     group
         .runs
         .iter()
-        .filter(|r| !r.metrics.is_empty())
         .map(|r| {
-            r.metrics
+            r.lines
                 .iter()
-                .map(|m| (m.env_steps, m.skill_coverage))
-                .collect()
+                .filter_map(|m| Some((m.env_steps, m.skill_coverage?)))
+                .collect::<Curve>()
         })
+        .filter(|curve| !curve.is_empty())
         .collect()
 }
 

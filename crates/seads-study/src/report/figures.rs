@@ -142,9 +142,9 @@ pub fn coverage_figures(
                 .runs
                 .iter()
                 .map(|r| {
-                    r.metrics
+                    r.lines
                         .iter()
-                        .map(|m| (m.epoch, m.env_steps as f64, m.skill_coverage))
+                        .filter_map(|m| Some((m.epoch, m.env_steps as f64, m.skill_coverage?)))
                         .collect()
                 })
                 .collect();
@@ -175,12 +175,13 @@ pub fn coverage_figures(
 /// policy as it trains (`metrics.jsonl`); a SEADS run has what `seads evaluate --checkpoints`
 /// added (with re-planning, depths pooled). Empty for a run not evaluated over training.
 fn success_series(run: &RunData) -> Vec<(u64, f64, f64)> {
-    if !run.task_metrics.is_empty() {
-        return run
-            .task_metrics
-            .iter()
-            .map(|m| (m.epoch, m.env_steps as f64, 100.0 * m.mean_success))
-            .collect();
+    let measured: Vec<(u64, f64, f64)> = run
+        .lines
+        .iter()
+        .filter_map(|m| Some((m.epoch, m.env_steps as f64, 100.0 * m.mean_success?)))
+        .collect();
+    if !measured.is_empty() {
+        return measured;
     }
     run.over_training
         .iter()

@@ -9,7 +9,7 @@ use crate::{Context as _, Result};
 use seads_planner::{
     DepthResult, EvaluationKind, Evaluator, Protocol, STANDARD_DEPTHS, SearchLimits,
 };
-use seads_run::{Algorithm, Metrics, TaskMetrics, TrainConfig};
+use seads_run::{MetricsRecord, TrainConfig};
 
 use crate::evaluation::CheckpointEvaluation;
 use crate::sweep::Sweep;
@@ -39,10 +39,9 @@ pub struct RunData {
     pub config: TrainConfig,
     /// Its number of skills K ([`crate::run_skills`]).
     pub skills: usize,
-    /// Skill-coverage evaluations (SEADS).
-    pub metrics: Vec<Metrics>,
-    /// Task-success evaluations over training (the SAC baseline).
-    pub task_metrics: Vec<TaskMetrics>,
+    /// The lines of its `metrics.jsonl`, whichever learner wrote them: skill coverage (SEADS),
+    /// task success over training (the baselines), wall time and phases.
+    pub lines: Vec<MetricsRecord>,
     /// Final task success of a baseline's policy acting alone, if any.
     pub policy: Option<Vec<DepthResult>>,
     /// Final task evaluation with re-planning, if any.
@@ -90,33 +89,21 @@ impl RunData {
 
     /// Environment steps at the last evaluation (0 before the first).
     pub fn env_steps(&self) -> u64 {
-        match self.config.algorithm() {
-            Algorithm::Seads => self.metrics.last().map_or(0, |m| m.env_steps),
-            Algorithm::Sac | Algorithm::Hac => self.task_metrics.last().map_or(0, |m| m.env_steps),
-        }
+        self.lines.last().map_or(0, |m| m.env_steps)
     }
 
     /// Skill coverage at the end of training.
     pub fn final_coverage(&self) -> Option<f64> {
-        self.metrics.last().map(|m| m.skill_coverage)
+        self.lines.last().and_then(|m| m.skill_coverage)
     }
 
     fn load(dir: &Path, variant: String, copy_to: PathBuf) -> Result<Self> {
         let config = seads_run::load_config(dir)?;
         let skills = crate::run_skills(&config)?;
         let mut damage = Vec::new();
-        let (metrics, task_metrics) = match config.algorithm() {
-            Algorithm::Seads => (metrics_or_damage::<Metrics>(dir, &mut damage), Vec::new()),
-            Algorithm::Sac | Algorithm::Hac => (
-                Vec::new(),
-                metrics_or_damage::<TaskMetrics>(dir, &mut damage),
-            ),
-        };
+        let lines = metrics_or_damage(dir, &mut damage);
         // The last epoch of training: an evaluation of the end of training names it.
-        let last_epoch = match config.algorithm() {
-            Algorithm::Seads => metrics.last().map(|m| m.epoch),
-            Algorithm::Sac | Algorithm::Hac => task_metrics.last().map(|m| m.epoch),
-        };
+        let last_epoch = lines.last().map(|m| m.epoch);
         let mut evaluation_notes = Vec::new();
         let mut unrecorded_evaluations = 0;
         let mut evaluated_by = Evaluators::default();
@@ -224,8 +211,7 @@ impl RunData {
             evaluated_by,
             config,
             skills,
-            metrics,
-            task_metrics,
+            lines,
         })
     }
 }
@@ -361,11 +347,8 @@ fn deep_search(further: &[(Protocol, Vec<DepthResult>)]) -> Option<DeepSearch> {
 
 /// The metrics lines of the run in `dir`; none without a metrics file (not started), and none
 /// with the reason added to `damage` when the file exists but cannot be read.
-fn metrics_or_damage<M: seads_run::store::MetricsLine>(
-    dir: &Path,
-    damage: &mut Vec<String>,
-) -> Vec<M> {
-    match seads_run::store::read_metrics_as::<M>(dir) {
+fn metrics_or_damage(dir: &Path, damage: &mut Vec<String>) -> Vec<MetricsRecord> {
+    match seads_run::store::read_metrics_as(dir) {
         Ok(lines) => lines,
         Err(e) => {
             if dir.join("metrics.jsonl").exists() {
@@ -567,8 +550,7 @@ pub(crate) fn bare_run(seed: u32) -> RunData {
         variant: "seads".into(),
         config: TrainConfig::default(),
         skills: 25,
-        metrics: Vec::new(),
-        task_metrics: Vec::new(),
+        lines: Vec::new(),
         policy: None,
         replan: None,
         plan_once: None,

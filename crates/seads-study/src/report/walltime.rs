@@ -3,18 +3,18 @@
 
 use std::fmt::Write as _;
 
-use seads_run::Algorithm;
-
 use super::csv_field;
 use super::runs::{Group, RunData};
 
-/// The phases a metrics line times, in table order.
-const PHASES: [&str; 5] = [
-    "collect",
-    "relabel",
-    "skill model",
-    "SAC updates",
-    "evaluate",
+/// The phases the learners' metrics lines time (the names in their `timings`), in table order,
+/// with their names in the table. A phase not listed here gets a column of its own after these,
+/// named as its line names it.
+const KNOWN_PHASES: [(&str, &str); 5] = [
+    ("collect", "collect"),
+    ("relabel", "relabel"),
+    ("skill_model", "skill model"),
+    ("sac", "SAC updates"),
+    ("evaluate", "evaluate"),
 ];
 
 /// One run's training time.
@@ -22,36 +22,34 @@ const PHASES: [&str; 5] = [
 struct Spent {
     wall_s: f64,
     env_steps: u64,
-    /// Seconds per phase of `PHASES`; `None` where the algorithm has no such phase.
-    phases: [Option<f64>; 5],
+    /// Seconds per phase, by the line's names.
+    phases: std::collections::BTreeMap<String, f64>,
 }
 
 /// What the run's last metrics line says, if it has one.
 fn spent(run: &RunData) -> Option<Spent> {
-    match run.config.algorithm() {
-        Algorithm::Seads => run.metrics.last().map(|m| {
-            let t = &m.timings;
-            Spent {
-                wall_s: m.wall_s,
-                env_steps: m.env_steps,
-                phases: [
-                    Some(t.collect),
-                    Some(t.relabel),
-                    Some(t.skill_model),
-                    Some(t.sac),
-                    Some(t.evaluate),
-                ],
+    run.lines.last().map(|m| Spent {
+        wall_s: m.wall_s,
+        env_steps: m.env_steps,
+        phases: m.timings.clone(),
+    })
+}
+
+/// The phases of the table: the known ones, then any other that a run's line times, as
+/// (the line's name, the table's name).
+fn phases(groups: &[Group<'_>]) -> Vec<(String, String)> {
+    let mut phases: Vec<(String, String)> = KNOWN_PHASES
+        .iter()
+        .map(|(key, name)| ((*key).to_owned(), (*name).to_owned()))
+        .collect();
+    for run in groups.iter().flat_map(|g| &g.runs) {
+        for key in run.lines.last().into_iter().flat_map(|m| m.timings.keys()) {
+            if !phases.iter().any(|(k, _)| k == key) {
+                phases.push((key.clone(), key.replace('_', " ")));
             }
-        }),
-        Algorithm::Sac | Algorithm::Hac => run.task_metrics.last().map(|m| {
-            let t = &m.timings;
-            Spent {
-                wall_s: m.wall_s,
-                env_steps: m.env_steps,
-                phases: [Some(t.collect), None, None, Some(t.sac), Some(t.evaluate)],
-            }
-        }),
+        }
     }
+    phases
 }
 
 fn mean(values: impl Iterator<Item = f64>) -> Option<f64> {
@@ -60,17 +58,18 @@ fn mean(values: impl Iterator<Item = f64>) -> Option<f64> {
 
 /// The wall-time table (markdown, one row per group) and its CSV (one row per run).
 pub fn walltime_tables(groups: &[Group<'_>]) -> (String, String) {
+    let phases = phases(groups);
     let mut md = String::from(
         "| environment | variant | runs | wall time (min): mean [min, max] | env steps/s |",
     );
-    for p in PHASES {
+    for (_, p) in &phases {
         let _ = write!(md, " {p} (min) |");
     }
     md += "\n|---|---|---|---|---|";
-    md += &"---|".repeat(PHASES.len());
+    md += &"---|".repeat(phases.len());
     md.push('\n');
     let mut csv = String::from("env,variant,run,wall_s,env_steps");
-    for p in PHASES {
+    for (_, p) in &phases {
         let _ = write!(csv, ",{}_s", p.replace(' ', "_").to_lowercase());
     }
     csv += ",processor\n";
@@ -94,8 +93,9 @@ pub fn walltime_tables(groups: &[Group<'_>]) -> (String, String) {
                 s.wall_s,
                 s.env_steps
             );
-            for p in s.phases {
-                let _ = write!(csv, ",{}", p.map_or(String::new(), |v| v.to_string()));
+            for (key, _) in &phases {
+                let seconds = s.phases.get(key);
+                let _ = write!(csv, ",{}", seconds.map_or(String::new(), |v| v.to_string()));
             }
             // Wall times depend on the processor: which trained the run ("; " between several).
             let processor = if run.processors.is_empty() {
@@ -124,11 +124,13 @@ pub fn walltime_tables(groups: &[Group<'_>]) -> (String, String) {
             minutes(Some(hi)),
             rate.map_or("–".to_owned(), |r| format!("{r:.0}"))
         );
-        for i in 0..PHASES.len() {
+        for (key, _) in &phases {
             let _ = write!(
                 md,
                 " {} |",
-                minutes(mean(spent.iter().filter_map(|(_, s)| s.phases[i])))
+                minutes(mean(
+                    spent.iter().filter_map(|(_, s)| s.phases.get(key).copied())
+                ))
             );
         }
         md.push('\n');
@@ -155,7 +157,7 @@ mod tests {
                         "sac": wall - 90.0, "evaluate": 6.0},
         });
         RunData {
-            metrics: vec![serde_json::from_value(line).unwrap()],
+            lines: vec![serde_json::from_value(line).unwrap()],
             processors: if seed == 1 {
                 vec!["AMD EPYC, 9554".into(), "Intel(R) Xeon(R)".into()]
             } else {
