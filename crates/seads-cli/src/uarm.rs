@@ -348,23 +348,16 @@ fn run_settings(run: &Path, space: ActionSpace) -> Result<RobotSettings> {
     }))
 }
 
-/// Interactions of a new robot run unless `--env-steps` says otherwise: the paper's 5000 with
-/// absolute pushes (seed S.5).
-const DEFAULT_ENV_STEPS: u64 = 5000;
-
-/// The training settings of the robot (seed S.5): the Cursor's, with SAC α = 0.1 and, for
-/// absolute pushes, 4 new episodes per epoch.
+/// The training settings of a new robot run: its action space's preset
+/// (`configs/uarm-lightsout-<space>.toml`, the paper's robot settings), with the options given.
 fn robot_config(env: &UarmEnv, args: &UarmTrainArgs) -> Result<TrainConfig> {
-    let mut config = TrainConfig::preset("lightsout-cursor")?;
-    config.env = env.spec().name.clone();
-    config.env_steps = args.env_steps.unwrap_or(DEFAULT_ENV_STEPS);
+    let mut config = TrainConfig::preset(&env.spec().name)?;
+    if let Some(steps) = args.env_steps {
+        config.env_steps = steps;
+    }
     config.seed = args.seed;
-    config.sac.alpha = 0.1;
     let training = &args.training;
     if let Some(seads) = config.seads_mut() {
-        if args.action_space == ActionSpace::Absolute {
-            seads.episodes_per_epoch = 4;
-        }
         if let Some(n) = training.updates_per_epoch {
             seads.updates_per_epoch = n as usize;
         }
@@ -385,7 +378,7 @@ pub fn train(mut args: UarmTrainArgs) -> Result<()> {
     let portable = if args.resume {
         load_config(&args.out)?.portable_numerics
     } else {
-        TrainConfig::preset("lightsout-cursor")?.portable_numerics
+        TrainConfig::preset(args.action_space.env_name())?.portable_numerics
     };
     crate::kernels::use_kernels(portable)?;
     if args.resume {

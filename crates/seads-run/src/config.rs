@@ -155,9 +155,13 @@ impl TrainConfig {
             .find(|(name, _)| *name == env)
             .map(|(_, text)| *text)
             .ok_or_else(|| {
+                let names: Vec<&str> = Self::presets_of(algorithm)
+                    .iter()
+                    .map(|(name, _)| *name)
+                    .collect();
                 RunError::Config(format!(
                     "unknown environment {env:?}; valid environments: {}",
-                    env_names().join(", ")
+                    names.join(", ")
                 ))
             })?;
         Self::from_toml(text)
@@ -191,8 +195,7 @@ impl TrainConfig {
     /// `env` (or `env` is given here), and what it leaves out comes from that environment's
     /// preset of its `algorithm` (or the given one; SEADS where none is named), never from
     /// generic defaults. Unknown fields, bad values and another algorithm's section are errors
-    /// naming the line or the field. The robot's environments (`uarm-…`) have no preset; their
-    /// runs write the whole configuration, taken as written.
+    /// naming the line or the field, and so is an environment with no preset.
     ///
     /// ```
     /// use seads_run::TrainConfig;
@@ -241,11 +244,6 @@ impl TrainConfig {
                 env_names().join(", ")
             )));
         };
-        // Environments outside the registry (the robot's) have no preset: their runs write the
-        // whole configuration, which is taken as written.
-        if is_robot_env(&env) {
-            return Self::from_table(table);
-        }
         let preset = Self::preset_for(&env, algorithm)?;
         let mut merged: toml::Table = preset
             .to_toml()
@@ -413,12 +411,6 @@ impl TrainConfig {
             ))
         })
     }
-}
-
-/// Whether `env` names one of the robot's environments (`uarm-…`), which are outside the
-/// registry of simulated environments and have no preset.
-fn is_robot_env(env: &str) -> bool {
-    !env_names().contains(&env) && env.starts_with("uarm-")
 }
 
 /// The machine's memory in bytes (`MemTotal` of `/proc/meminfo`), or `u64::MAX` where it
@@ -639,7 +631,34 @@ mod tests {
                 presets += 1;
             }
         }
-        assert_eq!(presets, 36);
+        assert_eq!(presets, 38);
+    }
+
+    /// The robot's presets (seed S.5) are the LightsOutCursor preset with 5000 interactions,
+    /// SAC α = 0.1 and, with absolute pushes, 4 new episodes an epoch: the settings the binary
+    /// built in code before they were presets.
+    #[test]
+    fn the_robots_presets_are_the_cursors_with_the_papers_robot_settings() {
+        let cursor = TrainConfig::preset("lightsout-cursor").unwrap();
+        for (env, episodes) in [
+            ("uarm-lightsout-absolute", 4),
+            ("uarm-lightsout-displacement", 32),
+        ] {
+            let mut expected = cursor.clone();
+            expected.env = env.into();
+            expected.env_steps = 5000;
+            expected.sac.alpha = 0.1;
+            expected.seads_mut().unwrap().episodes_per_epoch = episodes;
+            assert_eq!(TrainConfig::preset(env).unwrap(), expected);
+        }
+        // A name with no preset is an error that lists the ones there are.
+        let e = TrainConfig::from_user_toml("env = \"uarm-lightsout\"", None, None).unwrap_err();
+        assert!(
+            e.to_string()
+                .contains("unknown environment \"uarm-lightsout\"")
+                && e.to_string().contains("uarm-lightsout-absolute"),
+            "{e}"
+        );
     }
 
     /// Another algorithm's section, the older flat layout and `[sac] updates_per_epoch` are
