@@ -1,55 +1,64 @@
-//! The presets: every file of `configs/` (`<env>.toml` for SEADS, `sac-<env>.toml` and
-//! `hac-<env>.toml` for the baselines) is embedded, found by its name, so that a new
-//! environment's preset is a new file and nothing else (`$OUT_DIR/presets.rs`, included by
-//! `src/config.rs`).
+//! The presets: every file of `configs/` is embedded, found by its path, so that a new
+//! environment's or learner's preset is a new file and nothing else (`$OUT_DIR/presets.rs`,
+//! included by `src/config.rs`):
+//! - `configs/<env>.toml`: the environment's preset, with SEADS (the paper's learner);
+//! - `configs/<algorithm>/<env>.toml`: another learner's preset on that environment;
+//! - `configs/<algorithm>/every-env.toml`: a learner's settings on every environment, laid over
+//!   the environment's preset where the learner has no preset of its own there.
 
 #![allow(clippy::print_stdout)] // a build script talks to cargo on stdout
+
+use std::path::{Path, PathBuf};
 
 fn main() {
     println!("cargo:rerun-if-changed=build.rs");
     presets();
 }
 
-/// Writes `$OUT_DIR/presets.rs`: one table per algorithm of `(environment, TOML text)`, sorted by
-/// environment, every `configs/*.toml` in one of them by its name.
+/// Writes `$OUT_DIR/presets.rs`: `PRESETS`, every `(algorithm, environment, TOML text)`, sorted;
+/// a learner's settings on every environment have the environment `*`.
 fn presets() {
     let manifest = std::env::var("CARGO_MANIFEST_DIR").expect("cargo sets CARGO_MANIFEST_DIR");
-    let dir = std::path::Path::new(&manifest).join("configs");
+    let dir = Path::new(&manifest).join("configs");
     println!("cargo:rerun-if-changed={}", dir.display());
-    let mut tables: [(&str, Vec<(String, String)>); 3] = [
-        ("PRESETS", vec![]),
-        ("SAC_PRESETS", vec![]),
-        ("HAC_PRESETS", vec![]),
-    ];
-    let entries = std::fs::read_dir(&dir).expect("crates/seads-run/configs holds the presets");
+    let mut entries: Vec<(String, String, String)> = vec![];
+    for (path, algorithm) in toml_files(&dir, "seads") {
+        println!("cargo:rerun-if-changed={}", path.display());
+        let stem = path
+            .file_stem()
+            .and_then(|n| n.to_str())
+            .expect("a UTF-8 file name");
+        let env = if stem == "every-env" { "*" } else { stem };
+        entries.push((algorithm, env.to_owned(), path.display().to_string()));
+    }
+    entries.sort();
+    let mut code = String::from("// Written by build.rs from the files of configs/.\n");
+    code += "const PRESETS: &[(&str, &str, &str)] = &[\n";
+    for (algorithm, env, path) in entries {
+        code += &format!("    ({algorithm:?}, {env:?}, include_str!({path:?})),\n");
+    }
+    code += "];\n";
+    let out = Path::new(&std::env::var("OUT_DIR").expect("cargo sets OUT_DIR")).join("presets.rs");
+    std::fs::write(out, code).expect("OUT_DIR is writable");
+}
+
+/// The `.toml` files of `dir` with their algorithm: `algorithm` for the files in `dir` itself,
+/// a folder's name for the files in that folder.
+fn toml_files(dir: &Path, algorithm: &str) -> Vec<(PathBuf, String)> {
+    let mut files = vec![];
+    let entries = std::fs::read_dir(dir).expect("crates/seads-run/configs holds the presets");
     for entry in entries {
         let path = entry.expect("a readable configs folder").path();
-        let Some(stem) = path
-            .file_name()
-            .and_then(|n| n.to_str())
-            .and_then(|n| n.strip_suffix(".toml"))
-        else {
-            continue;
-        };
-        let (table, env) = match stem.split_once('-') {
-            Some(("sac", env)) => (1, env),
-            Some(("hac", env)) => (2, env),
-            _ => (0, stem),
-        };
-        tables[table]
-            .1
-            .push((env.to_owned(), path.display().to_string()));
-    }
-    let mut code = String::from("// Written by build.rs from the files of configs/.\n");
-    for (name, mut entries) in tables {
-        entries.sort();
-        code += &format!("const {name}: &[(&str, &str)] = &[\n");
-        for (env, path) in entries {
-            code += &format!("    ({env:?}, include_str!({path:?})),\n");
+        if path.is_dir() {
+            println!("cargo:rerun-if-changed={}", path.display());
+            let name = path
+                .file_name()
+                .and_then(|n| n.to_str())
+                .expect("a UTF-8 folder name");
+            files.extend(toml_files(&path, name));
+        } else if path.extension().is_some_and(|e| e == "toml") {
+            files.push((path, algorithm.to_owned()));
         }
-        code += "];\n";
     }
-    let out = std::path::Path::new(&std::env::var("OUT_DIR").expect("cargo sets OUT_DIR"))
-        .join("presets.rs");
-    std::fs::write(out, code).expect("OUT_DIR is writable");
+    files
 }

@@ -71,11 +71,11 @@ pub fn run(args: RunArgs) -> Result<()> {
         let lock = crate::lock_run(&args.out)?;
         let config = crate::run_config(&args.out)?;
         agrees_with_run(&args, &config)?;
-        if config.algorithm() != seads_rl::Algorithm::Seads {
+        if !config.is::<seads_rl::SeadsConfig>() {
             return Err(BadInput(anyhow::anyhow!(
                 "{} is a run of {}, not SEADS: resume it with seads train --resume",
                 args.out.display(),
-                config.algorithm().name()
+                config.algorithm()
             ))
             .into());
         }

@@ -11,7 +11,43 @@ use std::path::{Path, PathBuf};
 
 use anyhow::{Context, Result, anyhow, bail};
 use clap::Args;
-use seads_rl::{Algorithm, BaselineConfig, HacConfig, SeadsConfig, TrainConfig};
+use seads_rl::{BaselineConfig, HacConfig, SeadsConfig, Section, TrainConfig};
+
+/// The learners the older layouts knew (they knew no others).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+enum Algorithm {
+    #[default]
+    Seads,
+    Sac,
+    Hac,
+}
+
+impl Algorithm {
+    const ALL: [Algorithm; 3] = [Algorithm::Seads, Algorithm::Sac, Algorithm::Hac];
+
+    /// Its name in configurations.
+    fn name(self) -> &'static str {
+        match self {
+            Algorithm::Seads => SeadsConfig::ALGORITHM,
+            Algorithm::Sac => BaselineConfig::ALGORITHM,
+            Algorithm::Hac => HacConfig::ALGORITHM,
+        }
+    }
+
+    /// Its section's name.
+    fn section(self) -> &'static str {
+        match self {
+            Algorithm::Seads => SeadsConfig::NAME,
+            Algorithm::Sac => BaselineConfig::NAME,
+            Algorithm::Hac => HacConfig::NAME,
+        }
+    }
+
+    /// The learner of this name, if the older layouts knew it.
+    fn named(name: &str) -> Option<Self> {
+        Self::ALL.into_iter().find(|a| a.name() == name)
+    }
+}
 
 use crate::BadInput;
 
@@ -346,7 +382,7 @@ fn item_table(item: &toml_edit::Item) -> Result<toml::Table> {
 
 /// Replaces a manifest's table with `table`, inline where it was inline.
 fn replace_item(item: &mut toml_edit::Item, table: &toml::Table) -> Result<()> {
-    let text = toml::Value::Table(table.clone()).to_string();
+    let text = toml::Value::Table(sorted(table)).to_string();
     let value: toml_edit::Value = text.parse()?;
     match item {
         toml_edit::Item::Value(old) => {
@@ -362,6 +398,21 @@ fn replace_item(item: &mut toml_edit::Item, table: &toml::Table) -> Result<()> {
         }
     }
     Ok(())
+}
+
+/// `table` with its keys in order, at every depth: how the migrated manifests were written.
+fn sorted(table: &toml::Table) -> toml::Table {
+    let mut keys: Vec<&String> = table.keys().collect();
+    keys.sort();
+    keys.into_iter()
+        .map(|key| {
+            let value = match &table[key] {
+                toml::Value::Table(inner) => toml::Value::Table(sorted(inner)),
+                other => other.clone(),
+            };
+            (key.clone(), value)
+        })
+        .collect()
 }
 
 /// Upgrades one manifest layer of `algorithm`, rewriting it only where it changes.
@@ -483,9 +534,12 @@ mod tests {
         let old = old.replace("num_skills = 25\n", "");
         let new = migrate_config(&old).unwrap().unwrap();
         let config = TrainConfig::from_toml(&new).unwrap();
-        assert_eq!(config.algorithm(), Algorithm::Sac);
+        assert_eq!(config.algorithm(), "sac");
         assert_eq!(
-            config.learner.sac_baseline().unwrap().updates_per_epoch,
+            config
+                .section::<BaselineConfig>()
+                .unwrap()
+                .updates_per_epoch,
             0.5
         );
         assert_eq!(config.sac.hidden, [512, 512, 512]);

@@ -6,9 +6,7 @@ use std::path::PathBuf;
 use anyhow::{Context, Result};
 use clap::Args;
 use seads_rl::store::MetricsLine as _;
-use seads_rl::{
-    Algorithm, ComputeDevice, Hook, InWords, Learner, Moment, Run, TrainConfig, WithLearner,
-};
+use seads_rl::{ComputeDevice, Hook, InWords, Learner, Moment, Run, TrainConfig, WithLearner};
 
 use crate::BadInput;
 
@@ -18,12 +16,13 @@ pub struct TrainArgs {
     /// Environment to train on, with its preset (the paper's settings; see `seads envs`).
     #[arg(long, required_unless_present_any = ["resume", "config"])]
     env: Option<String>,
-    /// What to train: `seads`, or a baseline with the task reward: flat SAC (`sac`, SPEC §5.1;
-    /// presets `configs/sac-*.toml`) or two-level HAC (`hac`, SPEC §5.2; presets
-    /// `configs/hac-*.toml`). Default: the config's, else seads.
+    /// What to train, a learner of the registry (`seads_rl::learners`): `seads`, or a baseline
+    /// with the task reward: flat SAC (`sac`, SPEC §5.1; presets `configs/sac/*.toml`) or
+    /// two-level HAC (`hac`, SPEC §5.2; presets `configs/hac/*.toml`). Default: the config's,
+    /// else seads.
     #[arg(
         long,
-        value_parser = clap::builder::PossibleValuesParser::new(Algorithm::names()),
+        value_parser = clap::builder::PossibleValuesParser::new(seads_rl::learners::names()),
         conflicts_with = "resume"
     )]
     algorithm: Option<String>,
@@ -61,12 +60,17 @@ fn config(args: &TrainArgs) -> Result<TrainConfig> {
             let text = std::fs::read_to_string(path)
                 .map_err(|e| BadInput(anyhow::anyhow!("reading {}: {e}", path.display())))?;
             // What the file leaves out comes from its environment's preset.
-            let algorithm = args.algorithm.as_deref().map(|a| algorithm(Some(a)));
-            TrainConfig::from_user_toml(&text, env.as_deref(), algorithm)
+            TrainConfig::from_user_toml(&text, env.as_deref(), args.algorithm.as_deref())
                 .map_err(|e| BadInput(anyhow::anyhow!("{}: {e}", path.display())))?
         }
-        (None, Some(env)) => TrainConfig::preset_for(env, algorithm(args.algorithm.as_deref()))
-            .map_err(|e| BadInput(e.into()))?,
+        (None, Some(env)) => {
+            let algorithm = args.algorithm.as_deref();
+            TrainConfig::preset_for(
+                env,
+                algorithm.unwrap_or(<seads_rl::SeadsConfig as seads_rl::Section>::ALGORITHM),
+            )
+            .map_err(|e| BadInput(e.into()))?
+        }
         (None, None) => unreachable!("clap requires --env or --config"),
     };
     if let Some(seed) = args.seed {
@@ -80,12 +84,8 @@ fn config(args: &TrainArgs) -> Result<TrainConfig> {
     }
     crate::usable_device(config.device)?;
     config.validate().map_err(|e| BadInput(e.into()))?;
+    seads_rl::learners::complete(&mut config).map_err(|e| BadInput(e.into()))?;
     Ok(config)
-}
-
-/// The algorithm named on the command line (clap checked the name), SEADS where none is.
-fn algorithm(name: Option<&str>) -> Algorithm {
-    name.and_then(Algorithm::named).unwrap_or_default()
 }
 
 /// Runs `seads train`.
@@ -114,20 +114,21 @@ pub fn train(args: TrainArgs) -> Result<()> {
                     device,
                     quiet: args.quiet,
                 },
-            )
+            )?
         }
         None => {
             let config = config(&args)?;
             crate::kernels::use_kernels(config.portable_numerics)?;
             let out = args.out.as_ref().expect("clap requires --out");
+            let algorithm = config.algorithm().to_owned();
             seads_rl::with_learner(
-                config.algorithm(),
+                &algorithm,
                 Create {
                     out,
                     config,
                     quiet: args.quiet,
                 },
-            )
+            )?
         }
     }
 }

@@ -357,14 +357,14 @@ fn robot_config(env: &UarmEnv, args: &UarmTrainArgs) -> Result<TrainConfig> {
     }
     config.seed = args.seed;
     let training = &args.training;
-    if let Some(seads) = config.seads_mut() {
+    config.edit(|seads: &mut seads_rl::SeadsConfig| {
         if let Some(n) = training.updates_per_epoch {
             seads.updates_per_epoch = n as usize;
         }
         if let Some(n) = training.episodes_per_epoch {
             seads.episodes_per_epoch = n as usize;
         }
-    }
+    })?;
     if let Some(alpha) = training.alpha {
         config.sac.alpha = alpha;
     }

@@ -18,12 +18,17 @@ static RUN: LazyLock<tempfile::TempDir> = LazyLock::new(|| {
     let mut config = seads_rl::TrainConfig::preset("lightsout-cursor").unwrap();
     config.env_steps = 6000;
     config.sac.hidden = vec![64, 64];
-    config.seads_mut().unwrap().skill_model.hidden = vec![64, 64];
-    config.seads_mut().unwrap().sampled_episodes = 64;
-    config.seads_mut().unwrap().recent_episodes = 32;
+    config
+        .edit(|s: &mut seads_rl::SeadsConfig| {
+            s.skill_model.hidden = vec![64, 64];
+            (s.sampled_episodes, s.recent_episodes) = (64, 32);
+        })
+        .unwrap();
     config.eval_every = 50;
     config.checkpoint_every = 50;
-    config.seads_mut().unwrap().eval_seeds = 2;
+    config
+        .edit(|s: &mut seads_rl::SeadsConfig| s.eval_seeds = 2)
+        .unwrap();
     config.sac_threads_alone = 0;
     config.portable_numerics = true;
     let run_dir = dir.path().join("run");

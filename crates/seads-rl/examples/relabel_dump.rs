@@ -61,7 +61,9 @@ fn main() -> Result<()> {
     config.seed = args.seed;
     config.env_steps = args.env_steps;
     if args.skills.is_some() {
-        config.seads_mut().unwrap().num_skills = args.skills;
+        config
+            .edit(|s: &mut seads_rl::SeadsConfig| s.num_skills = args.skills)
+            .unwrap();
     }
     let mut trainer = Trainer::new(config)?;
     // The observer runs on the calling thread of `run_epoch`; it records only chosen epochs.

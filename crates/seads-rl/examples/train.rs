@@ -17,10 +17,10 @@ fn run(steps: u64, dir: &Path) -> Result<f64, RlError> {
     config.env_steps = steps;
     config.sac.hidden = vec![64, 64];
     (config.eval_every, config.checkpoint_every) = (10, 10);
-    if let Some(seads) = config.seads_mut() {
+    config.edit(|seads: &mut seads_rl::SeadsConfig| {
         seads.skill_model.hidden = vec![64, 64];
         seads.eval_seeds = 4;
-    }
+    })?;
     let mut run = Run::<Trainer>::create(dir, config)?;
     while !run.finished() {
         let event = run.step()?;

@@ -125,7 +125,7 @@ impl Agent {
         // network size) would evaluate another agent than the one trained, so it is refused as
         // a resume refuses it.
         crate::store::check_config(checkpoint, &config)?;
-        let seads = config.seads_section()?;
+        let seads = config.seads()?;
         let k = seads.num_skills.unwrap_or(spec.num_skills);
         let device = config.device.resolve()?;
         let mut sac = Sac::new(
@@ -193,7 +193,7 @@ pub fn load_policy(
             spec: &spec,
             checkpoint,
         },
-    )
+    )?
 }
 
 /// [`load_policy`]'s work with the run's learner.

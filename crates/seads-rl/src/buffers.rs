@@ -322,23 +322,27 @@ mod tests {
 
     fn config(sampled: usize, recent: usize, capacity: usize) -> TrainConfig {
         let mut config = TrainConfig::default();
-        let seads = config.seads_mut().unwrap();
-        seads.sampled_episodes = sampled;
-        seads.recent_episodes = recent;
-        seads.buffer_capacity = capacity;
-        seads.relabel.sac_p = 1.0;
+        config
+            .edit(|seads: &mut SeadsConfig| {
+                seads.sampled_episodes = sampled;
+                seads.recent_episodes = recent;
+                seads.buffer_capacity = capacity;
+                seads.relabel.sac_p = 1.0;
+            })
+            .unwrap();
         config
     }
 
     /// Buffers of K = 2 skills over `episodes`.
     fn buffers<'a>(
         config: &'a TrainConfig,
+        seads: &'a SeadsConfig,
         episodes: &'a mut VecDeque<Episode>,
         rng: &'a mut ChaCha8Rng,
     ) -> Buffers<'a> {
         Buffers {
             config,
-            seads: config.seads().unwrap(),
+            seads,
             k: 2,
             episodes,
             rng,
@@ -359,7 +363,8 @@ mod tests {
     fn the_oldest_episodes_are_evicted_and_updates_wait_for_a_full_batch() {
         let config = config(3, 1, 3);
         let (mut episodes, mut rng) = (VecDeque::new(), ChaCha8Rng::seed_from_u64(0));
-        let mut buffers = buffers(&config, &mut episodes, &mut rng);
+        let seads = config.seads().unwrap();
+        let mut buffers = buffers(&config, &seads, &mut episodes, &mut rng);
         buffers.push((0..2).map(|s| episode(s, 1, 0.0, None)).collect());
         assert!(!buffers.ready());
         buffers.push((2..5).map(|s| episode(s, 1, 0.0, None)).collect());
@@ -378,7 +383,8 @@ mod tests {
         let mut episodes: VecDeque<Episode> =
             [episode(0, 2, 10.0, Some(0)), episode(1, 1, 20.0, None)].into();
         let mut rng = ChaCha8Rng::seed_from_u64(0);
-        let buffers = buffers(&config, &mut episodes, &mut rng);
+        let seads = config.seads().unwrap();
+        let buffers = buffers(&config, &seads, &mut episodes, &mut rng);
         let rows = buffers.transition_batch(
             &spec(),
             &[0, 1],
@@ -404,11 +410,14 @@ mod tests {
     fn only_board_changing_episodes_are_scored_and_relabelled() {
         let mut config = config(2, 1, 8);
         config.sac.batch_size = 64;
-        config.seads_mut().unwrap().updates_per_epoch = 1;
+        config
+            .edit(|s: &mut SeadsConfig| s.updates_per_epoch = 1)
+            .unwrap();
         let mut episodes: VecDeque<Episode> =
             [episode(0, 2, 10.0, Some(0)), episode(1, 1, 20.0, None)].into();
         let mut rng = ChaCha8Rng::seed_from_u64(0);
-        let mut buffers = buffers(&config, &mut episodes, &mut rng);
+        let seads = config.seads().unwrap();
+        let mut buffers = buffers(&config, &seads, &mut episodes, &mut rng);
         let (minibatches, mean_reward) = buffers.sac_minibatches(&MoveIsSkill { k: 2 }, &spec());
         let r0 = -(1.0f64 + (-10.0f64).exp()).ln() + 2.0 * 2f64.ln();
         let minimum = -2.0 * 2f64.ln();
@@ -440,7 +449,8 @@ mod tests {
         let mut episodes: VecDeque<Episode> =
             [episode(1, 1, 0.0, Some(0)), episode(0, 1, 0.0, Some(1))].into();
         let mut rng = ChaCha8Rng::seed_from_u64(0);
-        let mut buffers = buffers(&config, &mut episodes, &mut rng);
+        let seads = config.seads().unwrap();
+        let mut buffers = buffers(&config, &seads, &mut episodes, &mut rng);
         let tuples = buffers.skill_model_batch(&MoveIsSkill { k: 2 });
         let mut labels: Vec<usize> = tuples.iter().map(|t| t.skill).collect();
         assert_eq!(labels[0], 0);

@@ -244,13 +244,8 @@ fn game_goal(spec: &EnvSpec) -> Result<SymbolicState, RlError> {
 }
 
 /// The run's HAC section: another algorithm's configuration is an error.
-fn hac_section(config: &TrainConfig) -> Result<&HacConfig, RlError> {
-    config.learner.hac().ok_or_else(|| {
-        RlError::config(format!(
-            "a {} run has no [hac] section: it is no HAC run",
-            config.algorithm().name()
-        ))
-    })
+fn hac_section(config: &TrainConfig) -> Result<HacConfig, RlError> {
+    Ok(config.section::<HacConfig>()?)
 }
 
 /// The two levels' networks for `config` on an environment of `spec`.
@@ -744,6 +739,7 @@ impl TaskPolicy for HacPolicy<'_> {
 }
 
 impl Learner for Hac {
+    type Section = crate::HacConfig;
     type Stats = TaskEpochStats;
     type Metrics = TaskMetrics;
 
@@ -813,14 +809,12 @@ mod tests {
     use super::*;
 
     fn small(test_p: f64) -> TrainConfig {
-        let mut config =
-            TrainConfig::preset_for("lightsout-cursor", crate::Algorithm::Hac).unwrap();
+        let mut config = TrainConfig::preset_for("lightsout-cursor", "hac").unwrap();
         config.sac.hidden = vec![16];
         config.sac.batch_size = 16;
-        let crate::LearnerConfig::Hac { hac } = &mut config.learner else {
-            unreachable!("HAC's preset")
-        };
-        (hac.subgoal_horizon, hac.subgoal_test_p) = (4, test_p);
+        config
+            .edit(|hac: &mut HacConfig| (hac.subgoal_horizon, hac.subgoal_test_p) = (4, test_p))
+            .unwrap();
         config.portable_numerics = true;
         config
     }

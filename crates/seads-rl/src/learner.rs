@@ -12,6 +12,9 @@ use crate::{RlError, TrainConfig};
 /// What a [`Run`](crate::Run) drives: an agent in training whose whole state a checkpoint folder holds.
 /// [`Trainer`](crate::Trainer) (SEADS) and [`TaskSac`](crate::TaskSac) (the task-reward baseline) are learners.
 pub trait Learner: Sized {
+    /// Its section of the configuration, whose [`Section::ALGORITHM`](seads_run::Section) is the
+    /// learner's name in the registry ([`learners`](crate::learners)).
+    type Section: seads_run::Section;
     /// What one epoch reports.
     type Stats: Clone + Send;
     /// One line of `metrics.jsonl`.

@@ -18,10 +18,11 @@
 //! // The paper's LightsOutCursor settings, shrunk so that the example runs in seconds.
 //! let mut config = TrainConfig::preset("lightsout-cursor")?;
 //! config.sac.hidden = vec![32, 32];
-//! let seads = config.seads_mut().expect("SEADS's preset has a [seads] section");
-//! seads.skill_model.hidden = vec![32, 32];
-//! (seads.sampled_episodes, seads.recent_episodes) = (32, 16);
-//! seads.eval_seeds = 2;
+//! config.edit(|seads: &mut seads_rl::SeadsConfig| {
+//!     seads.skill_model.hidden = vec![32, 32];
+//!     (seads.sampled_episodes, seads.recent_episodes) = (32, 16);
+//!     seads.eval_seeds = 2;
+//! })?;
 //! let mut trainer = Trainer::new(config)?;
 //! for _ in 0..3 {
 //!     let stats = trainer.run_epoch()?; // collect 32 episodes, relabel, update the model and SAC
@@ -43,7 +44,7 @@ mod episode;
 mod hac;
 mod in_words;
 mod learner;
-mod learners;
+pub mod learners;
 mod metrics;
 mod numerics;
 mod population;
@@ -82,10 +83,10 @@ pub use trainer::{COVERAGE_SEED, EpochStats, Trainer};
 // A run's data (configuration, directory, metrics lines) is `seads-run`'s, re-exported here for
 // the learners and their users.
 pub use seads_run::{
-    Algorithm, BaselineConfig, ComputeDevice, DeviceError, HacConfig, LearnerConfig, Metrics,
-    PopulationKey, RelabelConfig, RunError, SacConfig, SeadsConfig, TaskMetrics, TaskTimings,
-    Timings, TrainConfig, check_population, load_config, machine_memory_bytes, merge_toml,
-    raise_budget, read_metrics, store,
+    BaselineConfig, ComputeDevice, DeviceError, HacConfig, LearnerConfig, Metrics, PopulationKey,
+    RelabelConfig, RunError, SacConfig, SeadsConfig, Section, TaskMetrics, TaskTimings, Timings,
+    TrainConfig, check_population, learner_names, load_config, machine_memory_bytes, merge_toml,
+    raise_budget, read_metrics, section_name, store,
 };
 
 /// Sets the number of libtorch intra-op threads of the process.

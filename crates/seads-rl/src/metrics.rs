@@ -6,6 +6,7 @@ use crate::learner::{Learner, Moment};
 use crate::{EpochStats, Metrics, RlError, TrainConfig, Trainer};
 
 impl Learner for Trainer {
+    type Section = crate::SeadsConfig;
     type Stats = EpochStats;
     type Metrics = Metrics;
 

@@ -225,6 +225,7 @@ impl TaskSac {
 }
 
 impl Learner for TaskSac {
+    type Section = crate::BaselineConfig;
     type Stats = TaskEpochStats;
     type Metrics = TaskMetrics;
 

@@ -115,7 +115,7 @@ impl Trainer {
         eval_env: Box<dyn Environment>,
     ) -> Result<Self, RlError> {
         config.validate_values()?;
-        let seads = config.seads_section()?.clone();
+        let seads = config.seads()?;
         crate::numerics::check(config.portable_numerics)?;
         if config.threads > 0 {
             tch::set_num_threads(config.threads as i32);

@@ -5,31 +5,35 @@
 use seads_planner::TaskSet;
 use seads_rl::store::read_metrics_as;
 use seads_rl::{
-    Algorithm, Hac, Learner, Run, TaskMetrics, TaskSac, TrainConfig, task_success, updates_due,
+    BaselineConfig, Hac, HacConfig, Learner, Run, TaskMetrics, TaskSac, TrainConfig, task_success,
+    updates_due,
 };
 
 /// A small baseline run on LightsOutCursor: 8 environments, one update per epoch once 32
 /// transitions are stored.
 fn small(seed: u64, steps: u64) -> TrainConfig {
-    small_of(Algorithm::Sac, seed, steps)
+    small_of("sac", seed, steps)
 }
 
-fn small_of(algorithm: Algorithm, seed: u64, steps: u64) -> TrainConfig {
+fn small_of(algorithm: &str, seed: u64, steps: u64) -> TrainConfig {
     let mut config = TrainConfig::preset_for("lightsout-cursor", algorithm).unwrap();
     config.seed = seed;
     config.env_steps = steps;
     config.sac.hidden = vec![32, 32];
     config.sac.batch_size = 32;
-    if let Some(training) = config.learner.sac_baseline_mut() {
-        training.eval_boards = 2;
+    if config.is::<BaselineConfig>() {
+        config
+            .edit(|s: &mut BaselineConfig| s.eval_boards = 2)
+            .unwrap();
     }
     config.eval_every = 20;
     config.checkpoint_every = 20;
     config.portable_numerics = true;
     // Subgoals of 7 steps in episodes of 10·S: checkpoints fall inside subgoal attempts.
-    if algorithm == Algorithm::Hac {
-        config.learner.hac_mut().unwrap().eval_boards = 2;
-        config.learner.hac_mut().unwrap().subgoal_horizon = 7;
+    if config.is::<HacConfig>() {
+        config
+            .edit(|hac: &mut HacConfig| (hac.eval_boards, hac.subgoal_horizon) = (2, 7))
+            .unwrap();
     }
     config
 }
@@ -77,7 +81,7 @@ fn whole_run<L: Learner<Metrics = TaskMetrics>>(config: TrainConfig) -> Vec<Numb
 }
 
 /// Two runs of one seed are the same run, bit for bit; another seed is another run.
-fn a_seed_gives_the_same_run<L: Learner<Metrics = TaskMetrics>>(algorithm: Algorithm) {
+fn a_seed_gives_the_same_run<L: Learner<Metrics = TaskMetrics>>(algorithm: &str) {
     let a = whole_run::<L>(small_of(algorithm, 4, 480));
     assert_eq!(
         a.len(),
@@ -90,18 +94,18 @@ fn a_seed_gives_the_same_run<L: Learner<Metrics = TaskMetrics>>(algorithm: Algor
 
 #[test]
 fn a_seed_gives_the_same_sac_run() {
-    a_seed_gives_the_same_run::<TaskSac>(Algorithm::Sac);
+    a_seed_gives_the_same_run::<TaskSac>("sac");
 }
 
 #[test]
 fn a_seed_gives_the_same_hac_run() {
-    a_seed_gives_the_same_run::<Hac>(Algorithm::Hac);
+    a_seed_gives_the_same_run::<Hac>("hac");
 }
 
 /// A run stopped after its epoch-40 checkpoint and resumed in a new process state (a fresh
 /// `Run`) ends exactly as the uninterrupted run: the replay buffers, the streams, the open
 /// episodes (replayed from their seeds and actions) and HAC's subgoals are all restored.
-fn a_resumed_run_is_the_uninterrupted_run<L: Learner<Metrics = TaskMetrics>>(algorithm: Algorithm) {
+fn a_resumed_run_is_the_uninterrupted_run<L: Learner<Metrics = TaskMetrics>>(algorithm: &str) {
     let config = || small_of(algorithm, 6, 800);
     let whole = whole_run::<L>(config());
     let parted = tempfile::tempdir().unwrap();
@@ -124,12 +128,12 @@ fn a_resumed_run_is_the_uninterrupted_run<L: Learner<Metrics = TaskMetrics>>(alg
 
 #[test]
 fn a_resumed_sac_run_is_the_uninterrupted_run() {
-    a_resumed_run_is_the_uninterrupted_run::<TaskSac>(Algorithm::Sac);
+    a_resumed_run_is_the_uninterrupted_run::<TaskSac>("sac");
 }
 
 #[test]
 fn a_resumed_hac_run_is_the_uninterrupted_run() {
-    a_resumed_run_is_the_uninterrupted_run::<Hac>(Algorithm::Hac);
+    a_resumed_run_is_the_uninterrupted_run::<Hac>("hac");
 }
 
 /// Task success runs the SEADS protocol's test boards: every depth 1–5, the requested number of
@@ -182,14 +186,14 @@ fn presets_carry_the_seeds_best_settings() {
         ("tileswap-jaco", 0.5, 0.0001),
     ];
     assert_eq!(
-        TrainConfig::sac_presets().len(),
+        TrainConfig::preset_envs("sac").len(),
         12,
         "and LightsOut3DJaco, sliding-cursor and -reacher, and the three -reacher3"
     );
     for (env, n, alpha) in best {
-        let c = TrainConfig::preset_for(env, Algorithm::Sac).unwrap();
+        let c = TrainConfig::preset_for(env, "sac").unwrap();
         c.validate().unwrap();
-        assert_eq!(c.algorithm(), Algorithm::Sac);
+        assert_eq!(c.algorithm(), "sac");
         assert_eq!(c.env, env);
         assert_eq!(c.sac.hidden, [512, 512, 512]);
         assert_eq!(
@@ -198,7 +202,7 @@ fn presets_carry_the_seeds_best_settings() {
         );
         assert_eq!(
             (
-                c.learner.sac_baseline().unwrap().updates_per_epoch,
+                c.section::<BaselineConfig>().unwrap().updates_per_epoch,
                 c.sac.alpha
             ),
             (n, alpha),
@@ -206,8 +210,8 @@ fn presets_carry_the_seeds_best_settings() {
         );
         assert_eq!(
             (
-                c.learner.sac_baseline().unwrap().replay_capacity,
-                c.learner.sac_baseline().unwrap().samples_per_epoch
+                c.section::<BaselineConfig>().unwrap().replay_capacity,
+                c.section::<BaselineConfig>().unwrap().samples_per_epoch
             ),
             (1_000_000, 8)
         );
@@ -224,7 +228,7 @@ fn presets_carry_the_seeds_best_settings() {
 /// included, and reads back equal.
 #[test]
 fn configs_round_trip_through_toml() {
-    let sac = TrainConfig::preset_for("tileswap-cursor", Algorithm::Sac).unwrap();
+    let sac = TrainConfig::preset_for("tileswap-cursor", "sac").unwrap();
     let text = sac.to_toml();
     assert!(
         text.contains("[sac_baseline]") && text.contains("updates_per_epoch = 1.0"),
@@ -264,7 +268,7 @@ fn hac_presets_carry_the_seeds_best_settings() {
     ];
     // The paper's seven, the sliding puzzle's two with its TileSwap counterparts' settings, and
     // the three-link arm's three with the two-link Reacher's.
-    assert_eq!(TrainConfig::hac_presets().len(), 12);
+    assert_eq!(TrainConfig::preset_envs("hac").len(), 12);
     for (sliding, tileswap) in [
         ("sliding-cursor", "tileswap-cursor"),
         ("sliding-reacher", "tileswap-reacher"),
@@ -272,35 +276,35 @@ fn hac_presets_carry_the_seeds_best_settings() {
         ("tileswap-reacher3", "tileswap-reacher"),
         ("sliding-reacher3", "tileswap-reacher"),
     ] {
-        let a = TrainConfig::preset_for(sliding, Algorithm::Hac).unwrap();
-        let b = TrainConfig::preset_for(tileswap, Algorithm::Hac).unwrap();
+        let a = TrainConfig::preset_for(sliding, "hac").unwrap();
+        let b = TrainConfig::preset_for(tileswap, "hac").unwrap();
         assert_eq!(
-            (a.learner.hac().unwrap().temperature, a.sac.alpha),
-            (b.learner.hac().unwrap().temperature, b.sac.alpha)
+            (a.section::<HacConfig>().unwrap().temperature, a.sac.alpha),
+            (b.section::<HacConfig>().unwrap().temperature, b.sac.alpha)
         );
     }
     for (env, temperature, alpha_low, alpha_high) in best {
-        let c = TrainConfig::preset_for(env, Algorithm::Hac).unwrap();
+        let c = TrainConfig::preset_for(env, "hac").unwrap();
         c.validate().unwrap();
-        assert_eq!((c.algorithm(), c.env.as_str()), (Algorithm::Hac, env));
+        assert_eq!((c.algorithm(), c.env.as_str()), ("hac", env));
         assert_eq!(c.sac.hidden, [512, 512]);
         assert_eq!((c.sac.lr, c.sac.gamma, c.sac.tau), (3e-4, 0.99, 0.005));
         assert_eq!(
             (
-                c.learner.hac().unwrap().temperature,
+                c.section::<HacConfig>().unwrap().temperature,
                 c.sac.alpha,
-                c.learner.hac().unwrap().alpha_high
+                c.section::<HacConfig>().unwrap().alpha_high
             ),
             (temperature, alpha_low, alpha_high),
             "{env}"
         );
         // A subgoal gets the steps of one skill: T_max = 10 (Cursor) or 50.
         let horizon = if env.ends_with("cursor") { 10 } else { 50 };
-        assert_eq!(c.learner.hac().unwrap().subgoal_horizon, horizon);
-        let sac = TrainConfig::preset_for(env, Algorithm::Sac).unwrap();
+        assert_eq!(c.section::<HacConfig>().unwrap().subgoal_horizon, horizon);
+        let sac = TrainConfig::preset_for(env, "sac").unwrap();
         assert_eq!(
-            c.learner.hac().unwrap().training(),
-            sac.learner.sac_baseline().unwrap().clone(),
+            c.section::<HacConfig>().unwrap().training(),
+            sac.section::<BaselineConfig>().unwrap(),
             "{env}: N and the buffer as for SAC"
         );
         assert_eq!(c.env_steps, sac.env_steps);
@@ -310,8 +314,8 @@ fn hac_presets_carry_the_seeds_best_settings() {
 /// A HAC config.toml names all of `[hac]`, defaults included, and reads back equal.
 #[test]
 fn hac_configs_round_trip_through_toml() {
-    let mut hac = TrainConfig::preset_for("lightsout-cursor", Algorithm::Hac).unwrap();
-    hac.learner = seads_rl::LearnerConfig::of(Algorithm::Hac);
+    let mut hac = TrainConfig::preset_for("lightsout-cursor", "hac").unwrap();
+    hac.learner = seads_rl::LearnerConfig::of(&HacConfig::default()).unwrap();
     let text = hac.to_toml();
     assert!(
         text.contains("[hac]") && text.contains("replay_capacity = 1000000"),
@@ -331,7 +335,10 @@ fn bad_baseline_settings_are_refused() {
         let e = TrainConfig::from_toml(text).unwrap_err().to_string();
         assert!(e.contains(needle), "{text:?}: {e}");
     };
-    refused("algorithm = \"ppo\"", "unknown variant");
+    refused(
+        "algorithm = \"ppo\"",
+        "unknown learner \"ppo\" (one of hac, sac, seads)",
+    );
     refused(
         "algorithm = \"hac\"\n[hac]\ntemperature = 0.0",
         "hac.temperature",
@@ -393,7 +400,7 @@ fn bad_baseline_settings_are_refused() {
 /// solved task within T_lim.
 #[test]
 fn hac_task_success_covers_every_depth() {
-    let config = small_of(Algorithm::Hac, 1, 800);
+    let config = small_of("hac", 1, 800);
     let agent = Hac::new(config.clone()).unwrap();
     let results = task_success(
         &config,

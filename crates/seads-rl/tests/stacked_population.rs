@@ -16,7 +16,9 @@ mod common;
 fn small(seed: u64) -> TrainConfig {
     let mut config = common::small(seed, 2500);
     config.sac.hidden = vec![32, 32];
-    config.seads_mut().unwrap().skill_model.hidden = vec![32, 32];
+    config
+        .edit(|s: &mut seads_rl::SeadsConfig| s.skill_model.hidden = vec![32, 32])
+        .unwrap();
     (config.eval_every, config.checkpoint_every) = (4, 4);
     config
 }

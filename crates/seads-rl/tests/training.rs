@@ -4,7 +4,9 @@
 use rand::{RngExt, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use seads_rl::store::{checkpoints, latest_checkpoint};
-use seads_rl::{RlError, Run, Sac, SacConfig, TrainConfig, Trainer, TransitionBatch, read_metrics};
+use seads_rl::{
+    RlError, Run, Sac, SacConfig, SeadsConfig, TrainConfig, Trainer, TransitionBatch, read_metrics,
+};
 use tch::Device;
 
 mod common;
@@ -415,16 +417,19 @@ fn bad_configurations_are_rejected_with_a_reason() {
         ("sac.alpha", |c| c.sac.alpha = 0.0),
         ("sac.gamma", |c| c.sac.gamma = 1.5),
         ("skill_model.lr", |c| {
-            c.seads_mut().unwrap().skill_model.lr = -1.0
+            c.edit(|s: &mut SeadsConfig| s.skill_model.lr = -1.0)
+                .unwrap()
         }),
         ("relabel.sac_p", |c| {
-            c.seads_mut().unwrap().relabel.sac_p = 2.0
+            c.edit(|s: &mut SeadsConfig| s.relabel.sac_p = 2.0).unwrap()
         }),
         ("episodes_per_epoch", |c| {
-            c.seads_mut().unwrap().episodes_per_epoch = 0
+            c.edit(|s: &mut SeadsConfig| s.episodes_per_epoch = 0)
+                .unwrap()
         }),
         ("buffer_capacity", |c| {
-            c.seads_mut().unwrap().sampled_episodes = c.seads_mut().unwrap().buffer_capacity + 1
+            c.edit(|s: &mut SeadsConfig| s.sampled_episodes = s.buffer_capacity + 1)
+                .unwrap()
         }),
     ];
     for (needle, edit) in cases {
@@ -447,9 +452,9 @@ fn bad_configurations_are_rejected_with_a_reason() {
 
 #[test]
 fn presets_parse_and_round_trip() {
-    for (env, text) in TrainConfig::presets() {
-        let config = TrainConfig::from_toml(text).unwrap();
-        assert_eq!(&config.env, env);
+    for (env, config) in TrainConfig::presets_of("seads") {
+        let config = config.unwrap();
+        assert_eq!(config.env, env);
         assert_eq!(TrainConfig::from_toml(&config.to_toml()).unwrap(), config);
         // The robot's presets are the Cursor's (seed S.5).
         let expected_alpha = if env.contains("cursor") || env.starts_with("uarm-") {
@@ -491,19 +496,24 @@ fn every_committed_run_config_loads() {
         let stated: toml::Table = text.parse().unwrap();
         assert_eq!(
             stated.get("algorithm").and_then(|a| a.as_str()),
-            Some(config.algorithm().name()),
+            Some(config.algorithm()),
             "{}",
             path.display()
         );
-        for other in seads_rl::Algorithm::ALL {
-            assert_eq!(
-                stated.contains_key(other.section()),
-                other == config.algorithm(),
-                "{}: [{}]",
-                path.display(),
-                other.section()
-            );
-        }
+        let sections: Vec<&String> = stated
+            .iter()
+            .filter(|(key, value)| {
+                value.is_table() && !["env_config", "sac"].contains(&key.as_str())
+            })
+            .map(|(key, _)| key)
+            .collect();
+        assert_eq!(
+            sections,
+            [seads_rl::section_name(config.algorithm()).unwrap()],
+            "{}",
+            path.display()
+        );
+        seads_rl::learners::check(&config).unwrap();
         assert_eq!(TrainConfig::from_toml(&config.to_toml()).unwrap(), config);
         // As a run directory is read (the file laid over its preset): every command that opens
         // the run, `seads report` among them.

@@ -5,14 +5,15 @@ use crate::ComputeDevice;
 use seads_embodiment::{EnvConfig, env_names};
 use serde::{Deserialize, Serialize};
 
-use crate::sections::{Algorithm, BaselineConfig, LearnerConfig, SeadsConfig};
+use crate::sections::{BaselineConfig, HacConfig, LearnerConfig, SeadsConfig, Section};
 use crate::{RunError, SacConfig};
 
 /// Everything a training run needs: the run's own settings (environment, seed, budget,
 /// evaluation and checkpoint cadence, threads, numerics, device), the soft actor-critic's
 /// networks and optimiser that every algorithm trains (`[sac]`; HAC's low level), and its
-/// learner: `algorithm` and that algorithm's section only (`[seads]`, `[sac_baseline]` or
-/// `[hac]`, [`LearnerConfig`]). `Default` is the LightsOutCursor preset of the paper.
+/// learner: `algorithm` and that learner's section only ([`LearnerConfig`]: `[seads]`,
+/// `[sac_baseline]`, `[hac]`, or another learner's). `Default` is the LightsOutCursor preset of
+/// the paper.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(default)]
 pub struct TrainConfig {
@@ -76,10 +77,49 @@ impl Default for TrainConfig {
     }
 }
 
-// The shipped presets, the paper's settings per environment: `PRESETS` (SEADS,
-// `configs/<env>.toml`), `SAC_PRESETS` (`configs/sac-<env>.toml`) and `HAC_PRESETS`
-// (`configs/hac-<env>.toml`), each `(environment, TOML text)`, found by file name (build.rs).
+// The shipped presets, `PRESETS`: every `(algorithm, environment, TOML text)`, found by path
+// (build.rs): SEADS's `configs/<env>.toml`, another learner's `configs/<algorithm>/<env>.toml`,
+// and a learner's settings on every environment, `configs/<algorithm>/every-env.toml` (the
+// environment `*`).
 include!(concat!(env!("OUT_DIR"), "/presets.rs"));
+
+/// The environment of a learner's settings on every environment (`every-env.toml`).
+const EVERY_ENV: &str = "*";
+
+/// Every learner with presets, by name, and the name of its section (from its presets: the one
+/// table besides the run's own). The learners a configuration may name.
+static LEARNERS: std::sync::LazyLock<std::collections::BTreeMap<&'static str, String>> =
+    std::sync::LazyLock::new(|| {
+        let mut learners = std::collections::BTreeMap::new();
+        for &(algorithm, _, text) in PRESETS {
+            let table: toml::Table = text.parse().expect("a shipped preset parses");
+            let section = table
+                .iter()
+                .find(|(key, value)| value.is_table() && !RUN_TABLES.contains(&key.as_str()))
+                .map(|(key, _)| key.clone());
+            if let Some(section) = section {
+                learners.entry(algorithm).or_insert(section);
+            }
+        }
+        learners
+    });
+
+/// The tables of a configuration that are the run's own, not its learner's.
+const RUN_TABLES: [&str; 2] = ["env_config", "sac"];
+
+/// The names of the learners a configuration may name (those with presets), sorted.
+///
+/// ```
+/// assert_eq!(seads_run::learner_names(), ["hac", "sac", "seads"]);
+/// ```
+pub fn learner_names() -> Vec<&'static str> {
+    LEARNERS.keys().copied().collect()
+}
+
+/// The name of learner `algorithm`'s section, if it is a learner with presets.
+pub fn section_name(algorithm: &str) -> Option<&'static str> {
+    LEARNERS.get(algorithm).map(String::as_str)
+}
 
 impl TrainConfig {
     /// Sets the libtorch threads for a run with `cores` cores to itself. SEADS: two training
@@ -88,19 +128,20 @@ impl TrainConfig {
     /// `cores`.
     ///
     /// ```
-    /// use seads_run::{Algorithm, TrainConfig};
+    /// use seads_run::{BaselineConfig, TrainConfig};
     /// let mut config = TrainConfig::default();
     /// config.use_cores(4);
     /// assert_eq!((config.threads, config.sac_threads_alone), (2, 4));
     /// config.use_cores(1);
     /// assert_eq!((config.threads, config.sac_threads_alone), (1, 0));
-    /// let mut baseline = TrainConfig::default().with_algorithm(Algorithm::Sac);
+    /// let mut baseline = TrainConfig::default().with_section(&BaselineConfig::default())?;
     /// baseline.use_cores(4);
     /// assert_eq!((baseline.threads, baseline.sac_threads_alone), (4, 0));
+    /// # Ok::<(), seads_run::RunError>(())
     /// ```
     pub fn use_cores(&mut self, cores: usize) {
         let cores = cores.max(1);
-        if self.algorithm() != Algorithm::Seads {
+        if !self.is::<SeadsConfig>() {
             self.threads = cores;
             self.sac_threads_alone = 0;
             return;
@@ -109,86 +150,107 @@ impl TrainConfig {
         self.sac_threads_alone = if cores >= 2 { cores } else { 0 };
     }
 
-    /// Which algorithm the run trains.
-    pub fn algorithm(&self) -> Algorithm {
+    /// The learner the run trains (`algorithm`).
+    pub fn algorithm(&self) -> &str {
         self.learner.algorithm()
     }
 
-    /// SEADS's section, if the run trains SEADS.
-    pub fn seads(&self) -> Option<&SeadsConfig> {
-        self.learner.seads()
+    /// Whether the run trains the learner of section `S`.
+    pub fn is<S: Section>(&self) -> bool {
+        self.learner.is::<S>()
     }
 
-    /// SEADS's section, for a learner that must be SEADS: another algorithm's configuration is
-    /// an error.
-    pub fn seads_section(&self) -> Result<&SeadsConfig, RunError> {
-        self.seads().ok_or_else(|| {
-            RunError::Config(format!(
-                "a {} run has no [seads] section: it is no SEADS run",
-                self.algorithm().name()
-            ))
+    /// The learner's section, typed and checked ([`LearnerConfig::section`]).
+    pub fn section<S: Section>(&self) -> Result<S, RunError> {
+        self.learner.section()
+    }
+
+    /// SEADS's section, for a run that must be SEADS: another learner's configuration is an
+    /// error.
+    pub fn seads(&self) -> Result<SeadsConfig, RunError> {
+        self.section()
+    }
+
+    /// Changes the learner's section ([`LearnerConfig::edit`]).
+    pub fn edit<S: Section>(&mut self, edit: impl FnOnce(&mut S)) -> Result<(), RunError> {
+        self.learner.edit(edit)
+    }
+
+    /// These settings with the learner of `section` in place of the run's
+    /// ([`LearnerConfig::of`]).
+    pub fn with_section<S: Section>(self, section: &S) -> Result<Self, RunError> {
+        Ok(Self {
+            learner: LearnerConfig::of(section)?,
+            ..self
         })
     }
 
-    /// SEADS's section to change, if the run trains SEADS.
-    pub fn seads_mut(&mut self) -> Option<&mut SeadsConfig> {
-        self.learner.seads_mut()
-    }
-
-    /// These settings with `algorithm` and its section's defaults in place of the learner.
-    pub fn with_algorithm(self, algorithm: Algorithm) -> Self {
-        Self {
-            learner: LearnerConfig::of(algorithm),
-            ..self
-        }
-    }
-
-    /// The preset of environment `env` (the paper's settings).
+    /// The preset of environment `env` (the paper's settings, SEADS).
     pub fn preset(env: &str) -> Result<Self, RunError> {
-        Self::preset_for(env, Algorithm::Seads)
+        Self::preset_for(env, SeadsConfig::ALGORITHM)
     }
 
-    /// The preset of `algorithm` on environment `env`.
-    pub fn preset_for(env: &str, algorithm: Algorithm) -> Result<Self, RunError> {
-        let text = Self::presets_of(algorithm)
-            .iter()
-            .find(|(name, _)| *name == env)
-            .map(|(_, text)| *text)
-            .ok_or_else(|| {
-                let names: Vec<&str> = Self::presets_of(algorithm)
-                    .iter()
-                    .map(|(name, _)| *name)
-                    .collect();
-                RunError::Config(format!(
-                    "unknown environment {env:?}; valid environments: {}",
-                    names.join(", ")
-                ))
-            })?;
-        Self::from_toml(text)
-    }
-
-    /// Every preset of `algorithm`, as `(environment, TOML text)`.
-    pub fn presets_of(algorithm: Algorithm) -> &'static [(&'static str, &'static str)] {
-        match algorithm {
-            Algorithm::Seads => PRESETS,
-            Algorithm::Sac => SAC_PRESETS,
-            Algorithm::Hac => HAC_PRESETS,
+    /// The preset of learner `algorithm` on environment `env`: its own preset there
+    /// (`configs/<algorithm>/<env>.toml`), else the environment's with the learner's settings on
+    /// every environment laid over it in place of SEADS's section
+    /// (`configs/<algorithm>/every-env.toml`).
+    pub fn preset_for(env: &str, algorithm: &str) -> Result<Self, RunError> {
+        let find = |algorithm: &str, env: &str| {
+            PRESETS
+                .iter()
+                .find(|(a, e, _)| *a == algorithm && *e == env)
+                .map(|(_, _, text)| *text)
+        };
+        if section_name(algorithm).is_none() {
+            return Err(unknown_learner(algorithm));
         }
+        if let Some(text) = find(algorithm, env) {
+            return Self::from_toml(text);
+        }
+        let (Some(base), Some(layer)) = (
+            find(SeadsConfig::ALGORITHM, env),
+            find(algorithm, EVERY_ENV),
+        ) else {
+            return Err(RunError::Config(format!(
+                "unknown environment {env:?}; valid environments for {algorithm}: {}",
+                Self::preset_envs(algorithm).join(", ")
+            )));
+        };
+        let mut table: toml::Table = base.parse().expect("a shipped preset parses");
+        table.remove(SeadsConfig::NAME);
+        merge_toml(&mut table, &layer.parse().expect("a shipped preset parses"));
+        Self::from_table(table)
     }
 
-    /// Every SEADS preset, as `(environment, TOML text)`.
-    pub fn presets() -> &'static [(&'static str, &'static str)] {
+    /// The environments with a preset of learner `algorithm`, sorted.
+    pub fn preset_envs(algorithm: &str) -> Vec<&'static str> {
+        let every_env = PRESETS
+            .iter()
+            .any(|(a, e, _)| *a == algorithm && *e == EVERY_ENV);
+        let mut envs: Vec<&str> = PRESETS
+            .iter()
+            .filter(|(a, e, _)| {
+                *e != EVERY_ENV && (*a == algorithm || (every_env && *a == SeadsConfig::ALGORITHM))
+            })
+            .map(|(_, e, _)| *e)
+            .collect();
+        envs.sort_unstable();
+        envs.dedup();
+        envs
+    }
+
+    /// Every preset of learner `algorithm`, as `(environment, configuration)`.
+    pub fn presets_of(algorithm: &str) -> Vec<(&'static str, Result<Self, RunError>)> {
+        Self::preset_envs(algorithm)
+            .into_iter()
+            .map(|env| (env, Self::preset_for(env, algorithm)))
+            .collect()
+    }
+
+    /// Every shipped preset file's text, as `(algorithm, environment, TOML text)`; the
+    /// environment `*` for a learner's settings on every environment.
+    pub fn preset_files() -> &'static [(&'static str, &'static str, &'static str)] {
         PRESETS
-    }
-
-    /// Every preset of the SAC baseline, as `(environment, TOML text)`.
-    pub fn sac_presets() -> &'static [(&'static str, &'static str)] {
-        SAC_PRESETS
-    }
-
-    /// Every preset of the HAC baseline, as `(environment, TOML text)`.
-    pub fn hac_presets() -> &'static [(&'static str, &'static str)] {
-        HAC_PRESETS
     }
 
     /// A configuration a user wrote (a `--config` file, a run's `config.toml`): it must name its
@@ -212,17 +274,18 @@ impl TrainConfig {
     pub fn from_user_toml(
         text: &str,
         env: Option<&str>,
-        algorithm: Option<Algorithm>,
+        algorithm: Option<&str>,
     ) -> Result<Self, RunError> {
         let mut table = parse_table(text)?;
         let stated = algorithm_of(&table)?;
+        let stated = stated.as_deref();
         // Fields and types first, with the user's line numbers (the algorithm in force named
         // ahead of the text where the text names none).
         if stated.is_none() || algorithm.is_none_or(|a| Some(a) == stated) {
-            let named = algorithm.or(stated).unwrap_or_default();
+            let named = algorithm.or(stated).unwrap_or(SeadsConfig::ALGORITHM);
             let prefix = match stated {
                 Some(_) => String::new(),
-                None => format!("algorithm = \"{}\"\n", named.name()),
+                None => format!("algorithm = \"{named}\"\n"),
             };
             check_sections(&table, named)?;
             toml::from_str::<Self>(&format!("{prefix}{text}"))
@@ -231,11 +294,8 @@ impl TrainConfig {
         if let Some(env) = env {
             table.insert("env".into(), toml::Value::String(env.into()));
         }
-        let algorithm = algorithm.or(stated).unwrap_or_default();
-        table.insert(
-            "algorithm".into(),
-            toml::Value::String(algorithm.name().into()),
-        );
+        let algorithm = algorithm.or(stated).unwrap_or(SeadsConfig::ALGORITHM);
+        table.insert("algorithm".into(), toml::Value::String(algorithm.into()));
         // The values the file states, before what it leaves out is filled in.
         Self::from_table(table.clone())?;
         let Some(toml::Value::String(env)) = table.get("env").cloned() else {
@@ -263,15 +323,13 @@ impl TrainConfig {
     /// A configuration from a parsed TOML table (SEADS where it names no `algorithm`; fields left
     /// out take the generic defaults), its values validated.
     pub fn from_table(mut table: toml::Table) -> Result<Self, RunError> {
-        let algorithm = algorithm_of(&table)?.unwrap_or_default();
-        table.insert(
-            "algorithm".into(),
-            toml::Value::String(algorithm.name().into()),
-        );
-        check_sections(&table, algorithm)?;
-        let config: Self = table.try_into().map_err(|e: toml::de::Error| {
+        let algorithm = algorithm_of(&table)?.unwrap_or_else(|| SeadsConfig::ALGORITHM.into());
+        check_sections(&table, &algorithm)?;
+        table.insert("algorithm".into(), toml::Value::String(algorithm));
+        let mut config: Self = table.try_into().map_err(|e: toml::de::Error| {
             RunError::Config(older_layout_hint(e.message().trim().replace('\n', " ")))
         })?;
+        config.learner.complete_known()?;
         config.validate_values()?;
         Ok(config)
     }
@@ -314,12 +372,11 @@ impl TrainConfig {
         };
         let width = |hidden: &[i64]| hidden.iter().map(|&h| h.max(0) as f64).sum::<f64>();
         let sac_activations = f(self.sac.batch_size) * width(&self.sac.hidden) * 3.0;
-        let Some(seads) = self.seads() else {
-            // A baseline: its networks see at least the observation.
+        let Ok(seads) = self.seads() else {
+            // Another learner: its networks see at least the observation.
             let actor = mlp(obs, &self.sac.hidden, 2.0 * act);
             let critic = mlp(obs + act, &self.sac.hidden, 1.0);
             let replay = self
-                .learner
                 .baseline_training()
                 .map_or(0.0, |b| f(b.replay_capacity));
             return 4.0 * (4.0 * actor + 10.0 * critic + sac_activations + replay * (obs + act));
@@ -370,7 +427,7 @@ impl TrainConfig {
     pub fn validate_values(&self) -> Result<(), RunError> {
         let bad = |m: String| Err(RunError::Config(m));
         self.sac.validate()?;
-        self.learner.validate()?;
+        self.learner.clone().complete_known()?;
         // Counts that set a pool's size: beyond these a run would spawn more threads than a
         // machine has.
         for (name, value) in [
@@ -404,12 +461,16 @@ impl TrainConfig {
     /// How a baseline collects and learns (`[sac_baseline]`, or HAC's share of `[hac]`), for a
     /// learner that must be a baseline: SEADS's configuration is an error.
     pub fn baseline_training(&self) -> Result<BaselineConfig, RunError> {
-        self.learner.baseline_training().ok_or_else(|| {
-            RunError::Config(format!(
-                "a {} run is no task-reward baseline",
-                self.algorithm().name()
-            ))
-        })
+        if self.is::<HacConfig>() {
+            return Ok(self.section::<HacConfig>()?.training());
+        }
+        if self.is::<BaselineConfig>() {
+            return self.section::<BaselineConfig>();
+        }
+        Err(RunError::Config(format!(
+            "a {} run is no task-reward baseline",
+            self.algorithm()
+        )))
     }
 }
 
@@ -497,36 +558,47 @@ fn parse_table(text: &str) -> Result<toml::Table, RunError> {
         .map_err(|e| RunError::Config(one_line_toml_error(text, &e, 0)))
 }
 
-/// The algorithm a configuration's table names, if it names one.
-fn algorithm_of(table: &toml::Table) -> Result<Option<Algorithm>, RunError> {
-    table
-        .get("algorithm")
-        .map(|value| {
-            value.clone().try_into::<Algorithm>().map_err(|e| {
-                RunError::Config(format!(
-                    "algorithm: {} (one of {})",
-                    e.message().trim(),
-                    Algorithm::names().join(", ")
-                ))
-            })
-        })
-        .transpose()
+/// The learner a configuration's table names, if it names one: a learner with presets.
+fn algorithm_of(table: &toml::Table) -> Result<Option<String>, RunError> {
+    match table.get("algorithm") {
+        None => Ok(None),
+        Some(toml::Value::String(name)) if section_name(name).is_some() => Ok(Some(name.clone())),
+        Some(toml::Value::String(name)) => Err(unknown_learner(name)),
+        Some(other) => Err(RunError::Config(format!(
+            "algorithm must be a name (one of {}), got {other}",
+            learner_names().join(", ")
+        ))),
+    }
 }
 
-/// Refuses a section of another algorithm than `algorithm` in `table`, naming both.
-fn check_sections(table: &toml::Table, algorithm: Algorithm) -> Result<(), RunError> {
-    match Algorithm::ALL
-        .into_iter()
-        .find(|&other| other != algorithm && table.contains_key(other.section()))
-    {
-        Some(other) => Err(RunError::Config(format!(
-            "[{}] is the section of algorithm {:?}, not of this run's {:?}; remove it",
-            other.section(),
-            other.name(),
-            algorithm.name()
-        ))),
-        None => Ok(()),
+/// The error for a learner `name` that has no presets.
+fn unknown_learner(name: &str) -> RunError {
+    RunError::Config(format!(
+        "algorithm: unknown learner {name:?} (one of {})",
+        learner_names().join(", ")
+    ))
+}
+
+/// Refuses a table in `table` that is neither the run's own nor learner `algorithm`'s section,
+/// naming the learner whose section it is.
+fn check_sections(table: &toml::Table, algorithm: &str) -> Result<(), RunError> {
+    let own = section_name(algorithm);
+    for (key, value) in table {
+        if !value.is_table() || RUN_TABLES.contains(&key.as_str()) || Some(key.as_str()) == own {
+            continue;
+        }
+        let owner = LEARNERS.iter().find(|(_, section)| *section == key);
+        return Err(RunError::Config(match owner {
+            Some((other, _)) => format!(
+                "[{key}] is the section of algorithm {other:?}, not of this run's {algorithm:?}; remove it"
+            ),
+            None => older_layout_hint(format!(
+                "unknown field `{key}` (a run of {algorithm:?} has the section [{}])",
+                own.unwrap_or("?")
+            )),
+        }));
     }
+    Ok(())
 }
 
 /// `message`, with a pointer to `seads migrate` where it names an unknown field: the older
@@ -591,7 +663,7 @@ mod tests {
     #[test]
     fn the_jaco_presets_take_25_physics_steps_as_the_manipulators_option() {
         let mut jaco = 0;
-        for algorithm in Algorithm::ALL {
+        for algorithm in learner_names() {
             for env in env_names().into_iter().filter(|e| e.ends_with("-jaco")) {
                 let config = TrainConfig::preset_for(env, algorithm).unwrap();
                 assert_eq!(
@@ -611,21 +683,25 @@ mod tests {
     #[test]
     fn a_written_config_holds_its_algorithms_section_only() {
         let mut presets = 0;
-        for algorithm in Algorithm::ALL {
-            for (env, _) in TrainConfig::presets_of(algorithm) {
-                let config = TrainConfig::preset_for(env, algorithm).unwrap();
+        for algorithm in learner_names() {
+            for (env, config) in TrainConfig::presets_of(algorithm) {
+                let config = config.unwrap();
                 assert_eq!(config.algorithm(), algorithm);
                 let text = config.to_toml();
                 let table: toml::Table = text.parse().unwrap();
-                let sections: Vec<&str> = Algorithm::ALL
-                    .into_iter()
-                    .map(Algorithm::section)
-                    .filter(|s| table.contains_key(*s))
+                let sections: Vec<&str> = table
+                    .iter()
+                    .filter(|(k, v)| v.is_table() && !RUN_TABLES.contains(&k.as_str()))
+                    .map(|(k, _)| k.as_str())
                     .collect();
-                assert_eq!(sections, [algorithm.section()], "{env}: {text}");
+                assert_eq!(
+                    sections,
+                    [section_name(algorithm).unwrap()],
+                    "{env}: {text}"
+                );
                 assert_eq!(
                     table.get("algorithm").and_then(|a| a.as_str()),
-                    Some(algorithm.name())
+                    Some(algorithm)
                 );
                 assert_eq!(TrainConfig::from_toml(&text).unwrap(), config);
                 presets += 1;
@@ -648,7 +724,9 @@ mod tests {
             expected.env = env.into();
             expected.env_steps = 5000;
             expected.sac.alpha = 0.1;
-            expected.seads_mut().unwrap().episodes_per_epoch = episodes;
+            expected
+                .edit(|s: &mut SeadsConfig| s.episodes_per_epoch = episodes)
+                .unwrap();
             assert_eq!(TrainConfig::preset(env).unwrap(), expected);
         }
         // A name with no preset is an error that lists the ones there are.
@@ -693,10 +771,10 @@ mod tests {
         let sac = TrainConfig::from_user_toml(
             "env = \"lightsout-cursor\"\n[sac_baseline]\neval_boards = 3",
             None,
-            Some(Algorithm::Sac),
+            Some("sac"),
         )
         .unwrap();
-        assert_eq!(sac.learner.sac_baseline().unwrap().eval_boards, 3);
+        assert_eq!(sac.section::<BaselineConfig>().unwrap().eval_boards, 3);
     }
 
     #[test]
@@ -726,13 +804,12 @@ mod tests {
         );
         // The command line may give the environment and the algorithm.
         let sac =
-            TrainConfig::from_user_toml("seed = 4", Some("lightsout-cursor"), Some(Algorithm::Sac))
-                .unwrap();
+            TrainConfig::from_user_toml("seed = 4", Some("lightsout-cursor"), Some("sac")).unwrap();
         assert_eq!(
             (sac.seed, sac.sac.hidden.clone()),
             (
                 4,
-                TrainConfig::preset_for("lightsout-cursor", Algorithm::Sac)
+                TrainConfig::preset_for("lightsout-cursor", "sac")
                     .unwrap()
                     .sac
                     .hidden
@@ -857,17 +934,15 @@ mod tests {
                     config.threads = threads;
                     config.seed = seed;
                     config.env_steps = env_steps;
-                    config.learner = if baseline {
-                        LearnerConfig::Sac {
-                            sac_baseline: BaselineConfig {
-                                replay_capacity: replay,
-                                samples_per_epoch: samples,
-                                eval_boards: boards,
-                                ..BaselineConfig::default()
-                            },
-                        }
+                    let learner = if baseline {
+                        LearnerConfig::of(&BaselineConfig {
+                            replay_capacity: replay,
+                            samples_per_epoch: samples,
+                            eval_boards: boards,
+                            ..BaselineConfig::default()
+                        })
                     } else {
-                        let mut seads = config.seads().unwrap().clone();
+                        let mut seads = config.seads().unwrap();
                         seads.num_skills = Some(num_skills);
                         seads.skill_model.hidden = model_hidden;
                         seads.episodes_per_epoch = episodes;
@@ -878,9 +953,11 @@ mod tests {
                         seads.relabel.sac_p = p;
                         seads.eval_seeds = eval_seeds as u64;
                         seads.updates_per_epoch = updates;
-                        LearnerConfig::Seads { seads }
+                        LearnerConfig::of(&seads)
                     };
-                    if config.validate().is_err() {
+                    // A value beyond TOML's integers cannot be written, so is refused.
+                    let valid = learner.map(|l| config.learner = l).is_ok();
+                    if !valid || config.validate().is_err() {
                         refused.set(refused.get() + 1);
                         return Ok(());
                     }
@@ -929,7 +1006,8 @@ mod tests {
         b.threads = 4;
         b.sac_threads_alone = 0;
         assert_eq!(config_difference(&a, &b), None);
-        b.seads_mut().unwrap().skill_model.lr = 0.5;
+        b.edit(|s: &mut SeadsConfig| s.skill_model.lr = 0.5)
+            .unwrap();
         let (field, now, then) = config_difference(&b, &a).unwrap();
         assert_eq!(field, "seads.skill_model.lr");
         assert_eq!((now.as_str(), then.as_str()), ("0.5", "0.001"));

@@ -30,14 +30,16 @@ mod sections;
 mod skill_model;
 pub mod store;
 
-pub use config::{TrainConfig, config_difference, machine_memory_bytes, merge_toml};
+pub use config::{
+    TrainConfig, config_difference, learner_names, machine_memory_bytes, merge_toml, section_name,
+};
 pub use device::{ComputeDevice, DeviceError};
 pub use metrics::{Metrics, MetricsRecord, TaskMetrics, TaskTimings, Timings, read_metrics};
 pub use population::{PopulationKey, check_population};
 pub use sac::SacConfig;
 pub use sections::{
-    Algorithm, BaselineConfig, COVERAGE_SEED, HacConfig, LearnerConfig, MAX_PER_EPOCH,
-    RelabelConfig, SeadsConfig,
+    BaselineConfig, COVERAGE_SEED, HacConfig, LearnerConfig, MAX_PER_EPOCH, RelabelConfig,
+    SeadsConfig, Section,
 };
 pub use skill_model::{Normalisation, RelabelKind, RewardConfig, SkillModelConfig, SkillModelKind};
 pub use store::{load_config, raise_budget};

@@ -29,7 +29,7 @@ impl PopulationKey {
     fn fields(c: &TrainConfig) -> [(&'static str, String); 8] {
         let env_config = serde_json::to_string(&c.env_config).unwrap_or_default();
         [
-            ("algorithm", c.algorithm().name().to_owned()),
+            ("algorithm", c.algorithm().to_owned()),
             ("env", c.env.clone()),
             ("env_config", env_config),
             (
@@ -78,7 +78,8 @@ mod tests {
         let a = TrainConfig::preset("lightsout-cursor").unwrap();
         let mut b = a.clone();
         (b.seed, b.sac.lr) = (7, 1e-3);
-        b.seads_mut().unwrap().relabel.sac_p = 0.0;
+        b.edit(|s: &mut crate::SeadsConfig| s.relabel.sac_p = 0.0)
+            .unwrap();
         assert_eq!(PopulationKey::of(&a), PopulationKey::of(&b));
         assert_eq!(PopulationKey::mismatch(&a, &b), None);
         b.sac.hidden = vec![128, 128];

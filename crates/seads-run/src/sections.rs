@@ -1,191 +1,232 @@
-//! The algorithms and their sections of a run's configuration: `[seads]`, `[sac_baseline]` and
-//! `[hac]`, each with the paper's defaults and its own checks. A run's configuration holds its
-//! algorithm's section only: [`LearnerConfig`] is one of them, tagged by `algorithm`.
+//! The learners' sections of a run's configuration ([`Section`]): SEADS's `[seads]` and the
+//! baselines' `[sac_baseline]` and `[hac]`, each with the paper's defaults and its own checks,
+//! and [`LearnerConfig`], the one section a run's configuration holds.
+
+use std::fmt::Debug;
 
 use crate::{RelabelKind, RewardConfig, SkillModelConfig};
+use serde::de::DeserializeOwned;
 use serde::{Deserialize, Serialize};
 
 use crate::RunError;
 
-/// What a run trains.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
-#[serde(rename_all = "lowercase")]
-pub enum Algorithm {
-    /// SEADS: reward-free skills and their forward model (SPEC §3).
-    #[default]
-    Seads,
-    /// The flat SAC baseline with the task reward (SPEC §5.1).
-    Sac,
-    /// The two-level HAC baseline with the task reward (SPEC §5.2).
-    Hac,
+/// A learner's section of a run's configuration: its own settings, with their defaults (the
+/// paper's where the paper sets them) and their checks. A run's configuration holds its
+/// learner's name (`algorithm = "<ALGORITHM>"`) and that learner's section only (`[<NAME>]`),
+/// which [`LearnerConfig`] keeps as the file states it and gives typed with
+/// [`LearnerConfig::section`]. SEADS's section and the baselines' are here, since the data side
+/// reads them (populations, memory estimates); another learner's lives beside the learner.
+pub trait Section:
+    Serialize + DeserializeOwned + Default + Clone + Debug + PartialEq + Send + Sync + 'static
+{
+    /// The learner's name: in configs (`algorithm`), on the command line and in manifests.
+    const ALGORITHM: &'static str;
+    /// The section's name in a configuration file.
+    const NAME: &'static str;
+    /// Checks every value.
+    fn validate(&self) -> Result<(), RunError>;
 }
 
-impl Algorithm {
-    /// The name in configs and on the command line.
-    pub fn name(self) -> &'static str {
-        match self {
-            Algorithm::Seads => "seads",
-            Algorithm::Sac => "sac",
-            Algorithm::Hac => "hac",
-        }
-    }
-
-    /// Whether it is a task-reward baseline (SAC or HAC).
-    pub fn is_baseline(self) -> bool {
-        self != Algorithm::Seads
-    }
-
-    /// The name of its section in a configuration file.
-    pub fn section(self) -> &'static str {
-        match self {
-            Algorithm::Seads => "seads",
-            Algorithm::Sac => "sac_baseline",
-            Algorithm::Hac => "hac",
-        }
-    }
-
-    /// Every algorithm.
-    pub const ALL: [Algorithm; 3] = [Algorithm::Seads, Algorithm::Sac, Algorithm::Hac];
-
-    /// The algorithm of this name ([`Algorithm::name`]), if there is one.
-    ///
-    /// ```
-    /// use seads_run::Algorithm;
-    /// assert_eq!(Algorithm::named("hac"), Some(Algorithm::Hac));
-    /// assert_eq!(Algorithm::named("diayn"), None);
-    /// ```
-    pub fn named(name: &str) -> Option<Self> {
-        Self::ALL.into_iter().find(|a| a.name() == name)
-    }
-
-    /// The names of every algorithm, for help texts and errors.
-    pub fn names() -> Vec<&'static str> {
-        Self::ALL.into_iter().map(Self::name).collect()
+impl Section for SeadsConfig {
+    const ALGORITHM: &'static str = "seads";
+    const NAME: &'static str = "seads";
+    fn validate(&self) -> Result<(), RunError> {
+        SeadsConfig::validate(self)
     }
 }
 
-/// The learner of a run and its section: `algorithm = "seads"` reads `[seads]`, `"sac"`
-/// `[sac_baseline]`, `"hac"` `[hac]`; a section left out takes its defaults (the paper's), and any
-/// other section is an unknown field. Flattened into [`TrainConfig`](crate::TrainConfig).
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-#[serde(tag = "algorithm", rename_all = "lowercase", deny_unknown_fields)]
-pub enum LearnerConfig {
-    /// SEADS.
-    Seads {
-        /// Its section.
-        #[serde(default)]
-        seads: SeadsConfig,
-    },
-    /// The flat SAC baseline.
-    Sac {
-        /// Its section.
-        #[serde(default)]
-        sac_baseline: BaselineConfig,
-    },
-    /// The two-level HAC baseline.
-    Hac {
-        /// Its section.
-        #[serde(default)]
-        hac: HacConfig,
-    },
+impl Section for BaselineConfig {
+    const ALGORITHM: &'static str = "sac";
+    const NAME: &'static str = "sac_baseline";
+    fn validate(&self) -> Result<(), RunError> {
+        BaselineConfig::validate(self, Self::NAME)
+    }
+}
+
+impl Section for HacConfig {
+    const ALGORITHM: &'static str = "hac";
+    const NAME: &'static str = "hac";
+    fn validate(&self) -> Result<(), RunError> {
+        HacConfig::validate(self)
+    }
+}
+
+/// The learner of a run and its section, as the file states them: `algorithm` (SEADS where a
+/// file names none) and at most one table besides the run's own (`[env_config]`, `[sac]`), which
+/// is that learner's section (a section left out takes the learner's defaults). Any other key is
+/// an unknown field. Flattened into [`TrainConfig`](crate::TrainConfig); which section belongs
+/// to which learner is checked against the presets when a configuration is read
+/// ([`TrainConfig::from_table`](crate::TrainConfig::from_table)), and a section's values when
+/// it is read typed, or by the learners' registry (`seads_rl::learners`) as a run starts.
+#[derive(Debug, Clone, PartialEq)]
+pub struct LearnerConfig {
+    algorithm: String,
+    section: Option<(String, toml::Table)>,
 }
 
 impl Default for LearnerConfig {
     fn default() -> Self {
-        Self::of(Algorithm::Seads)
+        Self::of(&SeadsConfig::default()).expect("SEADS's defaults are written in TOML")
     }
 }
 
 impl LearnerConfig {
-    /// `algorithm` with its section's defaults.
-    pub fn of(algorithm: Algorithm) -> Self {
-        match algorithm {
-            Algorithm::Seads => Self::Seads {
-                seads: SeadsConfig::default(),
-            },
-            Algorithm::Sac => Self::Sac {
-                sac_baseline: BaselineConfig::default(),
-            },
-            Algorithm::Hac => Self::Hac {
-                hac: HacConfig::default(),
-            },
+    /// The learner of `section`, with these settings: an error where a value cannot be
+    /// written in TOML (an integer beyond 2⁶³ − 1).
+    pub fn of<S: Section>(section: &S) -> Result<Self, RunError> {
+        let table = toml::Table::try_from(section).map_err(|e| {
+            RunError::Config(format!("[{}] cannot be written in TOML: {e}", S::NAME))
+        })?;
+        Ok(Self {
+            algorithm: S::ALGORITHM.into(),
+            section: Some((S::NAME.into(), table)),
+        })
+    }
+
+    /// Learner `algorithm` with its section as stated (`None`: left out).
+    pub fn stated(algorithm: &str, section: Option<(String, toml::Table)>) -> Self {
+        Self {
+            algorithm: algorithm.into(),
+            section,
         }
     }
 
-    /// Which algorithm it is.
-    pub fn algorithm(&self) -> Algorithm {
-        match self {
-            Self::Seads { .. } => Algorithm::Seads,
-            Self::Sac { .. } => Algorithm::Sac,
-            Self::Hac { .. } => Algorithm::Hac,
+    /// The learner's name (`algorithm`).
+    pub fn algorithm(&self) -> &str {
+        &self.algorithm
+    }
+
+    /// The section's name and values as stated, if the file states them.
+    pub fn stated_section(&self) -> Option<(&str, &toml::Table)> {
+        self.section
+            .as_ref()
+            .map(|(name, table)| (name.as_str(), table))
+    }
+
+    /// Whether the learner is the one of section `S`.
+    pub fn is<S: Section>(&self) -> bool {
+        self.algorithm == S::ALGORITHM
+    }
+
+    /// The learner's section, typed and checked: an error if the learner is another, or if the
+    /// section has unknown fields or bad values.
+    pub fn section<S: Section>(&self) -> Result<S, RunError> {
+        let section: S = self.read()?;
+        section.validate()?;
+        Ok(section)
+    }
+
+    /// The learner's section, typed but not checked.
+    fn read<S: Section>(&self) -> Result<S, RunError> {
+        if !self.is::<S>() {
+            return Err(RunError::Config(format!(
+                "a {} run has no [{}] section: it is no {} run",
+                self.algorithm,
+                S::NAME,
+                S::ALGORITHM
+            )));
+        }
+        let section: S = match &self.section {
+            None => S::default(),
+            Some((name, _)) if name != S::NAME => {
+                return Err(RunError::Config(format!(
+                    "[{name}] is no section of algorithm {:?}, which reads [{}]",
+                    self.algorithm,
+                    S::NAME
+                )));
+            }
+            Some((_, table)) => {
+                toml::Value::Table(table.clone())
+                    .try_into()
+                    .map_err(|e: toml::de::Error| {
+                        RunError::Config(format!(
+                            "[{}]: {}",
+                            S::NAME,
+                            e.message().trim().replace('\n', " ")
+                        ))
+                    })?
+            }
+        };
+        Ok(section)
+    }
+
+    /// Checks the section of SEADS or of a baseline, whose types this crate holds, and writes it
+    /// out in full (every field, its defaults included, as the type writes it); another
+    /// learner's section stays as stated, and is checked and completed by its entry in the
+    /// learners' registry (`seads_rl::learners::complete`) as a run starts.
+    pub fn complete_known(&mut self) -> Result<(), RunError> {
+        if self.is::<SeadsConfig>() {
+            self.complete::<SeadsConfig>()
+        } else if self.is::<BaselineConfig>() {
+            self.complete::<BaselineConfig>()
+        } else if self.is::<HacConfig>() {
+            self.complete::<HacConfig>()
+        } else {
+            Ok(())
         }
     }
 
-    /// Checks every value of the section.
-    pub fn validate(&self) -> Result<(), RunError> {
-        match self {
-            Self::Seads { seads } => seads.validate(),
-            Self::Sac { sac_baseline } => sac_baseline.validate("sac_baseline"),
-            Self::Hac { hac } => hac.validate(),
-        }
+    /// Checks the section of learner `S` and writes it out in full: every field, its defaults
+    /// included, as `S` writes it (an error if the learner is another).
+    pub fn complete<S: Section>(&mut self) -> Result<(), RunError> {
+        *self = Self::of(&self.section::<S>()?)?;
+        Ok(())
     }
 
-    /// SEADS's section, if the learner is SEADS.
-    pub fn seads(&self) -> Option<&SeadsConfig> {
-        match self {
-            Self::Seads { seads } => Some(seads),
-            _ => None,
-        }
+    /// Changes the learner's section with `edit`: an error if the learner is another, if the
+    /// section has unknown fields, or if a value cannot be written in TOML. The values are
+    /// checked when the configuration is ([`TrainConfig::validate`](crate::TrainConfig::validate)),
+    /// so that several edits may pass through a state that is not valid.
+    pub fn edit<S: Section>(&mut self, edit: impl FnOnce(&mut S)) -> Result<(), RunError> {
+        let mut section = self.read::<S>()?;
+        edit(&mut section);
+        *self = Self::of(&section)?;
+        Ok(())
     }
+}
 
-    /// SEADS's section to change, if the learner is SEADS.
-    pub fn seads_mut(&mut self) -> Option<&mut SeadsConfig> {
-        match self {
-            Self::Seads { seads } => Some(seads),
-            _ => None,
+impl Serialize for LearnerConfig {
+    fn serialize<Ser: serde::Serializer>(&self, serializer: Ser) -> Result<Ser::Ok, Ser::Error> {
+        use serde::ser::SerializeMap;
+        let mut map = serializer.serialize_map(None)?;
+        map.serialize_entry("algorithm", &self.algorithm)?;
+        if let Some((name, table)) = &self.section {
+            map.serialize_entry(name, table)?;
         }
+        map.end()
     }
+}
 
-    /// The SAC baseline's section, if the learner is the SAC baseline.
-    pub fn sac_baseline(&self) -> Option<&BaselineConfig> {
-        match self {
-            Self::Sac { sac_baseline } => Some(sac_baseline),
-            _ => None,
+impl<'de> Deserialize<'de> for LearnerConfig {
+    fn deserialize<D: serde::Deserializer<'de>>(deserializer: D) -> Result<Self, D::Error> {
+        use serde::de::Error;
+        let mut algorithm = None;
+        let mut section: Option<(String, toml::Table)> = None;
+        let keys: std::collections::BTreeMap<String, toml::Value> =
+            Deserialize::deserialize(deserializer)?;
+        for (key, value) in keys {
+            match (key.as_str(), value) {
+                ("algorithm", toml::Value::String(name)) => algorithm = Some(name),
+                ("algorithm", other) => {
+                    return Err(D::Error::custom(format!(
+                        "algorithm must be a name, got {other}"
+                    )));
+                }
+                (_, toml::Value::Table(table)) => {
+                    if let Some((first, _)) = &section {
+                        return Err(D::Error::custom(format!(
+                            "two learners' sections, [{first}] and [{key}]: a run has one"
+                        )));
+                    }
+                    section = Some((key, table));
+                }
+                _ => return Err(D::Error::custom(format!("unknown field `{key}`"))),
+            }
         }
-    }
-
-    /// The SAC baseline's section to change, if the learner is the SAC baseline.
-    pub fn sac_baseline_mut(&mut self) -> Option<&mut BaselineConfig> {
-        match self {
-            Self::Sac { sac_baseline } => Some(sac_baseline),
-            _ => None,
-        }
-    }
-
-    /// HAC's section, if the learner is HAC.
-    pub fn hac(&self) -> Option<&HacConfig> {
-        match self {
-            Self::Hac { hac } => Some(hac),
-            _ => None,
-        }
-    }
-
-    /// HAC's section to change, if the learner is HAC.
-    pub fn hac_mut(&mut self) -> Option<&mut HacConfig> {
-        match self {
-            Self::Hac { hac } => Some(hac),
-            _ => None,
-        }
-    }
-
-    /// How a task-reward baseline collects and learns: `[sac_baseline]`, or HAC's share of
-    /// `[hac]`; `None` for SEADS.
-    pub fn baseline_training(&self) -> Option<BaselineConfig> {
-        match self {
-            Self::Seads { .. } => None,
-            Self::Sac { sac_baseline } => Some(sac_baseline.clone()),
-            Self::Hac { hac } => Some(hac.training()),
-        }
+        Ok(Self {
+            algorithm: algorithm.unwrap_or_else(|| SeadsConfig::ALGORITHM.into()),
+            section,
+        })
     }
 }
 

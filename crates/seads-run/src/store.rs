@@ -73,7 +73,7 @@ pub const ENVIRONMENT_FILE: &str = "environment.json";
 #[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
 struct Origin {
     env: String,
-    algorithm: crate::Algorithm,
+    algorithm: String,
     /// Whether the checkpoint keeps the state its environments carry from episode to episode
     /// (`environment.json`: the robot's twin); left out where it does not, and in checkpoints
     /// written before it was recorded.
@@ -90,7 +90,7 @@ fn is_false(value: &bool) -> bool {
 pub fn write_origin(dir: &Path, config: &crate::TrainConfig) -> Result<(), RunError> {
     let origin = Origin {
         env: config.env.clone(),
-        algorithm: config.algorithm(),
+        algorithm: config.algorithm().to_owned(),
         carried_state: dir.join(ENVIRONMENT_FILE).is_file(),
     };
     let path = dir.join(ORIGIN);
@@ -144,9 +144,9 @@ pub fn check_origin(checkpoint: &Path, config: &crate::TrainConfig) -> Result<()
             path: checkpoint.display().to_string(),
             reason: format!(
                 "it was written by a {} run on {}, not a {} run on {}",
-                origin.algorithm.name(),
+                origin.algorithm,
                 origin.env,
-                config.algorithm().name(),
+                config.algorithm(),
                 config.env
             ),
         });

@@ -58,7 +58,7 @@ pub use journal::Resumed;
 /// whose environment is not in the registry, one per field of the tablet's LightsOut 5×5). An
 /// environment that is neither is [`StudyError::Environment`].
 pub fn run_skills(config: &seads_run::TrainConfig) -> Result<usize> {
-    if let Some(k) = config.seads().and_then(|s| s.num_skills) {
+    if let Some(k) = config.seads().ok().and_then(|s| s.num_skills) {
         return Ok(k);
     }
     if seads_uarm::ActionSpace::of_env(&config.env).is_some() {

@@ -83,7 +83,7 @@ pub fn evaluate_run(args: EvaluateArgs) -> Result<()> {
     let mut config = crate::run_config(&args.run)?;
     config.device = crate::usable_device(args.device)?;
     let _lock = crate::lock_run(&args.run)?;
-    if config.algorithm().is_baseline() {
+    if !config.is::<seads_rl::SeadsConfig>() {
         if args.action_noise.is_some() {
             bail!(BadInput(anyhow::anyhow!(
                 "--action-noise is for planning evaluations of SEADS runs; {} is a baseline",

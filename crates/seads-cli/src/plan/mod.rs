@@ -109,12 +109,12 @@ pub fn load_agent(run: &Path, checkpoint: Option<u64>, device: ComputeDevice) ->
     }
     config.device = crate::usable_device(device)?;
     crate::kernels::use_kernels(config.portable_numerics)?;
-    if config.algorithm() != seads_rl::Algorithm::Seads {
+    if !config.is::<seads_rl::SeadsConfig>() {
         bail!(BadInput(anyhow::anyhow!(
             "{} is a {} baseline run: it has no skills to plan with (`seads evaluate --run` \
              measures its policy's task success)",
             run.display(),
-            config.algorithm().name()
+            config.algorithm()
         )));
     }
     // A checkpoint that is there but cannot be read or does not fit is a malformed input.

@@ -7,7 +7,7 @@ use std::time::Duration;
 
 use anyhow::{Context, Result};
 use seads_rl::store::MetricsLine as _;
-use seads_rl::{Algorithm, ComputeDevice, Learner, Members, Population, Run, WithLearner};
+use seads_rl::{ComputeDevice, Learner, Members, Population, Run, SeadsConfig, WithLearner};
 
 use seads_rl::InWords;
 use seads_skillmodel::SkillModelKind;
@@ -83,7 +83,7 @@ fn train(run: &Path, cores: usize, device: ComputeDevice) -> Result<()> {
     let config =
         seads_rl::load_config(run).with_context(|| format!("loading {}", run.display()))?;
     crate::kernels::use_kernels(config.portable_numerics)?;
-    seads_rl::with_learner(config.algorithm(), TrainOne { run, cores, device })
+    seads_rl::with_learner(config.algorithm(), TrainOne { run, cores, device })?
 }
 
 /// [`train`]'s work with the run's learner.
@@ -116,7 +116,7 @@ fn train_one<L: InWords>(run: &Path, cores: usize, device: ComputeDevice) -> Res
             run.display(),
             training.trainer().epoch(),
             config.threads,
-            config.algorithm().name()
+            config.algorithm()
         );
         crate::train::drive(&mut training, true)?;
     }
@@ -131,7 +131,7 @@ fn train_population(runs: &[&Path], cores: usize, device: ComputeDevice) -> Resu
     let config = seads_rl::load_config(runs[0])?;
     crate::kernels::use_kernels(config.portable_numerics)?;
     let cpu = ComputeDevice::Cpu;
-    if config.algorithm() == Algorithm::Seads && device != cpu {
+    if config.is::<SeadsConfig>() && device != cpu {
         return train_members(runs, cpu, |members| {
             seads_rl::StackedPopulation::new(members, cores, device)
         });
@@ -143,7 +143,7 @@ fn train_population(runs: &[&Path], cores: usize, device: ComputeDevice) -> Resu
             cores,
             device,
         },
-    )
+    )?
 }
 
 /// [`train_population`]'s work with the runs' learner, on the CPU or one device.
@@ -204,13 +204,13 @@ where
 fn evaluate(sweep: &Sweep, run: &Path, device: ComputeDevice) -> Result<()> {
     let config =
         seads_rl::load_config(run).with_context(|| format!("loading {}", run.display()))?;
-    if config.algorithm() != Algorithm::Seads {
+    if !config.is::<SeadsConfig>() {
         return evaluate_baseline(sweep, run, &config);
     }
     let plan = &sweep.evaluation;
     if config
         .seads()
-        .is_some_and(|s| s.skill_model.kind == SkillModelKind::Vic)
+        .is_ok_and(|s| s.skill_model.kind == SkillModelKind::Vic)
     {
         outln!(
             "{}: a VIC agent cannot plan; no task evaluation",

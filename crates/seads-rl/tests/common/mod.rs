@@ -26,12 +26,17 @@ pub fn small(seed: u64, steps: u64) -> TrainConfig {
     config.seed = seed;
     config.env_steps = steps;
     config.sac.hidden = vec![64, 64];
-    config.seads_mut().unwrap().skill_model.hidden = vec![64, 64];
-    config.seads_mut().unwrap().sampled_episodes = 64;
-    config.seads_mut().unwrap().recent_episodes = 32;
+    config
+        .edit(|s: &mut seads_rl::SeadsConfig| {
+            s.skill_model.hidden = vec![64, 64];
+            (s.sampled_episodes, s.recent_episodes) = (64, 32);
+        })
+        .unwrap();
     config.eval_every = 10;
     config.checkpoint_every = 10;
-    config.seads_mut().unwrap().eval_seeds = 2;
+    config
+        .edit(|s: &mut seads_rl::SeadsConfig| s.eval_seeds = 2)
+        .unwrap();
     // Tests run side by side: SAC taking a second thread would oversubscribe the cores.
     config.sac_threads_alone = 0;
     // Portable kernels, as the demo uses (cargo sets them: .cargo/config.toml).

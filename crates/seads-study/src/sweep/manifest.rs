@@ -7,7 +7,7 @@ use std::collections::BTreeMap;
 use crate::Result;
 use crate::error::{fail, failure};
 use seads_embodiment::env_names;
-use seads_run::{Algorithm, TrainConfig};
+use seads_run::{SeadsConfig, Section, TrainConfig};
 use serde::{Deserialize, Serialize};
 
 /// A study, as written in `experiments/*.toml`.
@@ -245,21 +245,17 @@ impl Manifest {
             .filter_map(|layer| layer.get("algorithm").and_then(|v| v.as_str()))
             .next_back();
         let algorithm = match named {
-            Some(name) => Algorithm::named(name).ok_or_else(|| {
-                failure!(
-                    "variant {:?}: unknown algorithm {name:?} (one of {})",
-                    variant.name,
-                    Algorithm::names().join(", ")
-                )
-            })?,
-            None => Algorithm::Seads,
+            Some(name) if seads_run::section_name(name).is_none() => fail!(
+                "variant {:?}: unknown algorithm {name:?} (one of {})",
+                variant.name,
+                seads_run::learner_names().join(", ")
+            ),
+            Some(name) => name,
+            None => SeadsConfig::ALGORITHM,
         };
-        let preset = TrainConfig::presets_of(algorithm)
-            .iter()
-            .find(|(name, _)| *name == env)
-            .map(|(_, text)| *text)
-            .ok_or_else(|| failure!("environment {env:?} has no preset"))?;
-        let mut table: toml::Table = toml::from_str(preset)?;
+        let preset = TrainConfig::preset_for(env, algorithm)
+            .map_err(|e| failure!("variant {:?}: {e}", variant.name))?;
+        let mut table: toml::Table = toml::from_str(&preset.to_toml())?;
         let layers = [
             ("overrides", &self.overrides),
             ("variant overrides", &variant.overrides),
@@ -413,7 +409,7 @@ env_overrides = { "lightsout-cursor" = { seads = { num_skills = 30 } }, "tileswa
                     "overrides = { env_steps = 1000 }",
                     "overrides = { env_steps = 1000, algorithm = \"diayn\" }",
                 ),
-                "unknown algorithm \"diayn\" (one of seads, sac, hac)",
+                "unknown algorithm \"diayn\" (one of hac, sac, seads)",
             ),
         ];
         for (text, expected) in cases {
@@ -506,75 +502,75 @@ env_overrides = { "lightsout-cursor" = { seads = { num_skills = 30 } }, "tileswa
                 // Each variant changes only what its name says (SPEC §3.9, §3.10, §5.1).
                 let hac_grid = m.name.starts_with("hac-grid");
                 let algorithm = if m.name == "sac-grid" || run.variant == "sac" {
-                    seads_run::Algorithm::Sac
+                    "sac"
                 } else if hac_grid || run.variant == "hac" {
-                    seads_run::Algorithm::Hac
+                    "hac"
                 } else {
-                    seads_run::Algorithm::Seads
+                    "seads"
                 };
                 let preset = TrainConfig::preset_for(&run.env, algorithm).unwrap();
                 let mut expected = preset.clone();
                 expected.seed = run.seed;
                 let c = &run.config;
+                // SEADS's section changed as `edit` does.
+                let seads = |expected: &mut TrainConfig, edit: &dyn Fn(&mut SeadsConfig)| {
+                    expected.edit(|s: &mut SeadsConfig| edit(s)).unwrap()
+                };
                 match run.variant.as_str() {
                     "seads" | "size-5" | "sac" | "hac" => {}
                     v if hac_grid => {
                         // t<tau_RB>-l<alpha_low>-h<alpha_high>.
                         let (t, rest) = v[1..].split_once("-l").unwrap();
                         let (low, high) = rest.split_once("-h").unwrap();
-                        let seads_run::LearnerConfig::Hac { hac } = &mut expected.learner else {
-                            panic!("HAC's preset")
-                        };
-                        hac.temperature = t.parse().unwrap();
-                        hac.alpha_high = high.parse().unwrap();
+                        expected
+                            .edit(|hac: &mut seads_run::HacConfig| {
+                                hac.temperature = t.parse().unwrap();
+                                hac.alpha_high = high.parse().unwrap();
+                            })
+                            .unwrap();
                         expected.sac.alpha = low.parse().unwrap();
                     }
                     v if m.name == "sac-grid" => {
                         // n<N>-a<alpha>, N with "_" for ".".
                         let (n, a) = v[1..].split_once("-a").unwrap();
-                        let seads_run::LearnerConfig::Sac { sac_baseline } = &mut expected.learner
-                        else {
-                            panic!("SAC's preset")
-                        };
-                        sac_baseline.updates_per_epoch = n.replace('_', ".").parse().unwrap();
+                        expected
+                            .edit(|sac: &mut seads_run::BaselineConfig| {
+                                sac.updates_per_epoch = n.replace('_', ".").parse().unwrap();
+                            })
+                            .unwrap();
                         expected.sac.alpha = a.parse().unwrap();
                     }
-                    "no-second-best-norm" => {
-                        expected.seads_mut().unwrap().reward.normalisation =
-                            seads_run::Normalisation::LogK;
-                    }
+                    "no-second-best-norm" => seads(&mut expected, &|s| {
+                        s.reward.normalisation = seads_run::Normalisation::LogK;
+                    }),
                     "no-novelty-bonus" => {
-                        expected.seads_mut().unwrap().reward.novelty_bonus = false
+                        seads(&mut expected, &|s| s.reward.novelty_bonus = false);
                     }
-                    "no-relabelling" => {
-                        expected.seads_mut().unwrap().relabel.skill_model_p = 0.0;
-                        expected.seads_mut().unwrap().relabel.sac_p = 0.0;
-                    }
+                    "no-relabelling" => seads(&mut expected, &|s| {
+                        (s.relabel.skill_model_p, s.relabel.sac_p) = (0.0, 0.0);
+                    }),
                     "no-forward-model-relabelling" => {
-                        expected.seads_mut().unwrap().relabel.skill_model_p = 0.0
+                        seads(&mut expected, &|s| s.relabel.skill_model_p = 0.0);
                     }
-                    "no-sac-relabelling" => expected.seads_mut().unwrap().relabel.sac_p = 0.0,
+                    "no-sac-relabelling" => seads(&mut expected, &|s| s.relabel.sac_p = 0.0),
                     "more-skills" => {
-                        expected.seads_mut().unwrap().num_skills =
-                            Some(if run.env.starts_with("lightsout") {
-                                30
-                            } else {
-                                15
-                            });
+                        let k = if run.env.starts_with("lightsout") {
+                            30
+                        } else {
+                            15
+                        };
+                        seads(&mut expected, &|s| s.num_skills = Some(k));
                     }
-                    v if v.starts_with("vic") => {
-                        expected.seads_mut().unwrap().skill_model.kind =
-                            seads_run::SkillModelKind::Vic;
-                        expected.seads_mut().unwrap().reward.novelty_bonus = false;
+                    v if v.starts_with("vic") => seads(&mut expected, &|s| {
+                        s.skill_model.kind = seads_run::SkillModelKind::Vic;
+                        s.reward.novelty_bonus = false;
                         if v != "vic-sbn" {
-                            expected.seads_mut().unwrap().reward.normalisation =
-                                seads_run::Normalisation::LogK;
+                            s.reward.normalisation = seads_run::Normalisation::LogK;
                         }
                         if v != "vic-relabelling" {
-                            expected.seads_mut().unwrap().relabel.skill_model_p = 0.0;
-                            expected.seads_mut().unwrap().relabel.sac_p = 0.0;
+                            (s.relabel.skill_model_p, s.relabel.sac_p) = (0.0, 0.0);
                         }
-                    }
+                    }),
                     v if v.starts_with("size-") => expected.env_config = c.env_config.clone(),
                     other => panic!("unexpected variant {other}"),
                 }
