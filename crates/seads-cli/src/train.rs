@@ -18,8 +18,9 @@ pub struct TrainArgs {
     env: Option<String>,
     /// What to train, a learner of the registry (`seads_rl::learners`): `seads`, or a baseline
     /// with the task reward: flat SAC (`sac`, SPEC §5.1; presets `configs/sac/*.toml`) or
-    /// two-level HAC (`hac`, SPEC §5.2; presets `configs/hac/*.toml`). Default: the config's,
-    /// else seads.
+    /// two-level HAC (`hac`, SPEC §5.2; presets `configs/hac/*.toml`); beyond the paper, DIAYN
+    /// (`diayn`: skills from a discriminator, no forward model). Default: the config's, else
+    /// seads.
     #[arg(
         long,
         value_parser = clap::builder::PossibleValuesParser::new(seads_rl::learners::names()),
@@ -84,7 +85,10 @@ fn config(args: &TrainArgs) -> Result<TrainConfig> {
     }
     crate::usable_device(config.device)?;
     config.validate().map_err(|e| BadInput(e.into()))?;
-    seads_rl::learners::complete(&mut config).map_err(|e| BadInput(e.into()))?;
+    seads_rl::learners::complete(&mut config).map_err(|e| match &args.config {
+        Some(path) => BadInput(anyhow::anyhow!("{}: {e}", path.display())),
+        None => BadInput(e.into()),
+    })?;
     Ok(config)
 }
 

@@ -2,12 +2,15 @@
 //! its [`Learner::Section`] to its section of the configuration. The binary (`seads train`, its
 //! `--algorithm` and `--help`), the sweeps and agents reach a learner through [`with_learner`];
 //! configurations are checked by [`check`] (and [`complete`]). A new learner is a type implementing
-//! [`Learner`] and [`InWords`], one line in [`registry!`]'s list below, and its presets in
-//! `crates/seads-run/configs/<name>/`, which the data side (manifests, reports) reads.
+//! [`Learner`] and [`InWords`], one line in the `registry!` list below, and its presets in
+//! `crates/seads-run/configs/<name>/`, which the data side (manifests, reports) reads. The
+//! learners beyond the paper's live in this module's folder: DIAYN ([`diayn`]) was added so.
 
 use seads_run::Section;
 
 use crate::{Hac, InWords, Learner, RlError, TaskSac, TrainConfig, Trainer};
+
+pub mod diayn;
 
 /// Work to do with the learner of an algorithm, whichever it is: a generic function that
 /// [`with_learner`] calls with the algorithm's learner type.
@@ -59,7 +62,7 @@ macro_rules! registry {
     };
 }
 
-registry![Trainer, TaskSac, Hac];
+registry![Trainer, TaskSac, Hac, diayn::Diayn];
 
 /// The name of learner `L`.
 fn name<L: Learner>() -> &'static str {
@@ -127,7 +130,7 @@ mod tests {
         config.learner = seads_run::LearnerConfig::stated("nobody", None);
         let e = check(&config).unwrap_err().to_string();
         assert!(
-            e.contains("unknown learner \"nobody\" (one of hac, sac, seads)"),
+            e.contains("unknown learner \"nobody\" (one of diayn, hac, sac, seads)"),
             "{e}"
         );
     }

@@ -337,7 +337,7 @@ fn bad_baseline_settings_are_refused() {
     };
     refused(
         "algorithm = \"ppo\"",
-        "unknown learner \"ppo\" (one of hac, sac, seads)",
+        "unknown learner \"ppo\" (one of diayn, hac, sac, seads)",
     );
     refused(
         "algorithm = \"hac\"\n[hac]\ntemperature = 0.0",

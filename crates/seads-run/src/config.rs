@@ -110,7 +110,7 @@ const RUN_TABLES: [&str; 2] = ["env_config", "sac"];
 /// The names of the learners a configuration may name (those with presets), sorted.
 ///
 /// ```
-/// assert_eq!(seads_run::learner_names(), ["hac", "sac", "seads"]);
+/// assert_eq!(seads_run::learner_names(), ["diayn", "hac", "sac", "seads"]);
 /// ```
 pub fn learner_names() -> Vec<&'static str> {
     LEARNERS.keys().copied().collect()
@@ -675,7 +675,8 @@ mod tests {
                 jaco += 1;
             }
         }
-        assert_eq!(jaco, 9);
+        // Three Jaco environments, each with a preset of all four learners.
+        assert_eq!(jaco, 12);
     }
 
     /// A written configuration holds `algorithm` and its algorithm's section only, and reads
@@ -707,7 +708,9 @@ mod tests {
                 presets += 1;
             }
         }
-        assert_eq!(presets, 38);
+        // 14 environments with SEADS, 12 each with SAC and HAC (not the robot's), and DIAYN on
+        // all 14 through its settings on every environment.
+        assert_eq!(presets, 14 + 12 + 12 + 14);
     }
 
     /// The robot's presets (seed S.5) are the LightsOutCursor preset with 5000 interactions,

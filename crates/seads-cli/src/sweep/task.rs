@@ -204,8 +204,17 @@ where
 fn evaluate(sweep: &Sweep, run: &Path, device: ComputeDevice) -> Result<()> {
     let config =
         seads_rl::load_config(run).with_context(|| format!("loading {}", run.display()))?;
-    if !config.is::<SeadsConfig>() {
+    if config.baseline_training().is_ok() {
         return evaluate_baseline(sweep, run, &config);
+    }
+    if !config.is::<SeadsConfig>() {
+        outln!(
+            "{}: a {} run has skills but no forward model to plan with; no task evaluation \
+             (its skill coverage is in metrics.jsonl)",
+            run.display(),
+            config.algorithm()
+        );
+        return Ok(());
     }
     let plan = &sweep.evaluation;
     if config

@@ -407,9 +407,9 @@ env_overrides = { "lightsout-cursor" = { seads = { num_skills = 30 } }, "tileswa
             (
                 SMALL.replace(
                     "overrides = { env_steps = 1000 }",
-                    "overrides = { env_steps = 1000, algorithm = \"diayn\" }",
+                    "overrides = { env_steps = 1000, algorithm = \"ppo\" }",
                 ),
-                "unknown algorithm \"diayn\" (one of hac, sac, seads)",
+                "unknown algorithm \"ppo\" (one of diayn, hac, sac, seads)",
             ),
         ];
         for (text, expected) in cases {
