@@ -487,6 +487,8 @@ env_overrides = { "lightsout-cursor" = { seads = { num_skills = 30 } }, "tileswa
                 include_str!("../../../../experiments/sac-grid.toml"),
                 6 * 9 * 5,
             ),
+            // Two boards, three learners, three seeds.
+            (include_str!("../../../../experiments/diayn.toml"), 2 * 3 * 3),
         ];
         for (text, count) in shipped {
             let m = Manifest::parse(text, "experiments").unwrap();
@@ -503,6 +505,8 @@ env_overrides = { "lightsout-cursor" = { seads = { num_skills = 30 } }, "tileswa
                 let hac_grid = m.name.starts_with("hac-grid");
                 let algorithm = if m.name == "sac-grid" || run.variant == "sac" {
                     "sac"
+                } else if run.variant == "diayn" {
+                    "diayn"
                 } else if hac_grid || run.variant == "hac" {
                     "hac"
                 } else {
@@ -517,7 +521,7 @@ env_overrides = { "lightsout-cursor" = { seads = { num_skills = 30 } }, "tileswa
                     expected.edit(|s: &mut SeadsConfig| edit(s)).unwrap()
                 };
                 match run.variant.as_str() {
-                    "seads" | "size-5" | "sac" | "hac" => {}
+                    "seads" | "size-5" | "sac" | "hac" | "diayn" => {}
                     v if hac_grid => {
                         // t<tau_RB>-l<alpha_low>-h<alpha_high>.
                         let (t, rest) = v[1..].split_once("-l").unwrap();
