@@ -453,8 +453,8 @@ fn the_python_bindings_write_no_unsafe_code() {
     }
 }
 
-/// Every registered environment has a shipped preset (the trainer embeds every file of
-/// `configs/` by its name: `every_preset_file_is_embedded_under_its_name` in seads-run).
+/// Every registered environment has a shipped preset (laid together from the layers of
+/// `configs/`: `every_preset_file_is_embedded_and_used` in seads-run).
 #[test]
 fn every_environment_has_a_preset() {
     let envs = seads_embodiment::env_names();
@@ -463,12 +463,8 @@ fn every_environment_has_a_preset() {
         "the Jaco environments are registered"
     );
     for env in envs {
-        let file = format!("configs/{env}.toml");
-        let text = read(&file);
-        assert!(
-            text.contains(&format!("env = \"{env}\"")),
-            "{file} trains {env}"
-        );
+        let preset = seads_run::TrainConfig::preset(env).unwrap();
+        assert_eq!(preset.env, env);
     }
 }
 

@@ -1,10 +1,10 @@
 //! The presets: every file of `configs/` is embedded, found by its path, so that a new
-//! environment's or learner's preset is a new file and nothing else (`$OUT_DIR/presets.rs`,
-//! included by `src/config.rs`):
-//! - `configs/<env>.toml`: the environment's preset, with SEADS (the paper's learner);
-//! - `configs/<algorithm>/<env>.toml`: another learner's preset on that environment;
-//! - `configs/<algorithm>/every-env.toml`: a learner's settings on every environment, laid over
-//!   the environment's preset where the learner has no preset of its own there.
+//! environment's, game's, manipulator's or learner's preset is a new file and nothing else
+//! (`$OUT_DIR/presets.rs`, included by `src/config.rs`, which lays the layers together):
+//! - `configs/<layer>.toml`: SEADS's layer of a manipulator (`cursor`), a game (`sliding`) or an
+//!   environment (`uarm-lightsout-absolute`);
+//! - `configs/<algorithm>/<layer>.toml`: another learner's layer of the same kinds;
+//! - `configs/<algorithm>/every-env.toml`: a learner's settings on every environment.
 
 #![allow(clippy::print_stdout)] // a build script talks to cargo on stdout
 
@@ -15,8 +15,8 @@ fn main() {
     presets();
 }
 
-/// Writes `$OUT_DIR/presets.rs`: `PRESETS`, every `(algorithm, environment, TOML text)`, sorted;
-/// a learner's settings on every environment have the environment `*`.
+/// Writes `$OUT_DIR/presets.rs`: `PRESETS`, every `(algorithm, layer, TOML text)`, sorted; a
+/// learner's settings on every environment have the layer `*`.
 fn presets() {
     let manifest = std::env::var("CARGO_MANIFEST_DIR").expect("cargo sets CARGO_MANIFEST_DIR");
     let dir = Path::new(&manifest).join("configs");

@@ -77,13 +77,13 @@ impl Default for TrainConfig {
     }
 }
 
-// The shipped presets, `PRESETS`: every `(algorithm, environment, TOML text)`, found by path
-// (build.rs): SEADS's `configs/<env>.toml`, another learner's `configs/<algorithm>/<env>.toml`,
+// The shipped presets, `PRESETS`: every `(algorithm, layer, TOML text)`, found by path
+// (build.rs): SEADS's `configs/<layer>.toml`, another learner's `configs/<algorithm>/<layer>.toml`,
 // and a learner's settings on every environment, `configs/<algorithm>/every-env.toml` (the
-// environment `*`).
+// layer `*`); `TrainConfig::preset_for` lays them together (`preset_layers`).
 include!(concat!(env!("OUT_DIR"), "/presets.rs"));
 
-/// The environment of a learner's settings on every environment (`every-env.toml`).
+/// The layer of a learner's settings on every environment (`every-env.toml`).
 const EVERY_ENV: &str = "*";
 
 /// Every learner with presets, by name, and the name of its section (from its presets: the one
@@ -103,6 +103,92 @@ static LEARNERS: std::sync::LazyLock<std::collections::BTreeMap<&'static str, St
         }
         learners
     });
+
+/// The layers of `configs/` that make environment `env`'s presets, in the order they are laid
+/// (each later one over the earlier): its manipulator's, its game's and its own, for an
+/// environment named `<game>-<manipulator>` (the registry's names; the robot's environments have
+/// their own layer only). A layer of a manipulator or a game may say `like = "<other>"`: that
+/// one stands in for it, in every learner's layers (the three-link arm is set up like the
+/// two-link one, the sliding puzzle like TileSwap), and what the layer holds besides goes over
+/// it.
+///
+/// ```
+/// assert_eq!(
+///     seads_run::preset_layers("sliding-reacher3"),
+///     ["reacher", "tileswap", "tileswap-reacher", "sliding-reacher3"]
+/// );
+/// ```
+pub fn preset_layers(env: &str) -> Vec<String> {
+    let Some((game, manipulator)) = env.rsplit_once('-') else {
+        return vec![env.to_owned()];
+    };
+    let (game, manipulator) = (alias(game), alias(manipulator));
+    let mut names = vec![
+        manipulator.clone(),
+        game.clone(),
+        format!("{game}-{manipulator}"),
+    ];
+    if names[2] != env {
+        names.push(env.to_owned());
+    }
+    names
+}
+
+/// What layer `name` stands for: the layer its SEADS layer is `like`, followed to the end.
+fn alias(name: &str) -> String {
+    let mut name = name.to_owned();
+    for _ in 0..PRESETS.len() {
+        match preset_file(SeadsConfig::ALGORITHM, &name)
+            .and_then(|t| t.get(LIKE).and_then(toml::Value::as_str).map(str::to_owned))
+        {
+            Some(other) => name = other,
+            None => break,
+        }
+    }
+    name
+}
+
+/// Whether SEADS's layer `name` is the whole preset of an environment outside the registry
+/// (the robot's): it names that environment as its `env`.
+fn is_own_preset(name: &str) -> bool {
+    preset_file(SeadsConfig::ALGORITHM, name)
+        .is_some_and(|t| t.get("env").and_then(toml::Value::as_str) == Some(name))
+}
+
+/// The key of a layer that another stands in for.
+const LIKE: &str = "like";
+
+/// The layer `name` of learner `algorithm` as a table, if there is one.
+fn preset_file(algorithm: &str, name: &str) -> Option<toml::Table> {
+    PRESETS
+        .iter()
+        .find(|(a, n, _)| *a == algorithm && *n == name)
+        .map(|(_, _, text)| text.parse().expect("a shipped preset parses"))
+}
+
+/// Lays the layers `names` of learner `algorithm` over `table`, and for a manipulator or game
+/// that stands in for another, what its own layer holds besides; whether any layer was there.
+fn lay(table: &mut toml::Table, algorithm: &str, names: &[String]) -> bool {
+    let mut found = false;
+    for name in names {
+        if let Some(mut layer) = preset_file(algorithm, name) {
+            layer.remove(LIKE);
+            merge_toml(table, &layer);
+            found = true;
+        }
+    }
+    found
+}
+
+/// Whether the layers found for `env` make a whole configuration: the environment's own, or a
+/// manipulator's (which hold the run's settings), so that a game's layer alone is none.
+fn preset_is_complete(env: &str, names: &[String], table: &toml::Table) -> bool {
+    let own = names.last().is_some_and(|n| n == env);
+    let manipulator = names
+        .first()
+        .is_some_and(|m| preset_file(SeadsConfig::ALGORITHM, m).is_some());
+    (own || manipulator) && table.contains_key("sac")
+}
 
 /// The tables of a configuration that are the run's own, not its learner's.
 const RUN_TABLES: [&str; 2] = ["env_config", "sac"];
@@ -190,49 +276,61 @@ impl TrainConfig {
         Self::preset_for(env, SeadsConfig::ALGORITHM)
     }
 
-    /// The preset of learner `algorithm` on environment `env`: its own preset there
-    /// (`configs/<algorithm>/<env>.toml`), else the environment's with the learner's settings on
-    /// every environment laid over it in place of SEADS's section
-    /// (`configs/<algorithm>/every-env.toml`).
+    /// The preset of learner `algorithm` on environment `env`, laid together from the layers of
+    /// `configs/` ([`preset_layers`]): SEADS's layers of the environment's manipulator, game and
+    /// the environment itself, then (for another learner, in place of SEADS's section) that
+    /// learner's settings on every environment and its layers of the same three names.
     pub fn preset_for(env: &str, algorithm: &str) -> Result<Self, RunError> {
-        let find = |algorithm: &str, env: &str| {
-            PRESETS
-                .iter()
-                .find(|(a, e, _)| *a == algorithm && *e == env)
-                .map(|(_, _, text)| *text)
-        };
         if section_name(algorithm).is_none() {
             return Err(unknown_learner(algorithm));
         }
-        if let Some(text) = find(algorithm, env) {
-            return Self::from_toml(text);
-        }
-        let (Some(base), Some(layer)) = (
-            find(SeadsConfig::ALGORITHM, env),
-            find(algorithm, EVERY_ENV),
-        ) else {
-            return Err(RunError::Config(format!(
+        let no_preset = || {
+            RunError::Config(format!(
                 "unknown environment {env:?}; valid environments for {algorithm}: {}",
                 Self::preset_envs(algorithm).join(", ")
-            )));
+            ))
         };
-        let mut table: toml::Table = base.parse().expect("a shipped preset parses");
-        table.remove(SeadsConfig::NAME);
-        merge_toml(&mut table, &layer.parse().expect("a shipped preset parses"));
+        let names = preset_layers(env);
+        let registered = env_names().contains(&env);
+        let mut table = toml::Table::new();
+        if !lay(&mut table, SeadsConfig::ALGORITHM, &names)
+            || !(registered || is_own_preset(env))
+            || !preset_is_complete(env, &names, &table)
+        {
+            return Err(no_preset());
+        }
+        if algorithm != SeadsConfig::ALGORITHM {
+            table.remove(SeadsConfig::NAME);
+            let every = lay(&mut table, algorithm, &[EVERY_ENV.to_owned()]);
+            if !lay(&mut table, algorithm, &names) && !every {
+                return Err(no_preset());
+            }
+        }
+        table.insert("env".into(), toml::Value::String(env.into()));
+        table.insert("algorithm".into(), toml::Value::String(algorithm.into()));
         Self::from_table(table)
     }
 
-    /// The environments with a preset of learner `algorithm`, sorted.
+    /// The environments with a preset of learner `algorithm`, sorted: the registered ones and
+    /// those with a layer of their own (the robot's).
     pub fn preset_envs(algorithm: &str) -> Vec<&'static str> {
-        let every_env = PRESETS
+        let own = PRESETS
             .iter()
-            .any(|(a, e, _)| *a == algorithm && *e == EVERY_ENV);
-        let mut envs: Vec<&str> = PRESETS
-            .iter()
-            .filter(|(a, e, _)| {
-                *e != EVERY_ENV && (*a == algorithm || (every_env && *a == SeadsConfig::ALGORITHM))
+            .filter(|(a, name, _)| *a == SeadsConfig::ALGORITHM && is_own_preset(name))
+            .map(|(_, name, _)| *name);
+        let mut envs: Vec<&str> = env_names()
+            .into_iter()
+            .chain(own)
+            .filter(|env| {
+                let names = preset_layers(env);
+                let mut table = toml::Table::new();
+                let found = |a: &str, names: &[String], t: &mut toml::Table| lay(t, a, names);
+                found(SeadsConfig::ALGORITHM, &names, &mut table)
+                    && preset_is_complete(env, &names, &table)
+                    && (algorithm == SeadsConfig::ALGORITHM
+                        || found(algorithm, &[EVERY_ENV.to_owned()], &mut table)
+                        || found(algorithm, &names, &mut table))
             })
-            .map(|(_, e, _)| *e)
             .collect();
         envs.sort_unstable();
         envs.dedup();
@@ -247,8 +345,9 @@ impl TrainConfig {
             .collect()
     }
 
-    /// Every shipped preset file's text, as `(algorithm, environment, TOML text)`; the
-    /// environment `*` for a learner's settings on every environment.
+    /// Every shipped preset file's text, as `(algorithm, layer, TOML text)`: the layer is a
+    /// manipulator, a game or an environment ([`preset_layers`]), or `*` for a learner's
+    /// settings on every environment.
     pub fn preset_files() -> &'static [(&'static str, &'static str, &'static str)] {
         PRESETS
     }

@@ -31,7 +31,8 @@ mod skill_model;
 pub mod store;
 
 pub use config::{
-    TrainConfig, config_difference, learner_names, machine_memory_bytes, merge_toml, section_name,
+    TrainConfig, config_difference, learner_names, machine_memory_bytes, merge_toml, preset_layers,
+    section_name,
 };
 pub use device::{ComputeDevice, DeviceError};
 pub use metrics::{Metrics, MetricsRecord, TaskMetrics, TaskTimings, Timings, read_metrics};

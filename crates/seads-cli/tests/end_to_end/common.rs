@@ -245,21 +245,23 @@ pub fn data_snapshot(dir: &Path) -> Vec<(std::path::PathBuf, Vec<u8>)> {
 
 /// A tiny training configuration (small networks, small budget) written into `dir`.
 pub fn tiny_config(dir: &std::path::Path) -> std::path::PathBuf {
-    let text = std::fs::read_to_string(concat!(
+    // The Cursor's layer of the presets, on LightsOut.
+    let layer = std::fs::read_to_string(concat!(
         env!("CARGO_MANIFEST_DIR"),
-        "/../../configs/lightsout-cursor.toml"
+        "/../../configs/cursor.toml"
     ))
-    .unwrap()
-    .replace("env_steps = 500000", "env_steps = 600")
-    .replace("hidden = [256, 256]", "hidden = [32, 32]")
-    .replace("sampled_episodes = 256", "sampled_episodes = 32")
-    .replace("recent_episodes = 256", "recent_episodes = 16")
-    .replace("eval_every = 100", "eval_every = 5")
-    .replace("checkpoint_every = 100", "checkpoint_every = 5")
-    .replace("eval_seeds = 20", "eval_seeds = 1")
-    // Tests run side by side: SAC taking a second thread would oversubscribe the cores.
-    .replace("sac_threads_alone = 2", "sac_threads_alone = 0")
-    .replace("portable_numerics = false", "portable_numerics = true");
+    .unwrap();
+    let text = format!("env = \"lightsout-cursor\"\n{layer}")
+        .replace("env_steps = 500000", "env_steps = 600")
+        .replace("hidden = [256, 256]", "hidden = [32, 32]")
+        .replace("sampled_episodes = 256", "sampled_episodes = 32")
+        .replace("recent_episodes = 256", "recent_episodes = 16")
+        .replace("eval_every = 100", "eval_every = 5")
+        .replace("checkpoint_every = 100", "checkpoint_every = 5")
+        .replace("eval_seeds = 20", "eval_seeds = 1")
+        // Tests run side by side: SAC taking a second thread would oversubscribe the cores.
+        .replace("sac_threads_alone = 2", "sac_threads_alone = 0")
+        .replace("portable_numerics = false", "portable_numerics = true");
     let path = dir.join("tiny.toml");
     std::fs::write(&path, text).unwrap();
     path

@@ -24,11 +24,13 @@ const SEADS: &str = env!("CARGO_BIN_EXE_seads");
 /// (14 in all) and a checkpoint every 5 (so checkpoints fall between evaluations too); 190
 /// moments.
 fn config(dir: &Path) -> PathBuf {
-    let mut text = std::fs::read_to_string(concat!(
-        env!("CARGO_MANIFEST_DIR"),
-        "/../../configs/lightsout-cursor.toml"
-    ))
-    .unwrap();
+    // The Cursor's layer of the presets, on LightsOut.
+    let mut text = "env = \"lightsout-cursor\"\n".to_owned()
+        + &std::fs::read_to_string(concat!(
+            env!("CARGO_MANIFEST_DIR"),
+            "/../../configs/cursor.toml"
+        ))
+        .unwrap();
     for (from, to) in [
         ("seed = 1", "seed = 5"),
         ("env_steps = 500000", "env_steps = 800"),

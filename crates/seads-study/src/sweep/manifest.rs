@@ -488,7 +488,10 @@ env_overrides = { "lightsout-cursor" = { seads = { num_skills = 30 } }, "tileswa
                 6 * 9 * 5,
             ),
             // Two boards, three learners, three seeds.
-            (include_str!("../../../../experiments/diayn.toml"), 2 * 3 * 3),
+            (
+                include_str!("../../../../experiments/diayn.toml"),
+                2 * 3 * 3,
+            ),
         ];
         for (text, count) in shipped {
             let m = Manifest::parse(text, "experiments").unwrap();
