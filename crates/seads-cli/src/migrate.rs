@@ -13,13 +13,15 @@ use anyhow::{Context, Result, anyhow, bail};
 use clap::Args;
 use seads_rl::{BaselineConfig, HacConfig, SeadsConfig, Section, TrainConfig};
 
-/// The learners the older layouts knew (they knew no others).
+/// The learners the older layouts knew (they knew no others), and `Newer`: a learner added
+/// since, whose files are in today's layout by birth (nothing of them is migrated).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 enum Algorithm {
     #[default]
     Seads,
     Sac,
     Hac,
+    Newer,
 }
 
 impl Algorithm {
@@ -31,6 +33,7 @@ impl Algorithm {
             Algorithm::Seads => SeadsConfig::ALGORITHM,
             Algorithm::Sac => BaselineConfig::ALGORITHM,
             Algorithm::Hac => HacConfig::ALGORITHM,
+            Algorithm::Newer => "a newer learner",
         }
     }
 
@@ -40,12 +43,17 @@ impl Algorithm {
             Algorithm::Seads => SeadsConfig::NAME,
             Algorithm::Sac => BaselineConfig::NAME,
             Algorithm::Hac => HacConfig::NAME,
+            Algorithm::Newer => "its own section",
         }
     }
 
-    /// The learner of this name, if the older layouts knew it.
+    /// The learner of this name, if the older layouts knew it, or [`Algorithm::Newer`] for a
+    /// learner with presets today.
     fn named(name: &str) -> Option<Self> {
-        Self::ALL.into_iter().find(|a| a.name() == name)
+        Self::ALL
+            .into_iter()
+            .find(|a| a.name() == name)
+            .or_else(|| seads_rl::section_name(name).map(|_| Algorithm::Newer))
     }
 }
 
@@ -189,6 +197,9 @@ const SAC_UPDATES: i64 = 16;
 /// layout: the flat layout's keys into their sections, the Jaco's `physics_substeps` into
 /// `[env_config.manipulator]`, SAC's `updates_per_epoch` into `[seads]`.
 fn upgrade(table: &mut toml::Table, algorithm: Algorithm) -> Result<()> {
+    if algorithm == Algorithm::Newer {
+        return Ok(());
+    }
     let mut seads = toml::Table::new();
     for key in SEADS_KEYS {
         if let Some(value) = table.remove(key) {
@@ -200,9 +211,10 @@ fn upgrade(table: &mut toml::Table, algorithm: Algorithm) -> Result<()> {
         let toml::Value::Table(baseline) = value else {
             bail!("baseline must be a table");
         };
+        // (A newer learner returned above: nothing of it is migrated.)
         let section = match algorithm {
             Algorithm::Hac => "hac",
-            Algorithm::Seads | Algorithm::Sac => "sac_baseline",
+            Algorithm::Seads | Algorithm::Sac | Algorithm::Newer => "sac_baseline",
         };
         move_into(table, section, baseline)?;
     }
@@ -279,6 +291,9 @@ fn drop_default_sections(table: &mut toml::Table, algorithm: Algorithm) -> Resul
     ) -> Result<bool> {
         Ok(value.try_into::<T>()? == T::default())
     }
+    if algorithm == Algorithm::Newer {
+        return Ok(());
+    }
     for other in Algorithm::ALL.into_iter().filter(|&a| a != algorithm) {
         let Some(value) = table.remove(other.section()) else {
             continue;
@@ -287,6 +302,7 @@ fn drop_default_sections(table: &mut toml::Table, algorithm: Algorithm) -> Resul
             Algorithm::Seads => at_default::<SeadsConfig>(value)?,
             Algorithm::Sac => at_default::<BaselineConfig>(value)?,
             Algorithm::Hac => at_default::<HacConfig>(value)?,
+            Algorithm::Newer => true,
         };
         if !default {
             bail!(
@@ -476,6 +492,23 @@ fn migrate_episodes(path: &Path) -> Result<Option<Vec<u8>>> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// A learner added since the older layouts (DIAYN) is in today's layout by birth: its
+    /// configurations and manifest layers are left as they are; a name no learner has is an
+    /// error.
+    #[test]
+    fn a_newer_learners_files_are_left_alone() {
+        let config = seads_rl::TrainConfig::preset_for("lightsout-cursor", "diayn")
+            .unwrap()
+            .to_toml();
+        assert_eq!(migrate_config(&config).unwrap(), None);
+        let manifest = "name = \"m\"\nenvironments = [\"lightsout-cursor\"]\nseeds = [1]\n\
+                        [[variant]]\nname = \"diayn\"\noverrides = { algorithm = \"diayn\" }\n";
+        assert_eq!(migrate_manifest(manifest).unwrap(), None);
+        let unknown = manifest.replace("algorithm = \"diayn\"", "algorithm = \"ppo\"");
+        let err = migrate_manifest(&unknown).unwrap_err().to_string();
+        assert!(err.contains("unknown algorithm \"ppo\""), "{err}");
+    }
 
     fn table(text: &str) -> toml::Table {
         text.parse().unwrap()
