@@ -54,11 +54,18 @@ pub mod sweep;
 pub use error::{BoxError, Context, Result, StudyError};
 pub use journal::Resumed;
 
-/// The number of skills K of a run: its `num_skills`, else its environment's (for a robot run,
-/// whose environment is not in the registry, one per field of the tablet's LightsOut 5×5). An
-/// environment that is neither is [`StudyError::Environment`].
+/// The number of skills K of a run: its learner's `num_skills` (SEADS's, DIAYN's: any learner's
+/// section that states one), else its environment's (for a robot run, whose environment is not
+/// in the registry, one per field of the tablet's LightsOut 5×5). An environment that is neither
+/// is [`StudyError::Environment`].
 pub fn run_skills(config: &seads_run::TrainConfig) -> Result<usize> {
-    if let Some(k) = config.seads().ok().and_then(|s| s.num_skills) {
+    let stated = config
+        .learner
+        .stated_section()
+        .and_then(|(_, section)| section.get("num_skills"))
+        .and_then(toml::Value::as_integer)
+        .and_then(|k| usize::try_from(k).ok());
+    if let Some(k) = stated {
         return Ok(k);
     }
     if seads_uarm::ActionSpace::of_env(&config.env).is_some() {
@@ -81,4 +88,42 @@ pub fn run_game(config: &seads_run::TrainConfig) -> Result<Box<dyn seads_games::
         .game
         .build(env.spec().board_size)
         .doing(|| format!("building the game of {}", config.env))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// K is the learner's own where its section states one, whichever learner it is, else the
+    /// environment's (25 moves on LightsOut 5×5, 12 swaps on TileSwap 3×3).
+    #[test]
+    fn a_runs_skills_are_its_learners_or_its_environments() {
+        let preset = |env: &str, algorithm: &str, k: Option<i64>| {
+            let mut table: toml::Table = seads_run::TrainConfig::preset_for(env, algorithm)
+                .unwrap()
+                .to_toml()
+                .parse()
+                .unwrap();
+            if let (Some(k), Some(toml::Value::Table(section))) = (k, table.get_mut(algorithm)) {
+                section.insert("num_skills".into(), toml::Value::Integer(k));
+            }
+            seads_run::TrainConfig::from_table(table).unwrap()
+        };
+        assert_eq!(
+            run_skills(&preset("lightsout-cursor", "seads", Some(30))).unwrap(),
+            30
+        );
+        assert_eq!(
+            run_skills(&preset("lightsout-cursor", "diayn", Some(7))).unwrap(),
+            7
+        );
+        assert_eq!(
+            run_skills(&preset("lightsout-cursor", "diayn", None)).unwrap(),
+            25
+        );
+        assert_eq!(
+            run_skills(&preset("tileswap-cursor", "seads", None)).unwrap(),
+            12
+        );
+    }
 }
