@@ -248,23 +248,20 @@ impl Diayn {
         self.k
     }
 
-    /// log q(k | s) for each row of `obs` (observations) and its skill, and the logits.
-    fn log_q(&self, obs: &Tensor, skills: &Tensor) -> (Tensor, Tensor) {
-        let logits = self.discriminator.forward(obs);
-        let log_q = logits
+    /// log q(k | s) for each row of `obs` (observations) and its skill.
+    fn log_q(&self, obs: &Tensor, skills: &Tensor) -> Tensor {
+        self.discriminator
+            .forward(obs)
             .log_softmax(-1, Kind::Float)
             .gather(1, &skills.unsqueeze(1), false)
-            .squeeze_dim(1);
-        (log_q, logits)
+            .squeeze_dim(1)
     }
 
     /// DIAYN's reward log q(k | s) − log p(k), p(k) = 1/K, for each row of `states` and its skill.
     fn rewards(&self, states: &Tensor, skills: &Tensor) -> Vec<f32> {
         let log_p = -(self.k as f64).ln();
-        let rewards = tch::no_grad(|| {
-            let (log_q, _) = self.log_q(states, skills);
-            (log_q - log_p).to_device(tch::Device::Cpu)
-        });
+        let rewards =
+            tch::no_grad(|| (self.log_q(states, skills) - log_p).to_device(tch::Device::Cpu));
         Vec::<f32>::try_from(&rewards).unwrap_or_default()
     }
 
@@ -345,11 +342,10 @@ impl Diayn {
             .to_device(device);
         let states = next.narrow(1, 0, o);
         let skills = next.narrow(1, o, self.k as i64).argmax(1, false);
-        let (log_q, logits) = self.log_q(&states, &skills);
-        let loss = logits.cross_entropy_for_logits(&skills);
+        // Cross-entropy of the discriminator on (s', k).
+        let loss = -self.log_q(&states, &skills).mean(Kind::Float);
         self.discriminator_opt.backward_step(&loss);
         let loss = f32::try_from(&loss).unwrap_or(f32::NAN);
-        drop(log_q);
         batch.rewards = self.rewards(&states, &skills);
         let timings = &mut self.progress.timings;
         timings.skill_model += start.elapsed().as_secs_f64();
