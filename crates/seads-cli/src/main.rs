@@ -78,6 +78,9 @@ enum Command {
     Solve(plan::SolveArgs),
     /// Task success of a trained agent per solution depth on test boards (the paper's protocol).
     Evaluate(plan::EvaluateArgs),
+    /// Fit SEADS's forward model to the frozen skills of any trained skill learner (DIAYN, VIC,
+    /// SEADS), so that they can be planned with (`seads evaluate --fitted-model`).
+    FitModel(plan::FitModelArgs),
     /// Figures of a run: skill coverage, success per depth, skill trajectories, push points.
     Plot(plot::PlotArgs),
     /// Planner speed: BFS with a forward model fitted to the LightsOut move table.
@@ -277,6 +280,7 @@ fn runs_libtorch_in_parallel(command: &Command) -> bool {
             | Command::Train(_)
             | Command::Solve(_)
             | Command::Evaluate(_)
+            | Command::FitModel(_)
             | Command::Plot(_)
             | Command::PlanBench(_)
             | Command::Sweep(sweep::SweepCommand::Run(_) | sweep::SweepCommand::Task(_))
@@ -332,6 +336,7 @@ fn main() -> ExitCode {
         Command::Train(args) => train::train(args),
         Command::Solve(args) => plan::solve_board(args),
         Command::Evaluate(args) => plan::evaluate_run(args),
+        Command::FitModel(args) => plan::fit_model(args),
         Command::Plot(args) => plot::plot(args),
         Command::PlanBench(args) => plan::plan_bench(args),
         Command::Record(args) => episodes::record(args),

@@ -6,10 +6,11 @@ use std::collections::BTreeMap;
 use std::path::Path;
 
 use seads_planner::{
-    DepthResult, Evaluation, EvaluationKind, EvaluationRecord, Protocol, SolveConfig, TaskRecord,
-    TaskSet, TaskSummary, evaluate_resuming,
+    DepthResult, Evaluation, EvaluationKind, EvaluationRecord, PlanModel, Protocol, SolveConfig,
+    TaskRecord, TaskSet, TaskSummary, evaluate_resuming,
 };
 use seads_rl::{Agent, TrainConfig};
+use seads_skillmodel::ForwardModel;
 use seads_study::evaluation::{checkpoint_of, keep_another_protocols, save_evaluation, task_line};
 use seads_study::journal::Place;
 use seads_study::{Context as _, Resumed, StudyError};
@@ -19,19 +20,38 @@ use crate::Result;
 /// Evaluates the agent with `protocol` (a planning kind), calling `each` with every task as it
 /// ends (for progress). An evaluation the agent's environment cannot play is
 /// [`StudyError::Invalid`].
+///
+/// It plans with the agent's own forward model; a protocol of a model fitted afterwards needs
+/// the run directory that holds it ([`run_evaluation`]) and is [`StudyError::Invalid`] here.
 pub fn evaluate_agent(
     agent: &mut Agent,
     protocol: &Protocol,
     each: impl FnMut(&TaskRecord<'_>),
 ) -> Result<Vec<DepthResult>> {
-    evaluate_agent_resuming(agent, protocol, |_, _| None, each)
+    if protocol.model == PlanModel::Fitted {
+        return Err(StudyError::invalid(
+            "planning with a fitted model evaluates a run directory, which holds the model",
+        )
+        .into());
+    }
+    evaluate_agent_resuming(agent, protocol, None, |_, _| None, each)
 }
 
-/// [`evaluate_agent`], counting the tasks `finished` knows (by depth and seed) as they ended
-/// before instead of solving them again.
+/// The model `protocol` plans with where it is not the agent's own: the one fitted to the
+/// skills of the agent's checkpoint in `run`.
+fn fitted_model(agent: &Agent, run: &Path, protocol: &Protocol) -> Result<Option<ForwardModel>> {
+    Ok(match protocol.model {
+        PlanModel::Own => None,
+        PlanModel::Fitted => Some(agent.fitted_model(run)?.0),
+    })
+}
+
+/// [`evaluate_agent`] with `fitted`'s model where it is given, counting the tasks `finished`
+/// knows (by depth and seed) as they ended before instead of solving them again.
 fn evaluate_agent_resuming(
     agent: &mut Agent,
     protocol: &Protocol,
+    fitted: Option<ForwardModel>,
     finished: impl FnMut(usize, u64) -> Option<TaskSummary>,
     mut each: impl FnMut(&TaskRecord<'_>),
 ) -> Result<Vec<DepthResult>> {
@@ -49,7 +69,11 @@ fn evaluate_agent_resuming(
         },
         action_noise: protocol.action_noise,
     };
-    let (policy, model) = agent.parts()?;
+    let mut fitted = fitted;
+    let (policy, model) = match fitted.as_mut() {
+        Some(model) => (&agent.policy, model),
+        None => agent.parts()?,
+    };
     evaluate_resuming(&evaluation, policy, model, finished, |task| each(task))
         .map_err(|e| StudyError::Environment(e).into())
 }
@@ -70,6 +94,7 @@ pub fn run_evaluation(
     mut each: impl FnMut(&TaskRecord<'_>),
 ) -> Result<EvaluationRecord> {
     let game = seads_study::run_game(&agent.config)?;
+    let fitted = fitted_model(agent, run, protocol)?;
     let (checkpoint, named) = checkpoint_of(run, &agent.checkpoint)?;
     // Before any work: an evaluation of another protocol in the way is moved to its own name,
     // or the evaluation is refused with nothing solved.
@@ -80,6 +105,7 @@ pub fn run_evaluation(
     let results = evaluate_agent_resuming(
         agent,
         protocol,
+        fitted,
         |depth, seed| finished.get(&(depth, seed)).cloned(),
         |task| {
             let line = task_line(game.as_ref(), task);
@@ -156,6 +182,7 @@ pub fn run_policy_evaluation(
             tasks,
             limits: None,
             action_noise: None,
+            model: seads_planner::PlanModel::Own,
         }),
         evaluated_by: seads_study::provenance::this_binary()
             .into_iter()

@@ -45,7 +45,13 @@ impl EvalError {
     /// Whether the input was bad (a run, option or file that cannot be evaluated), not the
     /// work.
     pub fn is_invalid(&self) -> bool {
-        matches!(self, Self::Study(e) if e.is_invalid())
+        match self {
+            Self::Study(e) => e.is_invalid(),
+            // What the run cannot do as asked (plan without a model, with a model fitted to
+            // another checkpoint).
+            Self::Learning(seads_rl::RlError::Run(seads_run::RunError::Config(_))) => true,
+            _ => false,
+        }
     }
 }
 

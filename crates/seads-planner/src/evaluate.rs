@@ -383,6 +383,7 @@ mod tests {
                     memory_limit_mib: None,
                 }),
                 action_noise: None,
+                model: crate::PlanModel::Own,
             }),
             evaluated_by: vec![Evaluator {
                 seads: "0.1.0".into(),

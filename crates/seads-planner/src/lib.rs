@@ -43,7 +43,7 @@ pub use execute::{Deviation, SolveConfig, SolveOutcome, solve};
 pub use meet::meet_plan;
 pub use memo::Memo;
 pub use protocol::{
-    DEFAULT_MAX_EXPANDED, EVALUATION_SEEDS, EvaluationKind, Protocol, STANDARD_BOARDS,
+    DEFAULT_MAX_EXPANDED, EVALUATION_SEEDS, EvaluationKind, PlanModel, Protocol, STANDARD_BOARDS,
     STANDARD_DEPTHS, SearchLimits, TASK_STREAM_SEED, TaskSet,
 };
 

@@ -282,6 +282,28 @@ pub struct Protocol {
     /// ([`seads_embodiment::ActionNoise`]); `None`: none.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub action_noise: Option<f64>,
+    /// Which forward model the planner searches with.
+    #[serde(default, skip_serializing_if = "PlanModel::is_own")]
+    pub model: PlanModel,
+}
+
+/// The forward model a planning evaluation searches with.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum PlanModel {
+    /// The one the agent learned while training (SEADS's).
+    #[default]
+    Own,
+    /// One fitted afterwards to the agent's frozen skills (`seads fit-model`): the model any
+    /// skill learner can be planned with, so that learners compare by their skills alone.
+    Fitted,
+}
+
+impl PlanModel {
+    /// Whether this is the agent's own model (the default, left out of the files).
+    pub fn is_own(&self) -> bool {
+        *self == Self::Own
+    }
 }
 
 impl Protocol {
@@ -293,6 +315,7 @@ impl Protocol {
             tasks: TaskSet::standard(boards),
             limits: Some(limits),
             action_noise: None,
+            model: PlanModel::Own,
         }
     }
 
@@ -301,8 +324,8 @@ impl Protocol {
     /// [`SearchLimits::default`] (2²² expanded states, no clock, the most likely plan,
     /// breadth-first, the planner's memory). One item per departure, as the files' names
     /// write it: `boards-2`, `train-boards`, `task-seed-7`, `expanded-1000` (or `unbounded`),
-    /// `timeout-0.5s`, `first-found`, `both-ends`, `memory-16384mib`. Empty for the standard
-    /// protocol.
+    /// `timeout-0.5s`, `first-found`, `both-ends`, `memory-16384mib`, `fitted-model`. Empty for
+    /// the standard protocol.
     pub fn departures(&self) -> Vec<String> {
         let mut items = Vec::new();
         let tasks = &self.tasks;
@@ -335,6 +358,9 @@ impl Protocol {
             if let Some(mib) = limits.memory_limit_mib {
                 items.push(format!("memory-{mib}mib"));
             }
+        }
+        if self.model == PlanModel::Fitted {
+            items.push("fitted-model".to_owned());
         }
         items
     }
@@ -514,8 +540,24 @@ mod tests {
             tasks: TaskSet::standard(STANDARD_BOARDS),
             limits: None,
             action_noise: None,
+            model: PlanModel::Own,
         };
         assert_eq!(policy.results_file(None), "evaluation-policy.json");
+        // Planning with a model fitted afterwards is named as such, and only then.
+        let fitted = Protocol {
+            model: PlanModel::Fitted,
+            ..Protocol::planning(false, STANDARD_BOARDS, SearchLimits::default())
+        };
+        assert_eq!(
+            fitted.results_file(None),
+            "evaluation-plan-once-fitted-model.json"
+        );
+        assert_eq!(fitted.label(), "fitted-model");
+        let json = serde_json::to_string(&standard).unwrap();
+        assert!(!json.contains("model"), "{json}");
+        let back: Protocol =
+            serde_json::from_str(&serde_json::to_string(&fitted).unwrap()).unwrap();
+        assert_eq!(back, fitted);
         // Two protocols that differ anywhere have different files.
         let mut names = std::collections::BTreeSet::new();
         for boards in [1, 20] {

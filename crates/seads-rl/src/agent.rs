@@ -10,11 +10,12 @@ use seads_skillmodel::{ForwardModel, SkillModel, SkillModelKind};
 use crate::episode::policy_input;
 use crate::store::{checkpoints, latest_checkpoint};
 use crate::task_policy::TaskPolicy;
-use crate::{InWords, RlError, Sac, TrainConfig, WithLearner, load_config};
+use crate::{InWords, RlError, Sac, SeadsConfig, TrainConfig, WithLearner, load_config};
+use seads_run::fitted::{FitRecord, fitted_model_dir, read_fit_record};
 
 /// The skill policy π(a | s, k) of a trained agent, executed deterministically.
 pub struct AgentPolicy {
-    sac: Sac,
+    pub(crate) sac: Sac,
     k: usize,
 }
 
@@ -73,7 +74,8 @@ pub struct Agent {
     pub epoch: u64,
     /// The skill policy.
     pub policy: AgentPolicy,
-    /// The forward model (`None` for a VIC agent, which cannot plan).
+    /// The agent's own forward model (SEADS's); `None` for a learner that learns none (VIC,
+    /// DIAYN), whose skills are planned with a model fitted to them ([`Agent::fitted_model`]).
     pub model: Option<ForwardModel>,
 }
 
@@ -125,8 +127,18 @@ impl Agent {
         // network size) would evaluate another agent than the one trained, so it is refused as
         // a resume refuses it.
         crate::store::check_config(checkpoint, &config)?;
-        let seads = config.seads()?;
-        let k = seads.num_skills.unwrap_or(spec.num_skills);
+        if config.baseline_training().is_ok() {
+            return Err(RlError::config(format!(
+                "a {} run learns a task policy, not skills",
+                config.algorithm()
+            )));
+        }
+        // Any skill learner: SAC's actor over [observation, one-hot skill]; SEADS also keeps
+        // its forward model in the checkpoint.
+        let k = config
+            .learner
+            .stated_num_skills()
+            .unwrap_or(spec.num_skills);
         let device = config.device.resolve()?;
         let mut sac = Sac::new(
             spec.obs_dim + k,
@@ -137,14 +149,17 @@ impl Agent {
             0,
         );
         sac.load(checkpoint, true)?;
-        let model = match seads.skill_model.kind {
-            SkillModelKind::Forward => {
-                let mut model =
-                    ForwardModel::new(spec.symbolic_len, k, &seads.skill_model, device, 0);
+        let own_model = match config.is::<SeadsConfig>() {
+            true => Some(config.seads()?.skill_model),
+            false => None,
+        };
+        let model = match own_model {
+            Some(settings) if settings.kind == SkillModelKind::Forward => {
+                let mut model = ForwardModel::new(spec.symbolic_len, k, &settings, device, 0);
                 model.load(checkpoint, false)?;
                 Some(model)
             }
-            SkillModelKind::Vic => None,
+            _ => None,
         };
         let epoch = checkpoint
             .file_name()
@@ -167,14 +182,56 @@ impl Agent {
     }
 
     /// The policy and the forward model, borrowed together (planning executes with one and
-    /// searches with the other). Errors for a VIC agent.
+    /// searches with the other). Errors for an agent without a forward model.
     pub fn parts(&mut self) -> Result<(&AgentPolicy, &mut ForwardModel), RlError> {
         match &mut self.model {
             Some(model) => Ok((&self.policy, model)),
-            None => Err(RlError::config(
-                "this agent learned a VIC skill discriminator, which cannot plan",
-            )),
+            None => Err(RlError::config(format!(
+                "this {} agent learned no forward model to plan with; fit one to its skills \
+                 (`seads fit-model`) and plan with that",
+                self.config.algorithm()
+            ))),
         }
+    }
+
+    /// Skills K: the width of the policy's one-hot skill input.
+    pub fn num_skills(&self) -> usize {
+        self.policy.k
+    }
+
+    /// The forward model fitted to this agent's skills (`seads fit-model`) in the run
+    /// directory `run`, with its record. Errors if the run has none, or if it was fitted to
+    /// another checkpoint's skills.
+    pub fn fitted_model(&self, run: &Path) -> Result<(ForwardModel, FitRecord), RlError> {
+        let dir = fitted_model_dir(run);
+        let record = read_fit_record(run)?.ok_or_else(|| {
+            RlError::config(format!(
+                "{} has no fitted model: fit one first (`seads fit-model --run {}`)",
+                run.display(),
+                run.display()
+            ))
+        })?;
+        if record.checkpoint.epoch != self.epoch || record.num_skills != self.policy.k {
+            return Err(RlError::config(format!(
+                "{}'s fitted model was fitted to the {} skills of epoch {}, not to the {} of \
+                 epoch {} evaluated: fit it again (`seads fit-model --refit`)",
+                run.display(),
+                record.num_skills,
+                record.checkpoint.epoch,
+                self.policy.k,
+                self.epoch
+            )));
+        }
+        let device = self.config.device.resolve()?;
+        let mut model = ForwardModel::new(
+            self.spec.symbolic_len,
+            record.num_skills,
+            &record.skill_model,
+            device,
+            0,
+        );
+        model.load(&dir, false)?;
+        Ok((model, record))
     }
 }
 

@@ -27,6 +27,14 @@ pub enum Purpose {
     SkillModelInit = 6,
     /// Seeds of the training environments, one per (epoch, episode slot).
     TrainEnvs = 7,
+    /// A model fitted to frozen skills (`seads fit-model`): the seed of each execution's board.
+    FitBoards = 8,
+    /// … the skill each execution runs.
+    FitSkills = 9,
+    /// … the model's initial weights.
+    FitInit = 10,
+    /// … the executions each gradient step learns from.
+    FitBatches = 11,
 }
 
 /// The stream of `purpose` in the run seeded with `seed`.
@@ -111,6 +119,10 @@ mod tests {
             Purpose::SacInit,
             Purpose::SkillModelInit,
             Purpose::TrainEnvs,
+            Purpose::FitBoards,
+            Purpose::FitSkills,
+            Purpose::FitInit,
+            Purpose::FitBatches,
         ];
         let mut firsts = Vec::new();
         for seed in 1..=5 {

@@ -11,6 +11,7 @@
 //!   names, order and metadata, and the run's one writer ([`store::RunLock`]).
 //! - [`Metrics`], [`TaskMetrics`]: the lines of `metrics.jsonl` of SEADS and of the baselines.
 //! - [`PopulationKey`]: which runs can train in one population.
+//! - [`fitted`]: a forward model fitted afterwards to a run's frozen skills, and its record.
 //!
 //! Architecture invariant: no libtorch in this crate's dependency tree (`tests/tidy.rs`).
 //!
@@ -23,6 +24,7 @@
 
 mod config;
 mod device;
+pub mod fitted;
 mod metrics;
 mod population;
 mod sac;

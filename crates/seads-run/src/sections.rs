@@ -103,6 +103,16 @@ impl LearnerConfig {
             .map(|(name, table)| (name.as_str(), table))
     }
 
+    /// The number of skills the learner's section states (`num_skills`, a key every skill
+    /// learner's section names alike); `None` where it states none (the environment's then).
+    pub fn stated_num_skills(&self) -> Option<usize> {
+        self.stated_section()?
+            .1
+            .get("num_skills")?
+            .as_integer()
+            .and_then(|k| usize::try_from(k).ok())
+    }
+
     /// Whether the learner is the one of section `S`.
     pub fn is<S: Section>(&self) -> bool {
         self.algorithm == S::ALGORITHM

@@ -161,6 +161,7 @@ impl CheckpointEvaluation {
             },
             limits: Some(self.limits),
             action_noise: None,
+            model: seads_planner::PlanModel::Own,
         }
     }
 }
@@ -215,6 +216,7 @@ pub fn over_training_protocol(tasks: &TaskSet, limits: SearchLimits, replan: boo
         tasks: tasks.clone(),
         limits: Some(limits),
         action_noise: None,
+        model: seads_planner::PlanModel::Own,
     }
 }
 

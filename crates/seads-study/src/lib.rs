@@ -59,13 +59,7 @@ pub use journal::Resumed;
 /// in the registry, one per field of the tablet's LightsOut 5×5). An environment that is neither
 /// is [`StudyError::Environment`].
 pub fn run_skills(config: &seads_run::TrainConfig) -> Result<usize> {
-    let stated = config
-        .learner
-        .stated_section()
-        .and_then(|(_, section)| section.get("num_skills"))
-        .and_then(toml::Value::as_integer)
-        .and_then(|k| usize::try_from(k).ok());
-    if let Some(k) = stated {
+    if let Some(k) = config.learner.stated_num_skills() {
         return Ok(k);
     }
     if seads_uarm::ActionSpace::of_env(&config.env).is_some() {

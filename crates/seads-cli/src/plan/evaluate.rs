@@ -6,7 +6,7 @@ use std::path::PathBuf;
 use anyhow::{Result, bail};
 use clap::Args;
 use seads_games::Split;
-use seads_planner::{EvaluationKind, Protocol, TaskSet, summarise};
+use seads_planner::{EvaluationKind, PlanModel, Protocol, TaskSet, summarise};
 use seads_rl::ComputeDevice;
 
 use super::{load_agent, run_evaluation};
@@ -51,6 +51,11 @@ pub struct EvaluateArgs {
     /// seed; the files are named `evaluation-replan-noise-STD…`.
     #[arg(long, value_parser = crate::numbers::non_negative_finite, conflicts_with = "checkpoints")]
     action_noise: Option<f64>,
+    /// Plan with the forward model fitted to the run's skills (`seads fit-model`) instead of
+    /// its own: the one way to plan with the skills of a learner that learns no model (DIAYN,
+    /// VIC). The files are named `evaluation-replan-fitted-model…`.
+    #[arg(long, conflicts_with = "checkpoints")]
+    fitted_model: bool,
     /// Where the networks run: cpu, cuda (the first GPU) or cuda:N, whichever device the run
     /// trained on. The plans are the same on either.
     #[arg(long, default_value = "cpu")]
@@ -83,10 +88,11 @@ pub fn evaluate_run(args: EvaluateArgs) -> Result<()> {
     let mut config = crate::run_config(&args.run)?;
     config.device = crate::usable_device(args.device)?;
     let _lock = crate::lock_run(&args.run)?;
-    if !config.is::<seads_rl::SeadsConfig>() {
-        if args.action_noise.is_some() {
+    if config.baseline_training().is_ok() {
+        if args.action_noise.is_some() || args.fitted_model {
             bail!(BadInput(anyhow::anyhow!(
-                "--action-noise is for planning evaluations of SEADS runs; {} is a baseline",
+                "--action-noise and --fitted-model are for planning evaluations of skill \
+                 learners; {} is a baseline",
                 args.run.display()
             )));
         }
@@ -142,6 +148,11 @@ pub fn evaluate_run(args: EvaluateArgs) -> Result<()> {
         },
         limits: Some(limits),
         action_noise: args.action_noise,
+        model: if args.fitted_model {
+            PlanModel::Fitted
+        } else {
+            PlanModel::Own
+        },
     };
     let record = run_evaluation(&mut agent, &args.run, &protocol, args.quiet || args.json)?;
     let results = record.results;
@@ -150,13 +161,18 @@ pub fn evaluate_run(args: EvaluateArgs) -> Result<()> {
         outln!("{}", serde_json::to_string(&summary)?);
     } else {
         outln!(
-            "{} (epoch {}), {}, {} boards per depth{}",
+            "{} (epoch {}), {}{}, {} boards per depth{}",
             agent.config.env,
             agent.epoch,
             if args.replan {
                 "with re-planning"
             } else {
                 "plan once"
+            },
+            if args.fitted_model {
+                " with the fitted model"
+            } else {
+                ""
             },
             args.boards,
             args.action_noise

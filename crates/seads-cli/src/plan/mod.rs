@@ -1,9 +1,11 @@
 //! Planning with a trained agent: `seads solve` (one board), `seads evaluate` (task success over
-//! many boards) and `seads plan-bench` (the planner's speed on a fitted model).
+//! many boards), `seads fit-model` (a forward model for any learner's skills) and
+//! `seads plan-bench` (the planner's speed on a fitted model).
 
 mod bench;
 mod evaluate;
 mod evaluation;
+mod fit;
 mod solve;
 
 use std::path::Path;
@@ -16,6 +18,7 @@ use seads_rl::{Agent, ComputeDevice};
 pub use bench::{PlanBenchArgs, plan_bench};
 pub use evaluate::{EvaluateArgs, evaluate_run};
 pub use evaluation::{evaluate_checkpoints, run_evaluation};
+pub use fit::{FitModelArgs, fit_model};
 pub use solve::{SolveArgs, solve_board};
 
 use crate::BadInput;
@@ -109,7 +112,7 @@ pub fn load_agent(run: &Path, checkpoint: Option<u64>, device: ComputeDevice) ->
     }
     config.device = crate::usable_device(device)?;
     crate::kernels::use_kernels(config.portable_numerics)?;
-    if !config.is::<seads_rl::SeadsConfig>() {
+    if config.baseline_training().is_ok() {
         bail!(BadInput(anyhow::anyhow!(
             "{} is a {} baseline run: it has no skills to plan with (`seads evaluate --run` \
              measures its policy's task success)",

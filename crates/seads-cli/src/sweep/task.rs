@@ -19,7 +19,7 @@ use crate::plan::{load_agent, run_evaluation};
 use crate::sweep::train::member_config;
 use seads_evaluation::evaluation::run_policy_evaluation;
 use seads_evaluation::over_training::Selection;
-use seads_planner::{EvaluationKind, Protocol, TaskSet};
+use seads_planner::{EvaluationKind, PlanModel, Protocol, TaskSet};
 use seads_study::sweep::{Task, Work};
 
 /// Runs the task of the runs `indices` of the sweep in `dir` with `cores` cores and the networks
@@ -207,30 +207,24 @@ fn evaluate(sweep: &Sweep, run: &Path, device: ComputeDevice) -> Result<()> {
     if config.baseline_training().is_ok() {
         return evaluate_baseline(sweep, run, &config);
     }
-    if !config.is::<SeadsConfig>() {
+    let plan = &sweep.evaluation;
+    // The planner's parts and bookkeeping run on the task's rayon pool (`cores` threads), each
+    // part's network on one libtorch thread.
+    seads_rl::set_threads(1);
+    let own_model = config
+        .seads()
+        .is_ok_and(|s| s.skill_model.kind == SkillModelKind::Forward);
+    if !own_model && !plan.fitted_model {
         outln!(
-            "{}: a {} run has skills but no forward model to plan with; no task evaluation \
-             (its skill coverage is in metrics.jsonl)",
+            "{}: a {} run learned no forward model to plan with; no task evaluation (its skill \
+             coverage is in metrics.jsonl; a study plans with its skills by `fitted_model = true` \
+             in its [evaluation])",
             run.display(),
             config.algorithm()
         );
         return Ok(());
     }
-    let plan = &sweep.evaluation;
-    if config
-        .seads()
-        .is_ok_and(|s| s.skill_model.kind == SkillModelKind::Vic)
-    {
-        outln!(
-            "{}: a VIC agent cannot plan; no task evaluation",
-            run.display()
-        );
-        return Ok(());
-    }
-    // The planner's parts and bookkeeping run on the task's rayon pool (`cores` threads), each
-    // part's network on one libtorch thread.
-    seads_rl::set_threads(1);
-    if plan.every > 0 {
+    if own_model && plan.every > 0 {
         let added = evaluate_checkpoints(
             run,
             Selection::Every(plan.every),
@@ -244,29 +238,68 @@ fn evaluate(sweep: &Sweep, run: &Path, device: ComputeDevice) -> Result<()> {
             run.display()
         );
     }
-    if plan.last {
-        let mut agent = load_agent(run, None, device)?;
+    if !plan.last {
+        return Ok(());
+    }
+    let mut agent = load_agent(run, None, device)?;
+    let mut models = Vec::new();
+    if own_model {
+        models.push(PlanModel::Own);
+    }
+    if plan.fitted_model {
+        fit_unless_fitted(&agent, run)?;
+        models.push(PlanModel::Fitted);
+    }
+    for model in models {
         for replan in [true, false] {
             let protocol = Protocol {
                 kind: EvaluationKind::planning(replan),
                 tasks: TaskSet::standard(plan.boards),
                 limits: Some(plan.limits()),
                 action_noise: None,
+                model,
             };
             let results = run_evaluation(&mut agent, run, &protocol, true)?.results;
             let solved: usize = results.iter().map(|r| r.solved).sum();
             let tasks: usize = results.iter().map(|r| r.tasks).sum();
             outln!(
-                "{}: {} {solved}/{tasks} solved",
+                "{}: {}{} {solved}/{tasks} solved",
                 run.display(),
                 if replan {
                     "with re-planning"
                 } else {
                     "plan once"
+                },
+                match model {
+                    PlanModel::Own => "",
+                    PlanModel::Fitted => " with the fitted model",
                 }
             );
         }
     }
+    Ok(())
+}
+
+/// Fits a forward model to the final skills of the run in `run` (the standard settings, the
+/// run's seed), unless one fitted to them is there (a task re-queued after fitting).
+fn fit_unless_fitted(agent: &seads_rl::Agent, run: &Path) -> Result<()> {
+    let fitted = seads_run::fitted::read_fit_record(run)?;
+    if fitted.is_some_and(|r| r.checkpoint.epoch == agent.epoch) {
+        return Ok(());
+    }
+    let settings = seads_run::fitted::FitSettings::standard(agent.config.seed);
+    let by = seads_study::provenance::this_binary()
+        .into_iter()
+        .cloned()
+        .collect();
+    let record = seads_rl::fit_model(agent, run, &settings, by, |_| {})?;
+    outln!(
+        "{}: a forward model fitted to its skills: the most likely successor right {:.1} % of \
+         {} held-out executions",
+        run.display(),
+        100.0 * record.quality.mode_accuracy,
+        record.quality.held_out
+    );
     Ok(())
 }
 

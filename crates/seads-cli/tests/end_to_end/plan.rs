@@ -732,3 +732,122 @@ fn a_stopped_evaluation_resumes_from_its_finished_tasks() {
     assert_eq!(lines(&damaged), planted_first);
     assert!(!damaged.join(format!("{tasks_file}.partial")).exists());
 }
+
+/// A learner without a forward model of its own (DIAYN) is planned with one fitted to its frozen
+/// skills: refused without it, fitted reproducibly, evaluated under its own name, reported in its
+/// own row, and never replaced under the evaluations that used it.
+#[test]
+fn a_diayn_run_plans_with_a_model_fitted_to_its_skills() {
+    let dir = tempfile::tempdir().unwrap();
+    let run = dir.path().join("diayn");
+    seads_ok(&[
+        "train",
+        "--env",
+        "lightsout-cursor",
+        "--algorithm",
+        "diayn",
+        "--env-steps",
+        "300",
+        "--out",
+        s(&run),
+        "--quiet",
+    ]);
+    let evaluate = |run: &std::path::Path, fitted: bool| {
+        let mut args = vec![
+            "evaluate",
+            "--run",
+            s(run),
+            "--boards",
+            "2",
+            "--max-expanded",
+            "2000",
+            "--replan",
+            "--json",
+        ];
+        if fitted {
+            args.push("--fitted-model");
+        }
+        args.iter().map(|a| a.to_string()).collect::<Vec<_>>()
+    };
+    let args = evaluate(&run, false);
+    let args: Vec<&str> = args.iter().map(String::as_str).collect();
+    check_bad_input(&args, "seads fit-model");
+    let fitted_args = evaluate(&run, true);
+    let fitted_args: Vec<&str> = fitted_args.iter().map(String::as_str).collect();
+    check_bad_input(&fitted_args, "has no fitted model");
+    // Two copies fitted alike are fitted to the bit: every choice flows from the seed.
+    let copy = dir.path().join("copy");
+    copy_dir(&run, &copy);
+    let fit = |run: &std::path::Path| {
+        json(&[
+            "fit-model",
+            "--run",
+            s(run),
+            "--episodes",
+            "200",
+            "--updates",
+            "30",
+            "--json",
+        ])
+    };
+    let record = fit(&run);
+    assert_eq!(record["num_skills"], 25);
+    assert_eq!(record["quality"]["held_out"], 20);
+    assert_eq!(record["settings"]["seed"], 1);
+    fit(&copy);
+    let weights = |run: &std::path::Path| {
+        std::fs::read(run.join("fitted-model/forward_model.safetensors")).unwrap()
+    };
+    assert_eq!(weights(&run), weights(&copy));
+    check_bad_input(
+        &["fit-model", "--run", s(&run), "--episodes", "200"],
+        "--refit",
+    );
+    check_bad_input(
+        &["fit-model", "--run", s(&run), "--episodes", "9"],
+        "--episodes",
+    );
+    let summary = json(&fitted_args);
+    assert_eq!(
+        summary["success_rate"].as_object().map(|m| m.len()),
+        Some(5),
+        "{summary}"
+    );
+    let stem = "evaluation-replan-boards-2-expanded-2000-fitted-model";
+    assert!(run.join(format!("{stem}.json")).is_file());
+    assert!(run.join(format!("{stem}-tasks.jsonl")).is_file());
+    // A model that evaluations planned with is not replaced under them.
+    check_bad_input(
+        &[
+            "fit-model",
+            "--run",
+            s(&run),
+            "--episodes",
+            "200",
+            "--refit",
+        ],
+        &format!("{stem}.json"),
+    );
+    let out = dir.path().join("report");
+    seads_ok(&["report", s(&run), "--out", s(&out), "--copy-runs"]);
+    let md = std::fs::read_to_string(out.join("report.md")).unwrap();
+    assert!(
+        md.contains("| re-planning | boards-2, expanded-2000, fitted-model | 1 |"),
+        "{md}"
+    );
+    let copied: Vec<_> = walkdir::WalkDir::new(out.join("runs"))
+        .into_iter()
+        .map(|e| e.unwrap().into_path())
+        .filter(|p| p.ends_with("fitted-model/fit.json"))
+        .collect();
+    assert_eq!(
+        copied.len(),
+        1,
+        "the fit's record comes along, not its weights"
+    );
+    assert!(
+        !copied[0]
+            .with_file_name("forward_model.safetensors")
+            .exists()
+    );
+}

@@ -286,9 +286,14 @@ pub fn write_report(options: &ReportOptions, out: &Path) -> Result<ReportSummary
             let dest = out.join("runs").join(&run.copy_to);
             std::fs::create_dir_all(&dest).doing(|| format!("creating {}", dest.display()))?;
             for file in runs::data_files(&run.dir)? {
-                let bytes = std::fs::read(&file).doing(|| format!("reading {}", file.display()))?;
-                let name = file.file_name().expect("a file has a name");
-                seads_run::store::write_atomic(&dest.join(name), &bytes)?;
+                let from = run.dir.join(&file);
+                let bytes = std::fs::read(&from).doing(|| format!("reading {}", from.display()))?;
+                let to = dest.join(&file);
+                if let Some(parent) = to.parent() {
+                    std::fs::create_dir_all(parent)
+                        .doing(|| format!("creating {}", parent.display()))?;
+                }
+                seads_run::store::write_atomic(&to, &bytes)?;
             }
         }
         let _ = writeln!(

@@ -7,7 +7,7 @@ use std::path::{Path, PathBuf};
 use crate::error::{fail, failure};
 use crate::{Context as _, Result};
 use seads_planner::{
-    DepthResult, EvaluationKind, Evaluator, Protocol, STANDARD_DEPTHS, SearchLimits,
+    DepthResult, EvaluationKind, Evaluator, PlanModel, Protocol, STANDARD_DEPTHS, SearchLimits,
 };
 use seads_run::{MetricsRecord, TrainConfig};
 
@@ -55,6 +55,10 @@ pub struct RunData {
     /// in a few words ([`Protocol::label`]: `standard`, or how it departs from the standard
     /// one; `not recorded` for a record without its protocol).
     pub success_protocols: [Option<String>; 3],
+    /// Final evaluations planning with a forward model fitted to the run's skills afterwards
+    /// (`seads fit-model`), with re-planning and planning once, each with its protocol's label
+    /// (`fitted-model`, and any other departure).
+    pub fitted: [Option<(Vec<DepthResult>, String)>; 2],
     /// Final task evaluations under action noise: (σ, with re-planning, per depth), in the
     /// order of their files' names.
     pub noisy: Vec<(f64, bool, Vec<DepthResult>)>,
@@ -124,6 +128,7 @@ impl RunData {
                             p.kind == kind
                                 && p.tasks.depths == STANDARD_DEPTHS
                                 && p.action_noise.is_none()
+                                && p.model == PlanModel::Own
                         })
                         .collect();
                     return Ok(match others.as_slice() {
@@ -186,6 +191,8 @@ impl RunData {
         let [replan, plan_once, policy] =
             [replan, plan_once, policy].map(|e| e.map(|(results, _)| results));
         let (noisy, deep) = (noisy_evaluations(&further), deep_search(&further));
+        let fitted = [EvaluationKind::Replan, EvaluationKind::PlanOnce]
+            .map(|kind| fitted_evaluation(&further, kind, &mut evaluation_notes));
         let over_training = crate::evaluation::read_over_training(dir)?;
         for line in &over_training {
             evaluated_by.add(line.evaluated_by.iter().cloned().collect());
@@ -198,6 +205,7 @@ impl RunData {
             plan_once,
             policy,
             success_protocols,
+            fitted,
             replan_tasks,
             noisy,
             deep,
@@ -213,6 +221,38 @@ impl RunData {
             skills,
             lines,
         })
+    }
+}
+
+/// The run's final evaluation of `kind` on the standard depths planning with a fitted model, with
+/// its protocol's label; several (of different limits) are left out with a note, since none of
+/// them is the run's.
+fn fitted_evaluation(
+    further: &[(Protocol, Vec<DepthResult>)],
+    kind: EvaluationKind,
+    notes: &mut Vec<String>,
+) -> Option<(Vec<DepthResult>, String)> {
+    let found: Vec<&(Protocol, Vec<DepthResult>)> = further
+        .iter()
+        .filter(|(p, _)| {
+            p.kind == kind
+                && p.model == PlanModel::Fitted
+                && p.tasks.depths == STANDARD_DEPTHS
+                && p.action_noise.is_none()
+        })
+        .collect();
+    match found.as_slice() {
+        [] => None,
+        [(protocol, results)] => Some((results.clone(), protocol.label())),
+        several => {
+            let labels: Vec<String> = several.iter().map(|(p, _)| p.label()).collect();
+            notes.push(format!(
+                "{} evaluations with a fitted model of several protocols ({}): left out",
+                kind.name(),
+                labels.join("; ")
+            ));
+            None
+        }
     }
 }
 
@@ -517,9 +557,10 @@ pub fn group(runs: &[RunData]) -> Result<(Vec<Group<'_>>, Vec<&RunData>)> {
     Ok((groups, unfinished))
 }
 
-/// The files of a run that results rest on (small; never checkpoints): its configuration (with a
-/// robot run's `robot.toml`), metrics, evaluations, and which code on which machine trained it
-/// (`provenance.jsonl`).
+/// The files of a run that results rest on (small; never checkpoints), by their paths inside the
+/// run: its configuration (with a robot run's `robot.toml`), metrics, evaluations, which code on
+/// which machine trained it (`provenance.jsonl`), and the record of a model fitted to its skills
+/// (`fitted-model/fit.json`; not the model's weights).
 pub fn data_files(run: &Path) -> Result<Vec<PathBuf>> {
     let mut files = Vec::new();
     for entry in std::fs::read_dir(run).doing(|| format!("reading {}", run.display()))? {
@@ -534,8 +575,12 @@ pub fn data_files(run: &Path) -> Result<Vec<PathBuf>> {
             || (name.starts_with("evaluation")
                 && (name.ends_with(".json") || name.ends_with(".jsonl")));
         if wanted && path.is_file() {
-            files.push(path);
+            files.push(PathBuf::from(name));
         }
+    }
+    let fit_record = Path::new(seads_run::fitted::FITTED_MODEL).join(seads_run::fitted::FIT_RECORD);
+    if run.join(&fit_record).is_file() {
+        files.push(fit_record);
     }
     files.sort();
     Ok(files)
@@ -555,6 +600,7 @@ pub(crate) fn bare_run(seed: u32) -> RunData {
         replan: None,
         plan_once: None,
         success_protocols: [None, None, None],
+        fitted: [None, None],
         replan_tasks: EvaluationKind::Replan.tasks_file(&STANDARD_DEPTHS, None),
         noisy: Vec::new(),
         deep: None,

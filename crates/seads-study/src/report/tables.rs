@@ -197,12 +197,31 @@ fn protocol(run: &RunData, mode: Mode) -> &str {
         .unwrap_or("standard")
 }
 
+/// The run's final evaluation in one mode planning with a fitted model, with its protocol's
+/// label.
+fn fitted(run: &RunData, mode: Mode) -> Option<(&Vec<DepthResult>, &str)> {
+    let index = match mode {
+        Mode::Replan => 0,
+        Mode::PlanOnce => 1,
+        Mode::Policy => return None,
+    };
+    run.fitted[index]
+        .as_ref()
+        .map(|(results, label)| (results, label.as_str()))
+}
+
 /// Depths evaluated in a group.
 fn depths(groups: &[Group<'_>]) -> Vec<usize> {
     let mut depths: Vec<usize> = groups
         .iter()
         .flat_map(|g| g.runs.iter())
-        .flat_map(|r| r.replan.iter().chain(&r.plan_once).chain(&r.policy))
+        .flat_map(|r| {
+            r.replan
+                .iter()
+                .chain(&r.plan_once)
+                .chain(&r.policy)
+                .chain(r.fitted.iter().flatten().map(|(e, _)| e))
+        })
         .flat_map(|e| e.iter().map(|d| d.depth))
         .collect();
     depths.sort_unstable();
@@ -338,6 +357,9 @@ pub fn success_tables(groups: &[Group<'_>]) -> (String, String) {
                 if let Some(e) = evaluation(run, mode) {
                     by_protocol.entry(protocol(run, mode)).or_default().push(e);
                 }
+                if let Some((e, label)) = fitted(run, mode) {
+                    by_protocol.entry(label).or_default().push(e);
+                }
             }
             for (protocol, evaluated) in by_protocol {
                 other_protocols |= protocol != "standard";
@@ -370,8 +392,9 @@ pub fn success_tables(groups: &[Group<'_>]) -> (String, String) {
     if other_protocols {
         md += "Another protocol is named by how it departs from the standard one (`boards-N`, \
                `expanded-N` or `unbounded`, `timeout-Ns`, the plan choice, `both-ends`, \
-               `memory-NNmib`; `not recorded` for a record older than protocols); runs of \
-               different protocols are never pooled in one row.\n";
+               `memory-NNmib`, `fitted-model` for planning with a forward model fitted to the \
+               run's frozen skills afterwards; `not recorded` for a record older than \
+               protocols); runs of different protocols are never pooled in one row.\n";
     }
     let timeouts: usize = groups
         .iter()

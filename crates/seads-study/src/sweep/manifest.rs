@@ -72,6 +72,11 @@ pub struct EvaluationPlan {
     pub max_expanded: Option<usize>,
     /// Which plan each search returns: `most-likely` (default) or `first-found` (the paper's).
     pub plan: seads_planner::PlanChoice,
+    /// Also fit SEADS's forward model to each skill learner's final skills (`seads fit-model`,
+    /// its standard settings) and evaluate planning with it, with and without re-planning
+    /// (`evaluation-*-fitted-model.json`): how learners compare by their skills alone.
+    #[serde(skip_serializing_if = "std::ops::Not::not")]
+    pub fitted_model: bool,
 }
 
 impl Default for EvaluationPlan {
@@ -83,6 +88,7 @@ impl Default for EvaluationPlan {
             timeout: None,
             max_expanded: Some(seads_planner::DEFAULT_MAX_EXPANDED),
             plan: seads_planner::PlanChoice::MostLikely,
+            fitted_model: false,
         }
     }
 }
@@ -497,6 +503,8 @@ env_overrides = { "lightsout-cursor" = { seads = { num_skills = 30 } }, "tileswa
             let m = Manifest::parse(text, "experiments").unwrap();
             let runs = m.expand().unwrap();
             assert_eq!(runs.len(), count, "{}", m.name);
+            // Only the study of learners without a model of their own plans with fitted ones.
+            assert_eq!(m.evaluation.fitted_model, m.name == "diayn", "{}", m.name);
             assert_eq!(
                 m.reference(),
                 runs[0].variant,
