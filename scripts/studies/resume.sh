@@ -18,8 +18,9 @@
 #    starts each that is not running, detached (setsid, nohup): two cores, one chain each, the
 #    second running its studies one after another.
 #      chainR: the Reacher cells (docs/results/arms-reacher/run.sh), at nice 5;
-#      chainV, then chainB, then chainS: VIC, the TileSwapCursor baselines, board size, then the
-#      LightsOutJaco cells chainJ has not reached (each seed's no forward-model relabelling run
+#      chainV, then chainB, then chainS: VIC, the TileSwapCursor baselines, board size, then
+#      DIAYN against VIC and SEADS (experiments/diayn.toml), then the LightsOutJaco cells chainJ
+#      has not reached (each seed's no forward-model relabelling run
 #      first, SEADS's first on chainJ, so that the cores train a seed's pair together), then the
 #      13×13 board's seeds 1-3 (chainJ takes them from the far end), at nice 10;
 #      chainJ, once chainR is done: the board-size runs chainS has not reached (the 7×7 and 9×9
@@ -45,13 +46,14 @@ STUDIES=(
   "baselines-tileswap a634bb8 b2bfbff experiments/baselines-tileswap.toml docs/results/baselines-tileswap/runs/baselines-tileswap"
   "board-size 948442b 948442b experiments/board-size.toml docs/results/board-size-948442b/runs/board-size"
   "arms-jaco 73dac45 73dac45 experiments/arms-jaco.toml docs/results/arms-jaco/runs/arms-jaco"
+  "diayn 4df69f9 4df69f9 experiments/diayn.toml docs/results/diayn/runs/diayn"
 )
 # The last commit whose committed manifests and run configurations were in the layout the frozen
 # binaries read: `seads migrate` rewrote them in the next.
 LAYOUT=951086a
 # The binaries the studies run, frozen from these clean commits (a58a2c4 evaluates the Reacher
 # runs); a chain runs no other.
-FROZEN=(90d8a6b a58a2c4 a634bb8 948442b 73dac45)
+FROZEN=(90d8a6b a58a2c4 a634bb8 948442b 73dac45 4df69f9)
 # The Reacher runs in the order they train (finished ones are skipped).
 REACHER=(
   lightsout-reacher/seads/seed-1 lightsout-reacher/seads/seed-2 lightsout-reacher/seads/seed-3
@@ -161,11 +163,13 @@ EOF
   } | write "$chain.sh"
 }
 index_chain chainS "# Board size (issue 48 item 4), frozen 948442b, after the baselines: 7×7 and 9×9 seeds 1-3, then
-# 5×5 seeds 1-3, then the spaced 5×5 seeds 1-3; then the LightsOutJaco cells chainJ has not
-# reached, each seed's pair from the other end of the pair, so that both cores train Jaco
-# (issue 48 item 2, frozen 73dac45); then the 13×13 board, seeds 1-3 (issue 48 item 4, if
+# 5×5 seeds 1-3, then the spaced 5×5 seeds 1-3; then DIAYN, VIC and SEADS on both Cursor boards,
+# planned with fitted models (issue 78 item 7, frozen 4df69f9), the 18 runs in the sweep's order;
+# then the LightsOutJaco cells chainJ has not reached, each seed's pair from the other end of the
+# pair (issue 48 item 2, frozen 73dac45); then the 13×13 board, seeds 1-3 (issue 48 item 4, if
 # compute allows; scripts/studies/resume.sh)." 10 "chainB chainV" \
-  "948442b board-size 1 2 6 7 11 12 0 5 10 4 9 14" "73dac45 arms-jaco 1 0 3 2 5 4" \
+  "948442b board-size 1 2 6 7 11 12 0 5 10 4 9 14" \
+  "4df69f9 diayn 0 1 2 3 4 5 6 7 8 9 10 11 12 13 14 15 16 17" "73dac45 arms-jaco 1 0 3 2 5 4" \
   "948442b board-size 3 8 13"
 index_chain chainJ "# On chainR's core once the Reacher cells are done: the board-size runs chainS has not reached,
 # the 7×7 and 9×9 from the far end of its list, then the 5×5 and the spaced 5×5 the same way
