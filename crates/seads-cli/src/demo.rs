@@ -9,7 +9,7 @@ use seads_planner::summarise;
 use seads_rl::{Run, TrainConfig, Trainer};
 
 use crate::BadInput;
-use crate::plan::run_evaluation;
+use crate::plan::evaluate_with_bar;
 use seads_planner::Protocol;
 
 /// Arguments of `seads run`.
@@ -123,8 +123,8 @@ pub fn run(args: RunArgs) -> Result<()> {
     );
     outln!(" depth   with re-planning   plan once   median steps (re-planning)");
     let protocol = |replan| Protocol::planning(replan, args.boards, args.search.limits());
-    let replan = run_evaluation(&mut agent, &args.out, &protocol(true), false)?.results;
-    let once = run_evaluation(&mut agent, &args.out, &protocol(false), false)?.results;
+    let replan = evaluate_with_bar(&mut agent, &args.out, &protocol(true), false)?.results;
+    let once = evaluate_with_bar(&mut agent, &args.out, &protocol(false), false)?.results;
     let (a, b) = (summarise(&replan), summarise(&once));
     for r in &replan {
         let key = r.depth;

@@ -12,7 +12,7 @@ use seads_planner::DepthResult;
 use seads_rl::{Agent, find_checkpoint, read_metrics};
 
 use crate::envs::build_env;
-use crate::plan::{load_agent, run_evaluation};
+use crate::plan::{evaluate_with_bar, load_agent};
 use seads_planner::{EvaluationRecord, Protocol};
 use seads_study::evaluation::read_evaluation;
 use seads_study::figures::{coverage_figure, skill_figures, success_figure};
@@ -256,7 +256,7 @@ fn evaluations(
         {
             return Ok(record.results);
         }
-        Ok(run_evaluation(agent, run, &protocol, quiet)?.results)
+        Ok(evaluate_with_bar(agent, run, &protocol, quiet)?.results)
     };
     Ok([(true, load(true)?), (false, load(false)?)])
 }

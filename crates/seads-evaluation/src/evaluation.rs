@@ -11,8 +11,8 @@ use seads_planner::{
 };
 use seads_rl::{Agent, TrainConfig};
 use seads_skillmodel::ForwardModel;
+use seads_study::evaluation::journal::Place;
 use seads_study::evaluation::{checkpoint_of, keep_another_protocols, save_evaluation, task_line};
-use seads_study::journal::Place;
 use seads_study::{Context as _, Resumed, StudyError};
 
 use crate::Result;

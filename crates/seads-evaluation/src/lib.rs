@@ -1,5 +1,5 @@
 //! Running evaluations of trained runs; what they write into a run directory, and reading it
-//! back, is `seads-study`'s ([`seads_study::evaluation`], [`seads_study::journal`]), so that
+//! back, is `seads-study`'s ([`seads_study::evaluation`], [`seads_study::evaluation::journal`]), so that
 //! reports and sweeps read evaluations without libtorch.
 //!
 //! - [`evaluation`]: a trained agent planning on the evaluation protocol

@@ -15,8 +15,8 @@ use seads_rl::Agent;
 use seads_uarm::UarmEnv;
 
 use seads_study::StudyError;
+use seads_study::evaluation::journal::Place;
 use seads_study::evaluation::{checkpoint_of, save_evaluation, task_line};
-use seads_study::journal::Place;
 
 use crate::Result;
 

@@ -4,7 +4,7 @@
 //! - [`sweep`]: a [`Manifest`](sweep::Manifest) (TOML) expands into a planned
 //!   [`Sweep`](sweep::Sweep) on disk, one run directory per run; [`sweep::status`] reads where a
 //!   run stands from its directory alone; [`sweep::slurm`] writes a Slurm job array for it.
-//! - [`evaluation`], [`journal`]: the files an evaluation of a run writes, named by its protocol
+//! - [`evaluation`] (and its [`journal`](evaluation::journal)): the files an evaluation of a run writes, named by its protocol
 //!   and checkpoint, its journal while it runs, and the evaluations over training (running one is
 //!   `seads-evaluation`'s).
 //! - [`report`]: Table 1 with the one-sided Mann–Whitney test (exact p too), task success,
@@ -45,14 +45,13 @@ pub mod draw;
 mod error;
 pub mod evaluation;
 pub mod figures;
-pub mod journal;
 pub mod provenance;
 pub mod recording;
 pub mod report;
 pub mod sweep;
 
 pub use error::{BoxError, Context, Result, StudyError};
-pub use journal::Resumed;
+pub use evaluation::journal::Resumed;
 
 /// The number of skills K of a run: its learner's `num_skills` (SEADS's, DIAYN's: any learner's
 /// section that states one), else its environment's (for a robot run, whose environment is not

@@ -9,7 +9,7 @@ use seads_games::Split;
 use seads_planner::{EvaluationKind, PlanModel, Protocol, TaskSet, summarise};
 use seads_rl::ComputeDevice;
 
-use super::{load_agent, run_evaluation};
+use super::{evaluate_with_bar, load_agent};
 use crate::BadInput;
 use seads_evaluation::evaluation::run_policy_evaluation;
 use seads_study::evaluation;
@@ -116,7 +116,7 @@ pub fn evaluate_run(args: EvaluateArgs) -> Result<()> {
             depths,
             ..TaskSet::standard(args.boards)
         };
-        let added = super::evaluate_checkpoints(
+        let added = super::evaluate_checkpoints_with_bar(
             &args.run,
             selection,
             &tasks,
@@ -154,7 +154,7 @@ pub fn evaluate_run(args: EvaluateArgs) -> Result<()> {
             PlanModel::Own
         },
     };
-    let record = run_evaluation(&mut agent, &args.run, &protocol, args.quiet || args.json)?;
+    let record = evaluate_with_bar(&mut agent, &args.run, &protocol, args.quiet || args.json)?;
     let results = record.results;
     let summary = summarise(&results);
     if args.json {

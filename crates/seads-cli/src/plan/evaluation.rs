@@ -1,5 +1,6 @@
-//! Running an evaluation of a trained agent with a progress bar ([`seads_study::evaluation`]
-//! runs and saves it; what an evaluation is, is `seads_planner`'s protocol module).
+//! The progress bars of evaluations: each function here shows the work of the function of
+//! `seads-evaluation` it names (which runs an evaluation and saves it through
+//! [`seads_study::evaluation`]; what an evaluation is, is `seads_planner`'s protocol module).
 
 use std::path::Path;
 
@@ -8,9 +9,9 @@ use seads_evaluation::over_training::{self, Progress, Selection};
 use seads_planner::{EvaluationRecord, Protocol, SearchLimits, TaskSet};
 use seads_rl::Agent;
 
-/// Evaluates the agent with `protocol` and saves the record and one line per task into the run
-/// directory, with a progress bar unless `quiet`.
-pub fn run_evaluation(
+/// [`seads_evaluation::evaluation::run_evaluation`] with a progress bar unless `quiet`: evaluates
+/// the agent with `protocol` and saves the record and one line per task into the run directory.
+pub fn evaluate_with_bar(
     agent: &mut Agent,
     run: &Path,
     protocol: &Protocol,
@@ -46,7 +47,7 @@ pub fn run_evaluation(
 /// Evaluates the selected checkpoints of `run` over training
 /// ([`seads_evaluation::over_training::evaluate_checkpoints`]), with a progress bar unless `quiet`;
 /// returns the number of lines appended.
-pub fn evaluate_checkpoints(
+pub fn evaluate_checkpoints_with_bar(
     run: &Path,
     selection: Selection,
     tasks: &TaskSet,

@@ -17,7 +17,7 @@ use seads_rl::{Agent, ComputeDevice};
 
 pub use bench::{PlanBenchArgs, plan_bench};
 pub use evaluate::{EvaluateArgs, evaluate_run};
-pub use evaluation::{evaluate_checkpoints, run_evaluation};
+pub use evaluation::{evaluate_checkpoints_with_bar, evaluate_with_bar};
 pub use fit::{FitModelArgs, fit_model};
 pub use solve::{SolveArgs, solve_board};
 

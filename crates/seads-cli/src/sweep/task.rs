@@ -14,8 +14,8 @@ use seads_skillmodel::SkillModelKind;
 
 use super::index::Sweep;
 use crate::BadInput;
-use crate::plan::evaluate_checkpoints;
-use crate::plan::{load_agent, run_evaluation};
+use crate::plan::evaluate_checkpoints_with_bar;
+use crate::plan::{evaluate_with_bar, load_agent};
 use crate::sweep::train::member_config;
 use seads_evaluation::evaluation::run_policy_evaluation;
 use seads_evaluation::over_training::Selection;
@@ -225,7 +225,7 @@ fn evaluate(sweep: &Sweep, run: &Path, device: ComputeDevice) -> Result<()> {
         return Ok(());
     }
     if own_model && plan.every > 0 {
-        let added = evaluate_checkpoints(
+        let added = evaluate_checkpoints_with_bar(
             run,
             Selection::Every(plan.every),
             &TaskSet::standard(plan.boards),
@@ -259,7 +259,7 @@ fn evaluate(sweep: &Sweep, run: &Path, device: ComputeDevice) -> Result<()> {
                 action_noise: None,
                 model,
             };
-            let results = run_evaluation(&mut agent, run, &protocol, true)?.results;
+            let results = evaluate_with_bar(&mut agent, run, &protocol, true)?.results;
             let solved: usize = results.iter().map(|r| r.solved).sum();
             let tasks: usize = results.iter().map(|r| r.tasks).sum();
             outln!(

@@ -1,7 +1,10 @@
 //! The files an evaluation writes into a run directory: the end-of-training records, named by
 //! their protocol and checkpoint ([`seads_planner::EvaluationKind`] names them), and the
 //! evaluations over training (the paper's Fig. 3), one line per checkpoint and mode in
-//! [`OVER_TRAINING`]. Running an evaluation is `seads-evaluation`'s.
+//! [`OVER_TRAINING`]; and the [`journal`] of an evaluation in progress. Running an evaluation is
+//! `seads-evaluation`'s.
+
+pub mod journal;
 
 use std::path::Path;
 
