@@ -835,6 +835,13 @@ fn a_diayn_run_plans_with_a_model_fitted_to_its_skills() {
         md.contains("| re-planning | boards-2, expanded-2000, fitted-model | 1 |"),
         "{md}"
     );
+    // The fit's quality, as the record says it.
+    let right = 100.0 * record["quality"]["mode_accuracy"].as_f64().unwrap();
+    assert!(
+        md.contains("## Forward models fitted to the skills"),
+        "{md}"
+    );
+    assert!(md.contains(&format!("| 1 | {right:.1} ± 0.0 % |")), "{md}");
     let copied: Vec<_> = walkdir::WalkDir::new(out.join("runs"))
         .into_iter()
         .map(|e| e.unwrap().into_path())

@@ -216,6 +216,11 @@ pub fn write_report(options: &ReportOptions, out: &Path) -> Result<ReportSummary
     md += &success_md;
     md += &evaluation_notes(&collection.runs);
     let _ = writeln!(md, "\nAs CSV: `success.csv`.\n");
+    if let Some(fits) = tables::fit_table(&groups) {
+        let _ = writeln!(md, "## Forward models fitted to the skills\n");
+        md += &fits;
+        md.push('\n');
+    }
     if let Some(comparison) = tables::success_comparison(&groups, reference.as_deref()) {
         let _ = writeln!(md, "## SEADS against the baselines: task success\n");
         md += &comparison;

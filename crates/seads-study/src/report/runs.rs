@@ -59,6 +59,9 @@ pub struct RunData {
     /// (`seads fit-model`), with re-planning and planning once, each with its protocol's label
     /// (`fitted-model`, and any other departure).
     pub fitted: [Option<(Vec<DepthResult>, String)>; 2],
+    /// How well the forward model fitted to the run's skills explains held-out executions
+    /// (`fitted-model/fit.json`), if one was fitted to its last checkpoint.
+    pub fit: Option<seads_run::fitted::FitQuality>,
     /// Final task evaluations under action noise: (σ, with re-planning, per depth), in the
     /// order of their files' names.
     pub noisy: Vec<(f64, bool, Vec<DepthResult>)>,
@@ -193,6 +196,21 @@ impl RunData {
         let (noisy, deep) = (noisy_evaluations(&further), deep_search(&further));
         let fitted = [EvaluationKind::Replan, EvaluationKind::PlanOnce]
             .map(|kind| fitted_evaluation(&further, kind, &mut evaluation_notes));
+        let fit = match seads_run::fitted::read_fit_record(dir) {
+            Ok(Some(record)) if Some(record.checkpoint.epoch) == last_epoch => Some(record.quality),
+            Ok(Some(record)) => {
+                evaluation_notes.push(format!(
+                    "the fitted model is of epoch {}, not the end of training: left out",
+                    record.checkpoint.epoch
+                ));
+                None
+            }
+            Ok(None) => None,
+            Err(e) => {
+                damage.push(format!("{e:#}"));
+                None
+            }
+        };
         let over_training = crate::evaluation::read_over_training(dir)?;
         for line in &over_training {
             evaluated_by.add(line.evaluated_by.iter().cloned().collect());
@@ -206,6 +224,7 @@ impl RunData {
             policy,
             success_protocols,
             fitted,
+            fit,
             replan_tasks,
             noisy,
             deep,
@@ -601,6 +620,7 @@ pub(crate) fn bare_run(seed: u32) -> RunData {
         plan_once: None,
         success_protocols: [None, None, None],
         fitted: [None, None],
+        fit: None,
         replan_tasks: EvaluationKind::Replan.tasks_file(&STANDARD_DEPTHS, None),
         noisy: Vec::new(),
         deep: None,
