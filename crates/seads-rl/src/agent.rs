@@ -149,9 +149,10 @@ impl Agent {
             0,
         );
         sac.load(checkpoint, true)?;
-        let own_model = match config.is::<SeadsConfig>() {
-            true => Some(config.seads()?.skill_model),
-            false => None,
+        let own_model = if config.is::<SeadsConfig>() {
+            Some(config.seads()?.skill_model)
+        } else {
+            None
         };
         let model = match own_model {
             Some(settings) if settings.kind == SkillModelKind::Forward => {

@@ -229,25 +229,14 @@ pub fn fit_model(
 
 #[cfg(test)]
 mod tests {
-    use seads_games::{BoardGame, LightsOut};
+    use seads_games::LightsOut;
 
     use super::*;
 
     /// The game's own moves as skills (skill k presses field k): a perfect fit predicts every
     /// held-out execution, and the mode accuracy says so; a model trained on nothing does not.
     fn moves_of(game: &LightsOut, n: usize, seed: u64) -> Vec<SkillTransition> {
-        let mut rng = stream(seed, Purpose::FitBoards);
-        (0..n)
-            .map(|_| {
-                let z0 = game.random_board(&mut rng);
-                let skill = rng.random_range(0..game.num_moves());
-                SkillTransition {
-                    z0,
-                    skill,
-                    zt: game.apply(z0, skill),
-                }
-            })
-            .collect()
+        seads_skillmodel::move_transitions(game, n, &mut stream(seed, Purpose::FitBoards))
     }
 
     #[test]

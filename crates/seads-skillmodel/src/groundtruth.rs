@@ -24,20 +24,29 @@ pub fn fit_to_game(
         seed,
     );
     for _ in 0..steps {
-        let batch: Vec<SkillTransition> = (0..config.batch_size)
-            .map(|_| {
-                let z0 = game.random_board(&mut rng);
-                let skill = rng.random_range(0..game.num_moves());
-                SkillTransition {
-                    z0,
-                    skill,
-                    zt: game.apply(z0, skill),
-                }
-            })
-            .collect();
-        model.train_step(&batch);
+        model.train_step(&move_transitions(game, config.batch_size, &mut rng));
     }
     model
+}
+
+/// `n` random boards of `game`, each with a move drawn uniformly and the board it leads to: the
+/// executions of skills that are the game's moves (skill k = move k).
+pub fn move_transitions(
+    game: &dyn BoardGame,
+    n: usize,
+    rng: &mut ChaCha8Rng,
+) -> Vec<SkillTransition> {
+    (0..n)
+        .map(|_| {
+            let z0 = game.random_board(rng);
+            let skill = rng.random_range(0..game.num_moves());
+            SkillTransition {
+                z0,
+                skill,
+                zt: game.apply(z0, skill),
+            }
+        })
+        .collect()
 }
 
 /// Fraction of (random board, move) pairs whose predicted successor is exactly the true one.

@@ -33,7 +33,7 @@ mod relabel;
 mod reward;
 mod screen;
 
-pub use groundtruth::{agreement_with_game, fit_to_game};
+pub use groundtruth::{agreement_with_game, fit_to_game, move_transitions};
 pub use model::{
     BuildSkillModel, ForwardModel, OPTIMISER_FILES, SkillDiscriminator, SkillModel,
     SkillModelConfig, SkillModelKind, SkillTransition, fast_int8_products,

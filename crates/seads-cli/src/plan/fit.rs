@@ -6,7 +6,7 @@ use std::path::PathBuf;
 use anyhow::{Result, bail};
 use clap::Args;
 use seads_rl::{ComputeDevice, FitProgress};
-use seads_run::fitted::{FitSettings, read_fit_record};
+use seads_run::fitted::{FitRecord, FitSettings, read_fit_record};
 
 use super::load_agent;
 use crate::BadInput;
@@ -116,6 +116,20 @@ pub fn fit_model(args: FitModelArgs) -> Result<()> {
         );
     }
     Ok(())
+}
+
+/// [`seads_rl::fit_model`], the record naming this binary as the one that fitted.
+pub fn fit_naming_this_binary(
+    agent: &seads_rl::Agent,
+    run: &std::path::Path,
+    settings: &FitSettings,
+    progress: impl FnMut(FitProgress),
+) -> Result<FitRecord> {
+    let by = seads_study::provenance::this_binary()
+        .into_iter()
+        .cloned()
+        .collect();
+    Ok(seads_rl::fit_model(agent, run, settings, by, progress)?)
 }
 
 /// The run's evaluation files that planned with its fitted model (their results or their

@@ -18,7 +18,7 @@ use seads_rl::{Agent, ComputeDevice};
 pub use bench::{PlanBenchArgs, plan_bench};
 pub use evaluate::{EvaluateArgs, evaluate_run};
 pub use evaluation::{evaluate_checkpoints_with_bar, evaluate_with_bar};
-pub use fit::{FitModelArgs, fit_model};
+pub use fit::{FitModelArgs, fit_model, fit_naming_this_binary};
 pub use solve::{SolveArgs, solve_board};
 
 use crate::BadInput;

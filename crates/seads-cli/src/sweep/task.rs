@@ -288,11 +288,7 @@ fn fit_unless_fitted(agent: &seads_rl::Agent, run: &Path) -> Result<()> {
         return Ok(());
     }
     let settings = seads_run::fitted::FitSettings::standard(agent.config.seed);
-    let by = seads_study::provenance::this_binary()
-        .into_iter()
-        .cloned()
-        .collect();
-    let record = seads_rl::fit_model(agent, run, &settings, by, |_| {})?;
+    let record = crate::plan::fit_naming_this_binary(agent, run, &settings, |_| {})?;
     outln!(
         "{}: a forward model fitted to its skills: the most likely successor right {:.1} % of \
          {} held-out executions",
