@@ -69,13 +69,7 @@ fn the_study_chains_parse_and_run_only_frozen_binaries() {
             Command::new("bash").arg("-n").arg(&path),
             &format!("{name} parses"),
         );
-        // The chains name the binaries under $SEADS_FROZEN, `arms-run.sh` under its $F.
-        let used = [
-            binaries(&text, &format!("{fake_frozen}/")),
-            binaries(&text, "$F/"),
-        ]
-        .concat();
-        for commit in used {
+        for commit in binaries(&text, &format!("{fake_frozen}/")) {
             assert!(
                 frozen.iter().any(|f| f == commit),
                 "{name} runs {commit}, which resume.sh does not freeze ({frozen:?})"
@@ -104,12 +98,24 @@ fn a_restarted_chain_resumes_its_begun_runs_before_new_ones() {
     std::fs::create_dir_all(&sweeps).expect("the sweeps' folder");
     write_chains(&sweeps, &frozen);
     let chain = std::fs::read_to_string(sweeps.join("chainS.sh")).expect("chainS.sh");
-    // Its segments on the board-size sweep, in order: each `for i in …; do` line is followed by
-    // the line that reads the status of the sweep it trains.
+    // The sweep of its first segment and the binary that trains it: `B="<frozen>/<commit>/bin/seads"`
+    // then `… sweep status <sweep> --json …`.
+    let commit = binaries(&chain, &format!("{}/", frozen.display()))
+        .first()
+        .copied()
+        .expect("chainS.sh names a frozen binary")
+        .to_owned();
+    let sweep = chain
+        .split_once("sweep status ")
+        .and_then(|(_, rest)| rest.split_whitespace().next())
+        .expect("chainS.sh reads a sweep's status")
+        .to_owned();
+    // Its segments on that sweep, in order: each `for i in …; do` line is followed by the line
+    // that reads the status of the sweep it trains.
     let lines: Vec<&str> = chain.lines().collect();
     let segments: Vec<Vec<usize>> = lines
         .windows(2)
-        .filter(|w| w[1].contains("sweep status board-size "))
+        .filter(|w| w[1].contains(&format!("sweep status {sweep} ")))
         .filter_map(|w| w[0].trim().strip_prefix("for i in ")?.strip_suffix("; do"))
         .map(|l| {
             l.split_whitespace()
@@ -119,9 +125,9 @@ fn a_restarted_chain_resumes_its_begun_runs_before_new_ones() {
         .collect();
     let (order, later) = segments
         .split_first()
-        .expect("chainS.sh trains the board-size sweep");
+        .expect("chainS.sh trains its first sweep");
     let later: Vec<usize> = later.concat();
-    assert!(order.len() >= 4, "chainS.sh trains {order:?}");
+    assert!(order.len() >= 4, "chainS.sh trains {order:?} of {sweep}");
     // The sweep: the first index finished, the second held by another chain, the last begun.
     let (finished, held, begun) = (order[0], order[1], order[order.len() - 1]);
     let last = order.iter().chain(&later).max().copied().unwrap_or(0);
@@ -136,9 +142,11 @@ fn a_restarted_chain_resumes_its_begun_runs_before_new_ones() {
             serde_json::json!({"index": i, "status": status, "env_steps": steps})
         })
         .collect();
-    let state = sweeps.join("board-size.json");
+    let state = sweeps.join(format!("{sweep}.json"));
     std::fs::write(&state, serde_json::json!({ "runs": runs }).to_string()).expect("the state");
-    let fake = frozen.join("948442b/bin");
+    // The stand-in stands for the first sweep's binary only: the other segments, by other
+    // binaries, find none and train nothing.
+    let fake = frozen.join(&commit).join("bin");
     std::fs::create_dir_all(&fake).expect("the stand-in's folder");
     let seads = r#"#!/usr/bin/env bash
 # sweep status <sweep> --json | sweep task <sweep> --index <i> --cores 1
@@ -179,7 +187,7 @@ esac
         .map(|i| i.parse().expect("an index"))
         .collect();
     // The begun run first, then the segment's others but the finished and the held, then the
-    // later segments' runs on the same sweep (the stand-in knows no other sweep).
+    // later segments' runs on the same sweep.
     let mut expected = vec![begun];
     expected.extend(order[2..order.len() - 1].iter().copied());
     expected.extend(later.iter().copied());
