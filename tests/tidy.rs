@@ -987,3 +987,74 @@ fn the_wrapper_forwards_every_method_of_the_environment() {
         .collect();
     assert!(missing.is_empty(), "Wrapped does not forward {missing:?}");
 }
+
+/// The end of the braces that open at `open` in `code` (counted in code only).
+fn closing_brace(code: &str, open: usize) -> usize {
+    let mut depth = 0;
+    for (i, c) in code[open..].char_indices() {
+        match c {
+            '{' => depth += 1,
+            '}' => depth -= 1,
+            _ => {}
+        }
+        if depth == 0 {
+            return open + i;
+        }
+    }
+    code.len()
+}
+
+/// No panic of ours reaches Python as pyo3's `PanicException`, a `BaseException` that `except
+/// Exception` misses (issue 82): every method of a `#[pymethods]` block and every
+/// `#[pyfunction]` of the bindings that can fail (returns `PyResult`) runs its body through
+/// `guarded`, which turns a panic into a `RuntimeError` (the Python test
+/// `test_a_panic_of_ours_is_a_runtime_error_that_except_exception_catches` shows it does).
+/// The infallible ones are getters of a field or a size.
+#[test]
+fn every_fallible_python_method_guards_its_body() {
+    let mut checked = Vec::new();
+    let mut unguarded = Vec::new();
+    for file in rust_files(&root().join("crates/seads-py/src")) {
+        let code = code_only(&std::fs::read_to_string(&file).unwrap());
+        // The blocks: a #[pymethods] impl's braces, or a #[pyfunction]'s item.
+        let mut blocks = Vec::new();
+        for (at, _) in code.match_indices("#[pymethods]") {
+            let open = at + code[at..].find('{').unwrap();
+            blocks.push((open, closing_brace(&code, open)));
+        }
+        for (at, _) in code.match_indices("#[pyfunction]") {
+            let item = at + code[at..].find("fn ").unwrap();
+            let open = item + code[item..].find('{').unwrap();
+            blocks.push((at, closing_brace(&code, open)));
+        }
+        for (start, end) in blocks {
+            let block = &code[start..end];
+            for (at, _) in block.match_indices("fn ") {
+                let name: String = block[at + 3..]
+                    .chars()
+                    .take_while(|c| c.is_alphanumeric() || *c == '_')
+                    .collect();
+                let open = at + block[at..].find('{').unwrap();
+                let signature = &block[at..open];
+                if !signature.contains("PyResult<") {
+                    continue;
+                }
+                let body = &block[open..closing_brace(block, open)];
+                checked.push(name.clone());
+                if !body
+                    .trim_start_matches('{')
+                    .trim_start()
+                    .starts_with("crate::guarded(")
+                    && !body
+                        .trim_start_matches('{')
+                        .trim_start()
+                        .starts_with("guarded(")
+                {
+                    unguarded.push(format!("{}: {name}", file.display()));
+                }
+            }
+        }
+    }
+    assert!(checked.len() >= 25, "{checked:?}");
+    assert!(unguarded.is_empty(), "not guarded: {unguarded:#?}");
+}

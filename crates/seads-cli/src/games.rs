@@ -2,7 +2,7 @@
 
 use anyhow::Result;
 use clap::{Args, Subcommand};
-use seads_games::{DepthsReport, GameKind, SolveReport, SplitReport};
+use seads_games::{DepthsReport, GameKind, SolveControl, SolveReport, SplitReport};
 use serde::Serialize;
 
 use crate::bad_input;
@@ -67,10 +67,45 @@ pub fn run(cmd: GamesCommand) -> Result<()> {
             print_report(&report, game.json, |r| r.table())
         }
         GamesCommand::Solve { game, board } => {
-            let report = SolveReport::of(game.game, game.size(), &board).map_err(bad_input)?;
+            let report = solve_with_spinner(&game, &board).map_err(bad_input)?;
             print_report(&report, game.json, |r| r.table())
         }
     }
+}
+
+/// Solves `board`, while a spinner counts the nodes a searching solver (the 15-puzzle's IDA*,
+/// which may take minutes on a deep board) has expanded, out of its bound; the spinner is not
+/// drawn where the error output is no terminal, and cleared when the solve ends.
+fn solve_with_spinner(game: &GameArgs, board: &str) -> Result<SolveReport, seads_games::GameError> {
+    let control = SolveControl::default();
+    let spinner = indicatif::ProgressBar::new_spinner().with_style(
+        indicatif::ProgressStyle::with_template("{spinner} solving: {msg} [{elapsed}]")
+            .expect("a valid template"),
+    );
+    std::thread::scope(|scope| {
+        let main = std::thread::current();
+        let control = &control;
+        let solving = scope.spawn(move || {
+            let report = SolveReport::of_within(game.game, game.size(), board, control);
+            main.unpark();
+            report
+        });
+        while !solving.is_finished() {
+            let expanded = control.expanded();
+            if expanded > 0 {
+                spinner.set_message(format!(
+                    "{expanded} of at most {} search nodes expanded",
+                    control.max_nodes()
+                ));
+            }
+            spinner.tick();
+            std::thread::park_timeout(std::time::Duration::from_millis(100));
+        }
+        spinner.finish_and_clear();
+        solving
+            .join()
+            .unwrap_or_else(|panic| std::panic::resume_unwind(panic))
+    })
 }
 
 fn print_report<T: Serialize>(report: &T, json: bool, table: impl Fn(&T) -> String) -> Result<()> {

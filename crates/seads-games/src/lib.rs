@@ -190,6 +190,62 @@ pub enum GameError {
 /// more nodes.
 pub const SOLVE_NODES: u64 = 4_000_000_000;
 
+/// The bound and the live state of a game's searching solver (the 15-puzzle's IDA*,
+/// [`BoardGame::solve_within`]): how many search nodes it may expand, a flag another thread
+/// raises to stop it (Ctrl-C), and the nodes it has expanded so far, which it updates as it goes
+/// so that another thread can show progress.
+#[derive(Debug)]
+pub struct SolveControl {
+    max_nodes: u64,
+    stop: std::sync::atomic::AtomicBool,
+    expanded: std::sync::atomic::AtomicU64,
+}
+
+impl SolveControl {
+    /// A search bounded by `max_nodes` nodes, not stopped, nothing expanded.
+    pub fn new(max_nodes: u64) -> Self {
+        Self {
+            max_nodes,
+            stop: std::sync::atomic::AtomicBool::new(false),
+            expanded: std::sync::atomic::AtomicU64::new(0),
+        }
+    }
+
+    /// The bound of search nodes.
+    pub fn max_nodes(&self) -> u64 {
+        self.max_nodes
+    }
+
+    /// Stops the search at its next look (from any thread).
+    pub fn stop(&self) {
+        self.stop.store(true, std::sync::atomic::Ordering::Relaxed);
+    }
+
+    /// Whether the search was told to stop.
+    pub fn is_stopped(&self) -> bool {
+        self.stop.load(std::sync::atomic::Ordering::Relaxed)
+    }
+
+    /// The nodes the search has expanded, as of its last look (it looks every few tens of
+    /// thousands of nodes, and when it ends).
+    pub fn expanded(&self) -> u64 {
+        self.expanded.load(std::sync::atomic::Ordering::Relaxed)
+    }
+
+    /// Records how many nodes the search has expanded.
+    pub(crate) fn set_expanded(&self, nodes: u64) {
+        self.expanded
+            .store(nodes, std::sync::atomic::Ordering::Relaxed);
+    }
+}
+
+impl Default for SolveControl {
+    /// Bounded by [`SOLVE_NODES`].
+    fn default() -> Self {
+        Self::new(SOLVE_NODES)
+    }
+}
+
 /// Where on the board a move is made.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum MoveSite {
@@ -317,15 +373,14 @@ pub trait BoardGame: Send + Sync {
         None
     }
 
-    /// [`solve`](Self::solve), by a solver that searches (the 15-puzzle's IDA*) bounded by
-    /// `max_nodes` search nodes (past them, [`GameError::SearchLimit`]) and stopped by another
-    /// thread raising `stop` ([`GameError::Interrupted`]). A game whose solver does not search
-    /// solves as `solve` does.
+    /// [`solve`](Self::solve), by a solver that searches (the 15-puzzle's IDA*) within
+    /// `control`: bounded by its nodes (past them, [`GameError::SearchLimit`]), stopped by
+    /// another thread ([`GameError::Interrupted`]), its progress counted there. A game whose
+    /// solver does not search solves as `solve` does.
     fn solve_within(
         &self,
         board: SymbolicState,
-        _max_nodes: u64,
-        _stop: &std::sync::atomic::AtomicBool,
+        _control: &SolveControl,
     ) -> Option<Result<Vec<MoveId>, GameError>> {
         self.solve(board)
     }

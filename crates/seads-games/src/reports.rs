@@ -144,9 +144,20 @@ impl SolveReport {
     /// assert!(report.table().ends_with("0 (press row 0 col 0)"));
     /// ```
     pub fn of(game: GameKind, size: usize, board: &str) -> Result<Self, GameError> {
+        Self::of_within(game, size, board, &crate::SolveControl::default())
+    }
+
+    /// [`of`](Self::of), a searching solver (the 15-puzzle's) within `control`: its bound of
+    /// nodes, stopped and its progress watched from another thread.
+    pub fn of_within(
+        game: GameKind,
+        size: usize,
+        board: &str,
+        control: &crate::SolveControl,
+    ) -> Result<Self, GameError> {
         let g = game.build(size)?;
         let z = g.parse(board)?;
-        let moves = match g.solve(z) {
+        let moves = match g.solve_within(z, control) {
             Some(moves) => moves?,
             None => {
                 let e = listed(game, size)?;

@@ -3,7 +3,6 @@
 //! nothing. Unlike LightsOut's and TileSwap's, its moves thus depend on the state.
 
 use std::sync::OnceLock;
-use std::sync::atomic::{AtomicBool, Ordering};
 
 use rand::seq::SliceRandom;
 use rand::{RngExt, seq::IndexedRandom as _};
@@ -11,7 +10,7 @@ use rand::{RngExt, seq::IndexedRandom as _};
 use crate::perm::{FACTORIAL, is_one_hot_permutation, one_hot, rank, tiles_of, unrank};
 use crate::{
     BoardGame, DepthTable, Enumerable, FieldMark, GameEntry, GameError, GameKind, MAX_DRAWS,
-    MoveId, MoveSite, SOLVE_NODES, Split, SymbolicState, split_of,
+    MoveId, MoveSite, SolveControl, Split, SymbolicState, split_of,
 };
 
 /// The sliding puzzle in the registry.
@@ -249,8 +248,8 @@ impl BoardGame for SlidingPuzzle {
                 .choose(rng)
                 .copied();
         }
-        let never = AtomicBool::new(false);
-        let mut budget = Budget::new(SAMPLE_NODES, &never);
+        let control = SolveControl::new(SAMPLE_NODES);
+        let mut budget = Budget::new(&control);
         for _ in 0..MAX_DRAWS {
             let mut board = self.goal();
             let mut last_gap = usize::MAX;
@@ -293,15 +292,14 @@ impl BoardGame for SlidingPuzzle {
     }
     /// The 8-puzzle from its complete depth table, the 15-puzzle by IDA* with the Manhattan
     /// distance (fast to a depth of about 40; the hardest boards take 80 moves and much longer),
-    /// within [`SOLVE_NODES`] search nodes.
+    /// within [`crate::SOLVE_NODES`] search nodes.
     fn solve(&self, board: SymbolicState) -> Option<Result<Vec<MoveId>, GameError>> {
-        self.solve_within(board, SOLVE_NODES, &AtomicBool::new(false))
+        self.solve_within(board, &SolveControl::default())
     }
     fn solve_within(
         &self,
         board: SymbolicState,
-        max_nodes: u64,
-        stop: &AtomicBool,
+        control: &SolveControl,
     ) -> Option<Result<Vec<MoveId>, GameError>> {
         let unsolvable = GameError::Unsolvable { game: "sliding" };
         if !self.is_valid(board) || self.can_reach(board, self.goal()) != Some(true) {
@@ -310,17 +308,17 @@ impl BoardGame for SlidingPuzzle {
         Some(if self.n == 3 {
             eight_puzzle_table().solve(self, board)
         } else {
-            let mut budget = Budget::new(max_nodes, stop);
-            ida_star(self.n, &self.tiles(board).0[..self.cells()], &mut budget).ok_or(
-                if stop.load(Ordering::Relaxed) {
-                    GameError::Interrupted { game: "sliding" }
-                } else {
-                    GameError::SearchLimit {
-                        game: "sliding",
-                        nodes: max_nodes,
-                    }
-                },
-            )
+            let mut budget = Budget::new(control);
+            let solved = ida_star(self.n, &self.tiles(board).0[..self.cells()], &mut budget);
+            control.set_expanded(budget.taken);
+            solved.ok_or(if control.is_stopped() {
+                GameError::Interrupted { game: "sliding" }
+            } else {
+                GameError::SearchLimit {
+                    game: "sliding",
+                    nodes: control.max_nodes(),
+                }
+            })
         })
     }
     fn solution_depth(&self, board: SymbolicState) -> Option<Result<usize, GameError>> {
@@ -362,22 +360,23 @@ fn eight_puzzle_table() -> &'static DepthTable {
     })
 }
 
-/// What an IDA* search may still do: the nodes left to expand, and a flag another thread raises
-/// to stop it (looked at on the first node and every [`Budget::CHECK_EVERY`] nodes after it).
+/// What an IDA* search may still do: the nodes left to expand under its [`SolveControl`],
+/// which it looks at on the first node and every [`Budget::CHECK_EVERY`] nodes after it
+/// (stopped? then it ends) and tells how many nodes it has taken.
 struct Budget<'a> {
     left: u64,
     taken: u64,
-    stop: &'a AtomicBool,
+    control: &'a SolveControl,
 }
 
 impl<'a> Budget<'a> {
     const CHECK_EVERY: u64 = 1 << 16;
 
-    fn new(nodes: u64, stop: &'a AtomicBool) -> Self {
+    fn new(control: &'a SolveControl) -> Self {
         Self {
-            left: nodes,
+            left: control.max_nodes(),
             taken: 0,
-            stop,
+            control,
         }
     }
 
@@ -386,9 +385,12 @@ impl<'a> Budget<'a> {
         if self.left == 0 {
             return false;
         }
-        if self.taken.is_multiple_of(Self::CHECK_EVERY) && self.stop.load(Ordering::Relaxed) {
-            self.left = 0;
-            return false;
+        if self.taken.is_multiple_of(Self::CHECK_EVERY) {
+            self.control.set_expanded(self.taken);
+            if self.control.is_stopped() {
+                self.left = 0;
+                return false;
+            }
         }
         self.left -= 1;
         self.taken += 1;
@@ -563,8 +565,8 @@ mod tests {
             for &index in e.layer(d).iter().step_by(e.layer(d).len().div_ceil(6)) {
                 let board = g.board_at(index);
                 let tiles = g.values(board);
-                let never = AtomicBool::new(false);
-                let moves = ida_star(3, &tiles, &mut Budget::new(u64::MAX, &never)).unwrap();
+                let control = SolveControl::new(u64::MAX);
+                let moves = ida_star(3, &tiles, &mut Budget::new(&control)).unwrap();
                 assert_eq!(moves.len(), d, "board {}", g.format(board));
                 assert!(g.is_goal(g.apply_all(board, &moves)));
             }
@@ -597,19 +599,27 @@ mod tests {
         // A board of depth 12 takes at least 13 nodes: 12 are too few.
         let board = g.layer(12)[0];
         let moves = g.solve(board).unwrap().unwrap();
-        let go = AtomicBool::new(false);
-        let stopped = g.solve_within(board, 12, &go).unwrap().unwrap_err();
+        let few = SolveControl::new(12);
+        let stopped = g.solve_within(board, &few).unwrap().unwrap_err();
         assert!(
             matches!(stopped, GameError::SearchLimit { nodes: 12, .. }),
             "{stopped}"
         );
-        assert_eq!(
-            g.solve_within(board, u64::MAX, &go).unwrap().unwrap(),
-            moves
-        );
+        assert_eq!(few.expanded(), 12, "the bound's nodes were all expanded");
+        let enough = SolveControl::new(u64::MAX);
+        assert_eq!(g.solve_within(board, &enough).unwrap().unwrap(), moves);
+        // The nodes it took are counted (issue 82: a long solve showed no progress): at least
+        // one per layer of the solution, and within the least bound that solves it.
+        let expanded = enough.expanded();
+        assert!(expanded > 12, "{expanded} nodes");
+        let just = SolveControl::new(expanded);
+        assert_eq!(g.solve_within(board, &just).unwrap().unwrap(), moves);
+        let short = SolveControl::new(expanded - 1);
+        assert!(g.solve_within(board, &short).unwrap().is_err());
         // A raised flag stops the search at its next look (another thread raises it: Ctrl-C).
-        let stop = AtomicBool::new(true);
-        let interrupted = g.solve_within(board, u64::MAX, &stop).unwrap().unwrap_err();
+        let stop = SolveControl::new(u64::MAX);
+        stop.stop();
+        let interrupted = g.solve_within(board, &stop).unwrap().unwrap_err();
         assert!(
             matches!(interrupted, GameError::Interrupted { .. }),
             "{interrupted}"

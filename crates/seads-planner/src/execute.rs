@@ -77,7 +77,8 @@ pub struct Deviation {
 }
 
 /// Solves the task in `env` (its current board towards `goal`) with `policy`, planning with
-/// `successor`.
+/// `successor`. Raising `config.planner.interrupt` stops it: a search at its next check, the
+/// execution before the next skill (the outcome then says why).
 pub fn solve(
     env: &mut dyn Environment,
     policy: &dyn SkillPolicy,
@@ -118,6 +119,9 @@ pub fn solve(
     if !config.replan {
         // Algorithm 1: execute the whole plan; only the final board counts.
         for (&skill, &predicted) in plan.skills.iter().zip(&plan.predicted) {
+            if interrupted(config, &mut outcome) {
+                return Ok(outcome);
+            }
             run(env, policy, skill, predicted, &mut outcome)?;
         }
         outcome.solved = env.board() == goal;
@@ -129,6 +133,9 @@ pub fn solve(
     // Algorithm 2: execute skill by skill, re-planning on a deviation from the prediction.
     let mut step = 0;
     loop {
+        if interrupted(config, &mut outcome) {
+            return Ok(outcome);
+        }
         run(
             env,
             policy,
@@ -267,6 +274,15 @@ impl Successor for Avoiding<'_> {
     ) -> Option<Vec<f32>> {
         self.inner.log_likelihoods(steps)
     }
+}
+
+/// Whether the solve was interrupted; if so, the outcome says so.
+fn interrupted(config: &SolveConfig, outcome: &mut SolveOutcome) -> bool {
+    let raised = config.planner.interrupt.is_raised();
+    if raised {
+        outcome.failure = Some(PlanError::Interrupted.to_string());
+    }
+    raised
 }
 
 /// Executes `skill`, recording a deviation when the board it leaves is not `predicted`.

@@ -281,6 +281,50 @@ fn a_perfect_policy_solves_with_and_without_replanning() {
     }
 }
 
+/// A policy that raises `interrupt` when it is first asked to act, as Ctrl-C would while a
+/// skill runs.
+struct Interrupting<'a>(CursorPolicy, &'a seads_planner::Interrupt);
+
+impl SkillPolicy for Interrupting<'_> {
+    fn num_skills(&self) -> usize {
+        self.0.num_skills()
+    }
+    fn act(&self, observations: &[f32], skills: &[usize], actions: &mut [f32]) {
+        self.1.raise();
+        self.0.act(observations, skills, actions);
+    }
+}
+
+/// An interrupt raised while a skill runs stops the solve before the next skill, with and
+/// without re-planning: one skill of a five-move plan runs, and the outcome says why it ended.
+#[test]
+fn an_interrupt_stops_the_execution_before_the_next_skill() {
+    let lo = &*LIGHTSOUT;
+    for replan in [false, true] {
+        let mut env = test_env(5, 0);
+        let config = SolveConfig {
+            replan,
+            ..SolveConfig::default()
+        };
+        let policy = Interrupting(CursorPolicy::lightsout(None), &config.planner.interrupt);
+        let out = solve(
+            env.as_mut(),
+            &policy,
+            &mut GameSuccessor::new(lo),
+            lo.goal(),
+            &config,
+        )
+        .unwrap();
+        assert_eq!(out.first_plan.len(), 5, "{out:?}");
+        assert_eq!(out.executed.len(), 1, "replan {replan}: {out:?}");
+        assert!(!out.solved);
+        assert_eq!(
+            out.failure.as_deref(),
+            Some(PlanError::Interrupted.to_string().as_str())
+        );
+    }
+}
+
 #[test]
 fn replanning_recovers_from_a_slip() {
     let lo = &*LIGHTSOUT;

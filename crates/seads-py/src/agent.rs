@@ -147,26 +147,28 @@ impl Agent {
     #[staticmethod]
     #[pyo3(signature = (run_dir, checkpoint=None))]
     fn load(py: Python<'_>, run_dir: PathBuf, checkpoint: Option<u64>) -> PyResult<Self> {
-        let seads_infer::Agent {
-            policy,
-            model,
-            env,
-            env_config,
-            spec,
-            epoch,
-        } = py
-            .detach(|| seads_infer::Agent::load(&run_dir, checkpoint))
-            .map_err(value_error)?;
-        // The game of the run's own environment (its board size, from `[env_config]`).
-        let game = spec.game.build(spec.board_size).map_err(value_error)?;
-        Ok(Self {
-            policy,
-            model: Mutex::new(model),
-            env,
-            env_config,
-            spec,
-            epoch,
-            game,
+        crate::guarded(|| {
+            let seads_infer::Agent {
+                policy,
+                model,
+                env,
+                env_config,
+                spec,
+                epoch,
+            } = py
+                .detach(|| seads_infer::Agent::load(&run_dir, checkpoint))
+                .map_err(value_error)?;
+            // The game of the run's own environment (its board size, from `[env_config]`).
+            let game = spec.game.build(spec.board_size).map_err(value_error)?;
+            Ok(Self {
+                policy,
+                model: Mutex::new(model),
+                env,
+                env_config,
+                spec,
+                epoch,
+                game,
+            })
         })
     }
 
@@ -200,102 +202,106 @@ impl Agent {
         deterministic: bool,
         seed: Option<u64>,
     ) -> PyResult<Bound<'py, PyAny>> {
-        // float32 as it is; float64 (NumPy's default) converted, where every value fits.
-        let f32_obs = obs.extract::<PyReadonlyArrayDyn<'py, f32>>().ok();
-        let f64_obs = match f32_obs {
-            Some(_) => None,
-            None => Some(obs.extract::<PyReadonlyArrayDyn<'py, f64>>().map_err(|_| {
-                value_error("observations: a NumPy array of float32 (or float64) values")
-            })?),
-        };
-        let shape = match (&f32_obs, &f64_obs) {
-            (Some(o), _) => o.shape().to_vec(),
-            (_, Some(o)) => o.shape().to_vec(),
-            _ => unreachable!("one of them was extracted"),
-        };
-        let rows = match shape[..] {
-            [n] if n == self.spec.obs_dim => 1,
-            [rows, n] if n == self.spec.obs_dim => rows,
-            _ => {
+        crate::guarded(|| {
+            // float32 as it is; float64 (NumPy's default) converted, where every value fits.
+            let f32_obs = obs.extract::<PyReadonlyArrayDyn<'py, f32>>().ok();
+            let f64_obs = match f32_obs {
+                Some(_) => None,
+                None => Some(obs.extract::<PyReadonlyArrayDyn<'py, f64>>().map_err(|_| {
+                    value_error("observations: a NumPy array of float32 (or float64) values")
+                })?),
+            };
+            let shape = match (&f32_obs, &f64_obs) {
+                (Some(o), _) => o.shape().to_vec(),
+                (_, Some(o)) => o.shape().to_vec(),
+                _ => unreachable!("one of them was extracted"),
+            };
+            let rows = match shape[..] {
+                [n] if n == self.spec.obs_dim => 1,
+                [rows, n] if n == self.spec.obs_dim => rows,
+                _ => {
+                    return Err(value_error(format!(
+                        "observations of shape {shape:?}: ({}) or (rows, {})",
+                        self.spec.obs_dim, self.spec.obs_dim
+                    )));
+                }
+            };
+            // One skill for every row is never repeated into a list of all rows.
+            let (one, each): (Option<usize>, Vec<usize>) = match skill.extract::<usize>() {
+                Ok(k) => (Some(k), Vec::new()),
+                Err(_) => (
+                    None,
+                    skill.extract::<Vec<usize>>().map_err(|_| {
+                        value_error("skill: a non-negative whole number or one per observation row")
+                    })?,
+                ),
+            };
+            if one.is_none() && each.len() != rows {
                 return Err(value_error(format!(
-                    "observations of shape {shape:?}: ({}) or (rows, {})",
-                    self.spec.obs_dim, self.spec.obs_dim
+                    "{} skills for {rows} observation rows",
+                    each.len()
                 )));
             }
-        };
-        // One skill for every row is never repeated into a list of all rows.
-        let (one, each): (Option<usize>, Vec<usize>) = match skill.extract::<usize>() {
-            Ok(k) => (Some(k), Vec::new()),
-            Err(_) => (
-                None,
-                skill.extract::<Vec<usize>>().map_err(|_| {
-                    value_error("skill: a non-negative whole number or one per observation row")
-                })?,
-            ),
-        };
-        if one.is_none() && each.len() != rows {
-            return Err(value_error(format!(
-                "{} skills for {rows} observation rows",
-                each.len()
-            )));
-        }
-        let mut rng = match (deterministic, seed) {
-            (true, _) => None,
-            (false, Some(seed)) => Some(ChaCha8Rng::seed_from_u64(seed)),
-            (false, None) => {
-                return Err(value_error(
-                    "a sampled action needs a seed (act(..., deterministic=False, seed=S))",
-                ));
-            }
-        };
-        // The actions are reserved up front, so that too many rows are a MemoryError, not an
-        // abort; the policy runs on chunks of rows, so that its layers hold a chunk at a time.
-        let mut actions: Vec<f32> = Vec::new();
-        actions
-            .try_reserve_exact(rows.saturating_mul(self.spec.action_dim))
-            .map_err(|_| {
-                PyMemoryError::new_err(format!("no memory for the actions of {rows} observations"))
-            })?;
-        let f32_view = f32_obs.as_ref().map(|o| o.as_array());
-        let f64_view = f64_obs.as_ref().map(|o| o.as_array());
-        let mut f32_values = f32_view.iter().flat_map(|v| v.iter().copied());
-        let mut f64_values = f64_view.iter().flat_map(|v| v.iter().copied());
-        let mut chunk: Vec<f32> = Vec::with_capacity(ACT_ROWS * self.spec.obs_dim);
-        // One skill for every row: a chunk's worth of it, made once.
-        let repeated = one.map_or_else(Vec::new, |k| vec![k; ACT_ROWS.min(rows)]);
-        for first in (0..rows).step_by(ACT_ROWS) {
-            let last = (first + ACT_ROWS).min(rows);
-            let n = (last - first) * self.spec.obs_dim;
-            chunk.clear();
-            if f32_view.is_some() {
-                chunk.extend(f32_values.by_ref().take(n));
-            } else {
-                for v in f64_values.by_ref().take(n) {
-                    let narrow = v as f32;
-                    if v.is_finite() && narrow.is_infinite() {
-                        return Err(value_error(format!(
-                            "an observation of {v} lies beyond float32's range"
-                        )));
-                    }
-                    chunk.push(narrow);
+            let mut rng = match (deterministic, seed) {
+                (true, _) => None,
+                (false, Some(seed)) => Some(ChaCha8Rng::seed_from_u64(seed)),
+                (false, None) => {
+                    return Err(value_error(
+                        "a sampled action needs a seed (act(..., deterministic=False, seed=S))",
+                    ));
                 }
-            }
-            let skills = match one {
-                Some(_) => &repeated[..last - first],
-                None => &each[first..last],
             };
-            let part = self
-                .policy
-                .actions(&chunk, skills, rng.as_mut())
-                .map_err(value_error)?;
-            actions.extend(part);
-        }
-        if shape.len() == 1 {
-            Ok(PyArray1::from_vec(py, actions).into_any())
-        } else {
-            let array = PyArray1::from_vec(py, actions);
-            Ok(array.reshape([rows, self.spec.action_dim])?.into_any())
-        }
+            // The actions are reserved up front, so that too many rows are a MemoryError, not an
+            // abort; the policy runs on chunks of rows, so that its layers hold a chunk at a time.
+            let mut actions: Vec<f32> = Vec::new();
+            actions
+                .try_reserve_exact(rows.saturating_mul(self.spec.action_dim))
+                .map_err(|_| {
+                    PyMemoryError::new_err(format!(
+                        "no memory for the actions of {rows} observations"
+                    ))
+                })?;
+            let f32_view = f32_obs.as_ref().map(|o| o.as_array());
+            let f64_view = f64_obs.as_ref().map(|o| o.as_array());
+            let mut f32_values = f32_view.iter().flat_map(|v| v.iter().copied());
+            let mut f64_values = f64_view.iter().flat_map(|v| v.iter().copied());
+            let mut chunk: Vec<f32> = Vec::with_capacity(ACT_ROWS * self.spec.obs_dim);
+            // One skill for every row: a chunk's worth of it, made once.
+            let repeated = one.map_or_else(Vec::new, |k| vec![k; ACT_ROWS.min(rows)]);
+            for first in (0..rows).step_by(ACT_ROWS) {
+                let last = (first + ACT_ROWS).min(rows);
+                let n = (last - first) * self.spec.obs_dim;
+                chunk.clear();
+                if f32_view.is_some() {
+                    chunk.extend(f32_values.by_ref().take(n));
+                } else {
+                    for v in f64_values.by_ref().take(n) {
+                        let narrow = v as f32;
+                        if v.is_finite() && narrow.is_infinite() {
+                            return Err(value_error(format!(
+                                "an observation of {v} lies beyond float32's range"
+                            )));
+                        }
+                        chunk.push(narrow);
+                    }
+                }
+                let skills = match one {
+                    Some(_) => &repeated[..last - first],
+                    None => &each[first..last],
+                };
+                let part = self
+                    .policy
+                    .actions(&chunk, skills, rng.as_mut())
+                    .map_err(value_error)?;
+                actions.extend(part);
+            }
+            if shape.len() == 1 {
+                Ok(PyArray1::from_vec(py, actions).into_any())
+            } else {
+                let array = PyArray1::from_vec(py, actions);
+                Ok(array.reshape([rows, self.spec.action_dim])?.into_any())
+            }
+        })
     }
 
     /// `successors(board)`: the board the forward model predicts after each skill (K rows of
@@ -305,11 +311,13 @@ impl Agent {
         py: Python<'py>,
         board: Values,
     ) -> PyResult<Bound<'py, PyArray2<u8>>> {
-        let z = self.board(&board)?;
-        let mut next = Vec::new();
-        py.detach(|| lock(&self.model).successors(&[z], &mut next));
-        let rows: Vec<Vec<u8>> = next.iter().map(|&b| self.game.values(b)).collect();
-        PyArray2::from_vec2(py, &rows).map_err(value_error)
+        crate::guarded(|| {
+            let z = self.board(&board)?;
+            let mut next = Vec::new();
+            py.detach(|| lock(&self.model).successors(&[z], &mut next));
+            let rows: Vec<Vec<u8>> = next.iter().map(|&b| self.game.values(b)).collect();
+            PyArray2::from_vec2(py, &rows).map_err(value_error)
+        })
     }
 
     /// `plan(board, goal=None, max_depth=20, max_expanded=4194304, search="breadth",
@@ -327,22 +335,24 @@ impl Agent {
         search: &str,
         choice: &str,
     ) -> PyResult<Vec<usize>> {
-        let start = self.board(&board)?;
-        let goal = match goal {
-            Some(values) => self.board(&values)?,
-            None => self.game.goal(),
-        };
-        if start == goal {
-            return Ok(Vec::new());
-        }
-        let config = planner(max_depth, max_expanded, search, choice)?;
-        crate::interruptible(
-            py,
-            || find_plan(&mut *lock(&self.model), start, goal, &config),
-            || config.interrupt.raise(),
-        )?
-        .map(|plan| plan.skills)
-        .map_err(crate::plan_error)
+        crate::guarded(|| {
+            let start = self.board(&board)?;
+            let goal = match goal {
+                Some(values) => self.board(&values)?,
+                None => self.game.goal(),
+            };
+            if start == goal {
+                return Ok(Vec::new());
+            }
+            let config = planner(max_depth, max_expanded, search, choice)?;
+            crate::interruptible(
+                py,
+                || find_plan(&mut *lock(&self.model), start, goal, &config),
+                || config.interrupt.raise(),
+            )?
+            .map(|plan| plan.skills)
+            .map_err(crate::plan_error)
+        })
     }
 
     /// `solve(env, board=None, replan=True, max_expanded=4194304, search="breadth",
@@ -367,80 +377,82 @@ impl Agent {
         render: bool,
         size: usize,
     ) -> PyResult<Bound<'py, PyDict>> {
-        let core = env_core(env)?;
-        let mut core = core.borrow_mut();
-        let start = match board {
-            Some(values) => Some(self.board(&values)?),
-            None => None,
-        };
-        let config = SolveConfig {
-            replan,
-            planner: planner(20, max_expanded, search, choice)?,
-            ..SolveConfig::default()
-        };
-        let goal = self.game.goal();
-        let environment = self.own_env(&mut core)?;
-        if let Some(start) = start {
-            environment.set_board(start).map_err(value_error)?;
-        }
-        let policy = &self.policy;
-        if render {
-            crate::render::check_size(size)?;
-        }
-        // The search and the skills run with the GIL released (other Python threads go on),
-        // and Ctrl-C stops the search.
-        let (outcome, scenes) = crate::interruptible(
-            py,
-            || {
-                let mut model = lock(&self.model);
-                if render {
-                    // A copy (same state, same random streams) is filmed and then takes the
-                    // environment's place: the environment ends as an unfilmed solve leaves it.
-                    let mut filmed = Filmed::new(environment.box_clone());
-                    let outcome =
-                        seads_planner::solve(&mut filmed, policy, &mut *model, goal, &config);
-                    let scenes = filmed.take_frames();
-                    *environment = filmed.into_inner();
-                    (outcome, scenes)
-                } else {
-                    let outcome = seads_planner::solve(
-                        environment.as_mut(),
-                        policy,
-                        &mut *model,
-                        goal,
-                        &config,
-                    );
-                    (outcome, Vec::new())
-                }
-            },
-            || config.planner.interrupt.raise(),
-        )?;
-        let outcome = outcome.map_err(value_error)?;
-        let result = PyDict::new(py);
-        if render {
-            let frames = scenes
+        crate::guarded(|| {
+            let core = env_core(env)?;
+            let mut core = core.borrow_mut();
+            let start = match board {
+                Some(values) => Some(self.board(&values)?),
+                None => None,
+            };
+            let config = SolveConfig {
+                replan,
+                planner: planner(20, max_expanded, search, choice)?,
+                ..SolveConfig::default()
+            };
+            let goal = self.game.goal();
+            let environment = self.own_env(&mut core)?;
+            if let Some(start) = start {
+                environment.set_board(start).map_err(value_error)?;
+            }
+            let policy = &self.policy;
+            if render {
+                crate::render::check_size(size)?;
+            }
+            // The search and the skills run with the GIL released (other Python threads go on),
+            // and Ctrl-C stops the search.
+            let (outcome, scenes) = crate::interruptible(
+                py,
+                || {
+                    let mut model = lock(&self.model);
+                    if render {
+                        // A copy (same state, same random streams) is filmed and then takes the
+                        // environment's place: the environment ends as an unfilmed solve leaves it.
+                        let mut filmed = Filmed::new(environment.box_clone());
+                        let outcome =
+                            seads_planner::solve(&mut filmed, policy, &mut *model, goal, &config);
+                        let scenes = filmed.take_frames();
+                        *environment = filmed.into_inner();
+                        (outcome, scenes)
+                    } else {
+                        let outcome = seads_planner::solve(
+                            environment.as_mut(),
+                            policy,
+                            &mut *model,
+                            goal,
+                            &config,
+                        );
+                        (outcome, Vec::new())
+                    }
+                },
+                || config.planner.interrupt.raise(),
+            )?;
+            let outcome = outcome.map_err(value_error)?;
+            let result = PyDict::new(py);
+            if render {
+                let frames = scenes
+                    .iter()
+                    .map(|scene| crate::render::frame(py, scene, size))
+                    .collect::<PyResult<Vec<_>>>()?;
+                result.set_item("frames", frames)?;
+            }
+            result.set_item("solved", outcome.solved)?;
+            result.set_item("skills", outcome.executed.clone())?;
+            let moves: Vec<i64> = outcome
+                .runs
                 .iter()
-                .map(|scene| crate::render::frame(py, scene, size))
-                .collect::<PyResult<Vec<_>>>()?;
-            result.set_item("frames", frames)?;
-        }
-        result.set_item("solved", outcome.solved)?;
-        result.set_item("skills", outcome.executed.clone())?;
-        let moves: Vec<i64> = outcome
-            .runs
-            .iter()
-            .map(|r| match r.outcome.push {
-                Push::Move(m) => m as i64,
-                _ => -1,
-            })
-            .collect();
-        result.set_item("moves", moves)?;
-        let path: Vec<[f64; 2]> = outcome.runs.iter().flat_map(|r| r.path.clone()).collect();
-        result.set_item("path", path)?;
-        result.set_item("steps", outcome.manipulator_steps)?;
-        result.set_item("plans", outcome.plans)?;
-        result.set_item("failure", outcome.failure.clone())?;
-        Ok(result)
+                .map(|r| match r.outcome.push {
+                    Push::Move(m) => m as i64,
+                    _ => -1,
+                })
+                .collect();
+            result.set_item("moves", moves)?;
+            let path: Vec<[f64; 2]> = outcome.runs.iter().flat_map(|r| r.path.clone()).collect();
+            result.set_item("path", path)?;
+            result.set_item("steps", outcome.manipulator_steps)?;
+            result.set_item("plans", outcome.plans)?;
+            result.set_item("failure", outcome.failure.clone())?;
+            Ok(result)
+        })
     }
     /// `clip(env, skill, size=256)`: executes `skill` once from where the environment stands
     /// (reset it first, e.g. ``env.reset(seed=s)``) and returns a dict: frames (the top view,
@@ -454,36 +466,38 @@ impl Agent {
         skill: i64,
         size: usize,
     ) -> PyResult<Bound<'py, PyDict>> {
-        crate::render::check_size(size)?;
-        let skill = usize::try_from(skill)
-            .ok()
-            .filter(|&k| k < self.policy.num_skills())
-            .ok_or_else(|| {
-                value_error(format!(
-                    "skill {skill}: the agent has skills 0 to {}",
-                    self.policy.num_skills() - 1
-                ))
-            })?;
-        let core = env_core(env)?;
-        let mut core = core.borrow_mut();
-        let environment = self.own_env(&mut core)?;
-        let policy = &self.policy;
-        let (run, scenes) = py.detach(|| {
-            let mut filmed = Filmed::new(environment.box_clone());
-            let run = execute_skill(&mut filmed, policy, skill);
-            let scenes = filmed.take_frames();
-            *environment = filmed.into_inner();
-            (run, scenes)
-        });
-        let run = run.map_err(value_error)?;
-        let frames = scenes
-            .iter()
-            .map(|scene| crate::render::frame(py, scene, size))
-            .collect::<PyResult<Vec<_>>>()?;
-        let result = PyDict::new(py);
-        result.set_item("frames", frames)?;
-        result.set_item("move", run.outcome.game_move().map_or(-1, |m| m as i64))?;
-        result.set_item("steps", run.steps)?;
-        Ok(result)
+        crate::guarded(|| {
+            crate::render::check_size(size)?;
+            let skill = usize::try_from(skill)
+                .ok()
+                .filter(|&k| k < self.policy.num_skills())
+                .ok_or_else(|| {
+                    value_error(format!(
+                        "skill {skill}: the agent has skills 0 to {}",
+                        self.policy.num_skills() - 1
+                    ))
+                })?;
+            let core = env_core(env)?;
+            let mut core = core.borrow_mut();
+            let environment = self.own_env(&mut core)?;
+            let policy = &self.policy;
+            let (run, scenes) = py.detach(|| {
+                let mut filmed = Filmed::new(environment.box_clone());
+                let run = execute_skill(&mut filmed, policy, skill);
+                let scenes = filmed.take_frames();
+                *environment = filmed.into_inner();
+                (run, scenes)
+            });
+            let run = run.map_err(value_error)?;
+            let frames = scenes
+                .iter()
+                .map(|scene| crate::render::frame(py, scene, size))
+                .collect::<PyResult<Vec<_>>>()?;
+            let result = PyDict::new(py);
+            result.set_item("frames", frames)?;
+            result.set_item("move", run.outcome.game_move().map_or(-1, |m| m as i64))?;
+            result.set_item("steps", run.steps)?;
+            Ok(result)
+        })
     }
 }

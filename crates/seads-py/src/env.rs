@@ -159,17 +159,19 @@ impl Env {
     #[new]
     #[pyo3(signature = (name, options=None, task=false))]
     fn new(name: &str, options: Option<&str>, task: bool) -> PyResult<Self> {
-        let config = parse_options(options)?;
-        let core = Core::new(name, &config, task).map_err(value_error)?;
-        let game = core.game().map_err(value_error)?;
-        Ok(Self { core, game, config })
+        crate::guarded(|| {
+            let config = parse_options(options)?;
+            let core = Core::new(name, &config, task).map_err(value_error)?;
+            let game = core.game().map_err(value_error)?;
+            Ok(Self { core, game, config })
+        })
     }
 
     /// The environment's specification as a dict (name, game, board_size, obs_dim, action_dim,
     /// action_low, action_high, symbolic_len, manipulator_dim, state_low, state_high (the
     /// manipulator state's bounds, ±inf where unbounded), num_moves, step_limit).
     fn spec<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, pyo3::types::PyDict>> {
-        spec_dict(py, self.core.spec())
+        crate::guarded(|| spec_dict(py, self.core.spec()))
     }
 
     /// Re-seeds the board's and the manipulator's random streams.
@@ -179,8 +181,10 @@ impl Env {
 
     /// Starts an episode; returns the observation.
     fn reset<'py>(&mut self, py: Python<'py>) -> PyResult<Bound<'py, PyArray1<f32>>> {
-        self.core.reset().map_err(value_error)?;
-        Ok(self.observation(py))
+        crate::guarded(|| {
+            self.core.reset().map_err(value_error)?;
+            Ok(self.observation(py))
+        })
     }
 
     /// One step: `(observation, reward, terminated, truncated, move)`, `move` being the game
@@ -191,15 +195,17 @@ impl Env {
         py: Python<'py>,
         action: PyReadonlyArray1<'py, f32>,
     ) -> PyResult<(Bound<'py, PyArray1<f32>>, f32, bool, bool, i64)> {
-        let action = action.as_slice().map_err(value_error)?;
-        let s = self.core.step(action).map_err(value_error)?;
-        Ok((
-            self.observation(py),
-            s.reward,
-            s.terminated,
-            s.truncated,
-            s.game_move,
-        ))
+        crate::guarded(|| {
+            let action = action.as_slice().map_err(value_error)?;
+            let s = self.core.step(action).map_err(value_error)?;
+            Ok((
+                self.observation(py),
+                s.reward,
+                s.terminated,
+                s.truncated,
+                s.game_move,
+            ))
+        })
     }
 
     /// The current observation `[manipulator state, board bits, remaining time]`.
@@ -219,11 +225,13 @@ impl Env {
     /// (manipulator state, then the board's bits) and lifts the step limit, as `seads replay`
     /// does: the recorded actions then give the recorded observations (skill mode only).
     fn set_state(&mut self, state: PyReadonlyArray1<'_, f32>) -> PyResult<()> {
-        let state = state.as_slice().map_err(value_error)?;
-        let Core::Skill(env) = &mut self.core else {
-            return Err(value_error("set_state is for skill mode, not task mode"));
-        };
-        seads_embodiment::restore_state(env.as_mut(), state).map_err(value_error)
+        crate::guarded(|| {
+            let state = state.as_slice().map_err(value_error)?;
+            let Core::Skill(env) = &mut self.core else {
+                return Err(value_error("set_state is for skill mode, not task mode"));
+            };
+            seads_embodiment::restore_state(env.as_mut(), state).map_err(value_error)
+        })
     }
 
     /// The task's solution depth S (`None` in skill mode).
@@ -234,7 +242,7 @@ impl Env {
     /// A top view as an RGB image of `size` × `size` pixels.
     #[pyo3(signature = (size=256))]
     fn render<'py>(&self, py: Python<'py>, size: usize) -> PyResult<Bound<'py, PyArray3<u8>>> {
-        crate::render::image(py, self.core.env(), size)
+        crate::guarded(|| crate::render::image(py, self.core.env(), size))
     }
 }
 

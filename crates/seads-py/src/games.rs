@@ -2,12 +2,10 @@
 //! NumPy boards in and out: a board is its values, row-major (LightsOut: 0/1 per field;
 //! TileSwap and the sliding puzzle: the tile on each field, 0 the sliding puzzle's gap).
 
-use std::sync::atomic::{AtomicBool, Ordering};
-
 use numpy::{PyArray1, PyArray2};
 use pyo3::prelude::*;
 use seads_games::{
-    BoardDataset, BoardGame, Enumerable, GameKind, GameSuccessor, SOLVE_NODES, Split,
+    BoardDataset, BoardGame, Enumerable, GameKind, GameSuccessor, SolveControl, Split,
     SymbolicState, enumerate, split_of,
 };
 use seads_planner::{PlannerConfig, bfs_plan};
@@ -67,11 +65,13 @@ impl Game {
     #[new]
     #[pyo3(signature = (name, size=None))]
     fn new(name: &str, size: Option<usize>) -> PyResult<Self> {
-        let kind = GameKind::named(name).map_err(value_error)?;
-        let rules = kind
-            .build(size.unwrap_or(kind.default_size()))
-            .map_err(value_error)?;
-        Ok(Self { rules })
+        crate::guarded(|| {
+            let kind = GameKind::named(name).map_err(value_error)?;
+            let rules = kind
+                .build(size.unwrap_or(kind.default_size()))
+                .map_err(value_error)?;
+            Ok(Self { rules })
+        })
     }
 
     /// The game's name: `"lightsout"`, `"tileswap"` or `"sliding"`.
@@ -104,54 +104,59 @@ impl Game {
         board: Values,
         r#move: i64,
     ) -> PyResult<Bound<'py, PyArray1<u8>>> {
-        let board = self.board(board)?;
-        let mv = move_arg(r#move, self.game().num_moves())?;
-        Ok(self.array(py, self.game().apply(board, mv)))
+        crate::guarded(|| {
+            let board = self.board(board)?;
+            let mv = move_arg(r#move, self.game().num_moves())?;
+            Ok(self.array(py, self.game().apply(board, mv)))
+        })
     }
 
     /// Whether `board` is solved.
     fn is_goal(&self, board: Values) -> PyResult<bool> {
-        Ok(self.game().is_goal(self.board(board)?))
+        crate::guarded(|| Ok(self.game().is_goal(self.board(board)?)))
     }
 
     /// An optimal (shortest) move sequence that solves `board`; a `ValueError` if none does,
     /// or if the solver's search (the 15-puzzle's) stops at its bound of nodes. Ctrl-C stops it.
     fn solve(&self, py: Python<'_>, board: Values) -> PyResult<Vec<usize>> {
-        let board = self.board(board)?;
-        let game = self.game();
-        let stop = AtomicBool::new(false);
-        let solved = crate::interruptible(
-            py,
-            || game.solve_within(board, SOLVE_NODES, &stop),
-            || stop.store(true, Ordering::Relaxed),
-        )?;
-        match solved {
-            Some(moves) => moves.map_err(value_error),
-            None => Err(value_error("this game has no solver")),
-        }
+        crate::guarded(|| {
+            let board = self.board(board)?;
+            let game = self.game();
+            let control = SolveControl::default();
+            let solved =
+                crate::interruptible(py, || game.solve_within(board, &control), || control.stop())?;
+            match solved {
+                Some(moves) => moves.map_err(value_error),
+                None => Err(value_error("this game has no solver")),
+            }
+        })
     }
 
     /// The board's solution depth (length of an optimal solution); a `ValueError` if it has
     /// none. Ctrl-C stops a search.
     fn depth(&self, py: Python<'_>, board: Values) -> PyResult<usize> {
-        Ok(self.solve(py, board)?.len())
+        crate::guarded(|| Ok(self.solve(py, board)?.len()))
     }
 
     /// Number of boards per solution depth 0, 1, … (up to `max_depth` when given), by
     /// breadth-first enumeration from the goal.
     #[pyo3(signature = (max_depth=None))]
     fn depth_counts(&self, py: Python<'_>, max_depth: Option<usize>) -> PyResult<Vec<u64>> {
-        let game = self.enumerable()?;
-        py.detach(|| enumerate(game, max_depth).map(|e| e.depth_counts()))
-            .map_err(value_error)
+        crate::guarded(|| {
+            let game = self.enumerable()?;
+            py.detach(|| enumerate(game, max_depth).map(|e| e.depth_counts()))
+                .map_err(value_error)
+        })
     }
 
     /// `"train"` or `"test"`: the board's part of the split, by the CRC-32 of its values written
     /// as comma-separated text: `"train"` where it is 0 modulo 3 (a third of the boards), else
     /// `"test"` (two thirds).
     fn split(&self, board: Values) -> PyResult<&'static str> {
-        let board = self.board(board)?;
-        Ok(split_of(&self.game().values(board)).name())
+        crate::guarded(|| {
+            let board = self.board(board)?;
+            Ok(split_of(&self.game().values(board)).name())
+        })
     }
 
     /// Every board of solution depth `depth` in `split`, one per row (uint8), in the order of
@@ -163,29 +168,31 @@ impl Game {
         depth: usize,
         split: &str,
     ) -> PyResult<Bound<'py, PyArray2<u8>>> {
-        let split = parse_split(split)?;
-        if depth > 12 {
-            return Err(value_error(format!(
-                "depth {depth}: boards are listed up to depth 12"
-            )));
-        }
-        let game = self.enumerable()?;
-        let data = py
-            .detach(|| BoardDataset::build(game, depth))
-            .map_err(value_error)?;
-        let rows: Vec<Vec<u8>> = data
-            .boards(depth, split)
-            .iter()
-            .map(|&b| self.game().values(b))
-            .collect();
-        if rows.is_empty() {
-            return Ok(PyArray2::zeros(
-                py,
-                [0, self.game().size() * self.game().size()],
-                false,
-            ));
-        }
-        PyArray2::from_vec2(py, &rows).map_err(value_error)
+        crate::guarded(|| {
+            let split = parse_split(split)?;
+            if depth > 12 {
+                return Err(value_error(format!(
+                    "depth {depth}: boards are listed up to depth 12"
+                )));
+            }
+            let game = self.enumerable()?;
+            let data = py
+                .detach(|| BoardDataset::build(game, depth))
+                .map_err(value_error)?;
+            let rows: Vec<Vec<u8>> = data
+                .boards(depth, split)
+                .iter()
+                .map(|&b| self.game().values(b))
+                .collect();
+            if rows.is_empty() {
+                return Ok(PyArray2::zeros(
+                    py,
+                    [0, self.game().size() * self.game().size()],
+                    false,
+                ));
+            }
+            PyArray2::from_vec2(py, &rows).map_err(value_error)
+        })
     }
 }
 
@@ -203,35 +210,37 @@ pub fn plan(
     max_expanded: Option<usize>,
     max_depth: usize,
 ) -> PyResult<Vec<usize>> {
-    let start = game.board(board)?;
-    let goal = match goal {
-        Some(values) => game.board(values)?,
-        None => game.game().goal(),
-    };
-    if start == goal {
-        return Ok(Vec::new());
-    }
-    // Where the game tells at once that no plan exists, the search does not run to its limit.
-    if game.game().can_reach(start, goal) == Some(false) {
-        return Err(value_error(seads_games::GameError::Unsolvable {
-            game: game.game().kind().name(),
-        }));
-    }
-    let config = PlannerConfig {
-        max_layers: max_depth,
-        timeout_s,
-        max_expanded,
-        ..PlannerConfig::default()
-    };
-    let rules = game.game();
-    crate::interruptible(
-        py,
-        || {
-            let mut successor = GameSuccessor::new(rules);
-            bfs_plan(&mut successor, start, goal, &config)
-        },
-        || config.interrupt.raise(),
-    )?
-    .map(|plan| plan.skills)
-    .map_err(crate::plan_error)
+    crate::guarded(|| {
+        let start = game.board(board)?;
+        let goal = match goal {
+            Some(values) => game.board(values)?,
+            None => game.game().goal(),
+        };
+        if start == goal {
+            return Ok(Vec::new());
+        }
+        // Where the game tells at once that no plan exists, the search does not run to its limit.
+        if game.game().can_reach(start, goal) == Some(false) {
+            return Err(value_error(seads_games::GameError::Unsolvable {
+                game: game.game().kind().name(),
+            }));
+        }
+        let config = PlannerConfig {
+            max_layers: max_depth,
+            timeout_s,
+            max_expanded,
+            ..PlannerConfig::default()
+        };
+        let rules = game.game();
+        crate::interruptible(
+            py,
+            || {
+                let mut successor = GameSuccessor::new(rules);
+                bfs_plan(&mut successor, start, goal, &config)
+            },
+            || config.interrupt.raise(),
+        )?
+        .map(|plan| plan.skills)
+        .map_err(crate::plan_error)
+    })
 }

@@ -70,15 +70,27 @@ pub(crate) fn interruptible<T: Send>(
         if let Some(e) = interrupted {
             return Err(e);
         }
-        joined.map_err(|panic| {
-            let why = panic
-                .downcast_ref::<&str>()
-                .map(|s| (*s).to_owned())
-                .or_else(|| panic.downcast_ref::<String>().cloned())
-                .unwrap_or_default();
-            PyRuntimeError::new_err(format!("the computation failed: {why}"))
-        })
+        joined.map_err(panicked)
     })
+}
+
+/// Runs `work`, the body of a method Python calls: a panic in it (a defect of ours) is a
+/// `RuntimeError` saying what failed, which `except Exception` catches, never pyo3's
+/// `PanicException`, a `BaseException`. Every fallible method and function of the module runs
+/// its body through this (or [`interruptible`]); a test lists them.
+pub(crate) fn guarded<T>(work: impl FnOnce() -> PyResult<T>) -> PyResult<T> {
+    std::panic::catch_unwind(std::panic::AssertUnwindSafe(work))
+        .unwrap_or_else(|p| Err(panicked(p)))
+}
+
+/// A panic's payload as a `RuntimeError` with its message.
+fn panicked(payload: Box<dyn std::any::Any + Send>) -> PyErr {
+    let why = payload
+        .downcast_ref::<&str>()
+        .map(|s| (*s).to_owned())
+        .or_else(|| payload.downcast_ref::<String>().cloned())
+        .unwrap_or_default();
+    PyRuntimeError::new_err(format!("the computation failed: {why}"))
 }
 
 /// A search that found no plan as a Python exception: `MemoryError` where the machine had no
@@ -187,6 +199,13 @@ fn game_names() -> Vec<&'static str> {
 }
 
 /// The Python module.
+/// `_panic(message)`, for the tests only: panics with `message` inside a guarded call, as a
+/// defect of ours would, so that they can show it arrives as a `RuntimeError`.
+#[pyfunction]
+fn _panic(message: &str) -> PyResult<()> {
+    guarded(|| panic!("{message}"))
+}
+
 #[pymodule]
 fn _seads(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
@@ -198,5 +217,6 @@ fn _seads(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<games::Game>()?;
     m.add_class::<agent::Agent>()?;
     m.add_function(wrap_pyfunction!(games::plan, m)?)?;
+    m.add_function(wrap_pyfunction!(_panic, m)?)?;
     Ok(())
 }

@@ -95,47 +95,49 @@ impl VecEnv {
         task: bool,
         autoreset: &str,
     ) -> PyResult<Self> {
-        if !(1..=MAX_ENVS).contains(&num_envs) {
-            return Err(value_error(format!(
-                "num_envs {num_envs}: must be 1 to {MAX_ENVS}"
-            )));
-        }
-        let autoreset = Autoreset::parse(autoreset)?;
-        let config = parse_options(options)?;
-        let first = Core::new(name, &config, task).map_err(value_error)?;
-        let mut members = Vec::new();
-        members
-            .try_reserve_exact(num_envs)
-            .map_err(|_| memory_error(name, num_envs, 0))?;
-        members.push(Member {
-            core: first,
-            ended: false,
-        });
-        while members.len() < num_envs {
-            if members.len() % PROBE_EVERY == 0 {
-                py.check_signals()?;
-                Vec::<u8>::new()
-                    .try_reserve_exact(HEADROOM)
-                    .map_err(|_| memory_error(name, num_envs, members.len()))?;
+        crate::guarded(|| {
+            if !(1..=MAX_ENVS).contains(&num_envs) {
+                return Err(value_error(format!(
+                    "num_envs {num_envs}: must be 1 to {MAX_ENVS}"
+                )));
             }
-            let core = Core::new(name, &config, task).map_err(value_error)?;
-            members.push(Member { core, ended: false });
-        }
-        let spec = members[0].core.spec();
-        let game = members[0].core.game().map_err(value_error)?;
-        let threads = rayon::current_num_threads().max(1);
-        Ok(Self {
-            obs_dim: spec.obs_dim,
-            action_dim: spec.action_dim,
-            board_len: game.values(game.goal()).len(),
-            game,
-            members,
-            autoreset,
-            // At least four pieces of work per thread, so that every thread steps even a small
-            // vector of slow environments (a Jaco arm's step is ~100 µs) and a busy core holds
-            // back little; at most 64 environments a piece, so that a large vector is shared
-            // out finely too.
-            chunk: (num_envs / (4 * threads)).clamp(1, 64),
+            let autoreset = Autoreset::parse(autoreset)?;
+            let config = parse_options(options)?;
+            let first = Core::new(name, &config, task).map_err(value_error)?;
+            let mut members = Vec::new();
+            members
+                .try_reserve_exact(num_envs)
+                .map_err(|_| memory_error(name, num_envs, 0))?;
+            members.push(Member {
+                core: first,
+                ended: false,
+            });
+            while members.len() < num_envs {
+                if members.len() % PROBE_EVERY == 0 {
+                    py.check_signals()?;
+                    Vec::<u8>::new()
+                        .try_reserve_exact(HEADROOM)
+                        .map_err(|_| memory_error(name, num_envs, members.len()))?;
+                }
+                let core = Core::new(name, &config, task).map_err(value_error)?;
+                members.push(Member { core, ended: false });
+            }
+            let spec = members[0].core.spec();
+            let game = members[0].core.game().map_err(value_error)?;
+            let threads = rayon::current_num_threads().max(1);
+            Ok(Self {
+                obs_dim: spec.obs_dim,
+                action_dim: spec.action_dim,
+                board_len: game.values(game.goal()).len(),
+                game,
+                members,
+                autoreset,
+                // At least four pieces of work per thread, so that every thread steps even a small
+                // vector of slow environments (a Jaco arm's step is ~100 µs) and a busy core holds
+                // back little; at most 64 environments a piece, so that a large vector is shared
+                // out finely too.
+                chunk: (num_envs / (4 * threads)).clamp(1, 64),
+            })
         })
     }
 
@@ -158,7 +160,7 @@ impl VecEnv {
 
     /// The environments' specification as a dict (see `Env.spec`).
     fn spec<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, pyo3::types::PyDict>> {
-        crate::env::spec_dict(py, self.members[0].core.spec())
+        crate::guarded(|| crate::env::spec_dict(py, self.members[0].core.spec()))
     }
 
     /// Resets the environments (those where `mask` is true, when given; `seeds[i]` seeds
@@ -176,58 +178,62 @@ impl VecEnv {
         seeds: Option<Vec<u64>>,
         mask: Option<PyReadonlyArray1<'_, bool>>,
     ) -> PyResult<()> {
-        let n = self.members.len();
-        if let Some(seeds) = &seeds
-            && seeds.len() != n
-        {
-            return Err(value_error(format!(
-                "{} seeds for {n} environments",
-                seeds.len()
-            )));
-        }
-        let mask = match &mask {
-            Some(mask) => {
-                Some(self.checked_ref(mask.as_slice().map_err(value_error)?, 1, "reset_mask")?)
+        crate::guarded(|| {
+            let n = self.members.len();
+            if let Some(seeds) = &seeds
+                && seeds.len() != n
+            {
+                return Err(value_error(format!(
+                    "{} seeds for {n} environments",
+                    seeds.len()
+                )));
             }
-            None => None,
-        };
-        let obs = self.checked(
-            obs.as_slice_mut().map_err(value_error)?,
-            self.obs_dim,
-            "obs",
-        )?;
-        let board = self.checked(
-            board.as_slice_mut().map_err(value_error)?,
-            self.board_len,
-            "board",
-        )?;
-        let depth = self.checked(depth.as_slice_mut().map_err(value_error)?, 1, "depth")?;
-        let (obs_dim, board_len, chunk, game) =
-            (self.obs_dim, self.board_len, self.chunk, &*self.game);
-        let members = &mut self.members;
-        py.detach(|| {
-            obs.par_chunks_mut(obs_dim)
-                .zip(board.par_chunks_mut(board_len))
-                .zip(depth.par_iter_mut())
-                .zip(members.par_iter_mut())
-                .enumerate()
-                .with_min_len(chunk)
-                .try_for_each(|(i, (((obs, board), depth), m))| {
-                    if mask.is_some_and(|mask| !mask[i]) {
-                        return Ok(());
-                    }
-                    if let Some(seeds) = &seeds {
-                        m.core.seed(seeds[i]);
-                    }
-                    m.core.reset()?;
-                    m.ended = false;
-                    m.core.observe(obs);
-                    game.write_values(m.core.env().board(), board);
-                    *depth = m.core.depth().map_or(-1, |d| d as i64);
-                    Ok::<_, EnvError>(())
-                })
+            let mask = match &mask {
+                Some(mask) => Some(self.checked_ref(
+                    mask.as_slice().map_err(value_error)?,
+                    1,
+                    "reset_mask",
+                )?),
+                None => None,
+            };
+            let obs = self.checked(
+                obs.as_slice_mut().map_err(value_error)?,
+                self.obs_dim,
+                "obs",
+            )?;
+            let board = self.checked(
+                board.as_slice_mut().map_err(value_error)?,
+                self.board_len,
+                "board",
+            )?;
+            let depth = self.checked(depth.as_slice_mut().map_err(value_error)?, 1, "depth")?;
+            let (obs_dim, board_len, chunk, game) =
+                (self.obs_dim, self.board_len, self.chunk, &*self.game);
+            let members = &mut self.members;
+            py.detach(|| {
+                obs.par_chunks_mut(obs_dim)
+                    .zip(board.par_chunks_mut(board_len))
+                    .zip(depth.par_iter_mut())
+                    .zip(members.par_iter_mut())
+                    .enumerate()
+                    .with_min_len(chunk)
+                    .try_for_each(|(i, (((obs, board), depth), m))| {
+                        if mask.is_some_and(|mask| !mask[i]) {
+                            return Ok(());
+                        }
+                        if let Some(seeds) = &seeds {
+                            m.core.seed(seeds[i]);
+                        }
+                        m.core.reset()?;
+                        m.ended = false;
+                        m.core.observe(obs);
+                        game.write_values(m.core.env().board(), board);
+                        *depth = m.core.depth().map_or(-1, |d| d as i64);
+                        Ok::<_, EnvError>(())
+                    })
+            })
+            .map_err(value_error)
         })
-        .map_err(value_error)
     }
 
     /// Steps every environment with its row of `actions` (num_envs × action_dim, float32) and
@@ -255,132 +261,149 @@ impl VecEnv {
         mut final_board: PyReadwriteArray2<'_, u8>,
         mut ended: PyReadwriteArray1<'_, bool>,
     ) -> PyResult<()> {
-        let actions = self.checked_ref(
-            actions.as_slice().map_err(value_error)?,
-            self.action_dim,
-            "actions",
-        )?;
-        if let Some(i) = actions.iter().position(|a| !a.is_finite()) {
-            return Err(value_error(format!(
-                "actions: entry {} of environment {} is {}, not a finite number",
-                i % self.action_dim,
-                i / self.action_dim,
-                actions[i]
-            )));
-        }
-        if self.autoreset == Autoreset::Disabled
-            && let Some(i) = self.members.iter().position(|m| m.ended)
-        {
-            return Err(value_error(format!(
-                "environment {i}'s episode has ended and autoreset is disabled: reset it first \
+        crate::guarded(|| {
+            let actions = self.checked_ref(
+                actions.as_slice().map_err(value_error)?,
+                self.action_dim,
+                "actions",
+            )?;
+            if let Some(i) = actions.iter().position(|a| !a.is_finite()) {
+                return Err(value_error(format!(
+                    "actions: entry {} of environment {} is {}, not a finite number",
+                    i % self.action_dim,
+                    i / self.action_dim,
+                    actions[i]
+                )));
+            }
+            if self.autoreset == Autoreset::Disabled
+                && let Some(i) = self.members.iter().position(|m| m.ended)
+            {
+                return Err(value_error(format!(
+                    "environment {i}'s episode has ended and autoreset is disabled: reset it first \
                  (reset(options={{\"reset_mask\": …}}))"
-            )));
-        }
-        let (obs_dim, board_len) = (self.obs_dim, self.board_len);
-        let out = Out {
-            obs: self.checked(obs.as_slice_mut().map_err(value_error)?, obs_dim, "obs")?,
-            reward: self.checked(reward.as_slice_mut().map_err(value_error)?, 1, "reward")?,
-            terminated: self.checked(
-                terminated.as_slice_mut().map_err(value_error)?,
-                1,
-                "terminated",
-            )?,
-            truncated: self.checked(
-                truncated.as_slice_mut().map_err(value_error)?,
-                1,
-                "truncated",
-            )?,
-            game_move: self.checked(game_move.as_slice_mut().map_err(value_error)?, 1, "move")?,
-            board: self.checked(
-                board.as_slice_mut().map_err(value_error)?,
-                board_len,
-                "board",
-            )?,
-            depth: self.checked(depth.as_slice_mut().map_err(value_error)?, 1, "depth")?,
-            final_obs: self.checked(
-                final_obs.as_slice_mut().map_err(value_error)?,
-                obs_dim,
-                "final_obs",
-            )?,
-            final_board: self.checked(
-                final_board.as_slice_mut().map_err(value_error)?,
-                board_len,
-                "final_board",
-            )?,
-            ended: self.checked(ended.as_slice_mut().map_err(value_error)?, 1, "ended")?,
-        };
-        let (action_dim, chunk, autoreset, game) =
-            (self.action_dim, self.chunk, self.autoreset, &*self.game);
-        let members = &mut self.members;
-        // Pieces of `chunk` environments, each stepped in a plain loop: the arrays are cut
-        // once per piece, not once per environment.
-        py.detach(|| {
-            out.obs
-                .par_chunks_mut(obs_dim * chunk)
-                .zip(actions.par_chunks(action_dim * chunk))
-                .zip(members.par_chunks_mut(chunk))
-                .zip(out.reward.par_chunks_mut(chunk))
-                .zip(out.terminated.par_chunks_mut(chunk))
-                .zip(out.truncated.par_chunks_mut(chunk))
-                .zip(out.game_move.par_chunks_mut(chunk))
-                .zip(out.board.par_chunks_mut(board_len * chunk))
-                .zip(out.depth.par_chunks_mut(chunk))
-                .zip(out.final_obs.par_chunks_mut(obs_dim * chunk))
-                .zip(out.final_board.par_chunks_mut(board_len * chunk))
-                .zip(out.ended.par_chunks_mut(chunk))
-                .try_for_each(
-                    |(
-                        (
+                )));
+            }
+            let (obs_dim, board_len) = (self.obs_dim, self.board_len);
+            let out = Out {
+                obs: self.checked(obs.as_slice_mut().map_err(value_error)?, obs_dim, "obs")?,
+                reward: self.checked(reward.as_slice_mut().map_err(value_error)?, 1, "reward")?,
+                terminated: self.checked(
+                    terminated.as_slice_mut().map_err(value_error)?,
+                    1,
+                    "terminated",
+                )?,
+                truncated: self.checked(
+                    truncated.as_slice_mut().map_err(value_error)?,
+                    1,
+                    "truncated",
+                )?,
+                game_move: self.checked(
+                    game_move.as_slice_mut().map_err(value_error)?,
+                    1,
+                    "move",
+                )?,
+                board: self.checked(
+                    board.as_slice_mut().map_err(value_error)?,
+                    board_len,
+                    "board",
+                )?,
+                depth: self.checked(depth.as_slice_mut().map_err(value_error)?, 1, "depth")?,
+                final_obs: self.checked(
+                    final_obs.as_slice_mut().map_err(value_error)?,
+                    obs_dim,
+                    "final_obs",
+                )?,
+                final_board: self.checked(
+                    final_board.as_slice_mut().map_err(value_error)?,
+                    board_len,
+                    "final_board",
+                )?,
+                ended: self.checked(ended.as_slice_mut().map_err(value_error)?, 1, "ended")?,
+            };
+            let (action_dim, chunk, autoreset, game) =
+                (self.action_dim, self.chunk, self.autoreset, &*self.game);
+            let members = &mut self.members;
+            // Pieces of `chunk` environments, each stepped in a plain loop: the arrays are cut
+            // once per piece, not once per environment.
+            py.detach(|| {
+                out.obs
+                    .par_chunks_mut(obs_dim * chunk)
+                    .zip(actions.par_chunks(action_dim * chunk))
+                    .zip(members.par_chunks_mut(chunk))
+                    .zip(out.reward.par_chunks_mut(chunk))
+                    .zip(out.terminated.par_chunks_mut(chunk))
+                    .zip(out.truncated.par_chunks_mut(chunk))
+                    .zip(out.game_move.par_chunks_mut(chunk))
+                    .zip(out.board.par_chunks_mut(board_len * chunk))
+                    .zip(out.depth.par_chunks_mut(chunk))
+                    .zip(out.final_obs.par_chunks_mut(obs_dim * chunk))
+                    .zip(out.final_board.par_chunks_mut(board_len * chunk))
+                    .zip(out.ended.par_chunks_mut(chunk))
+                    .try_for_each(
+                        |(
                             (
-                                ((((((((obs, actions), members), r), te), tr), mv), board), depth),
-                                fo,
+                                (
+                                    (
+                                        (((((((obs, actions), members), r), te), tr), mv), board),
+                                        depth,
+                                    ),
+                                    fo,
+                                ),
+                                fb,
                             ),
-                            fb,
-                        ),
-                        end,
-                    )| {
-                        for (j, m) in members.iter_mut().enumerate() {
-                            let (o, b) = (j * obs_dim, j * board_len);
-                            let s = if m.ended {
-                                m.core.reset()?;
-                                Stepped {
-                                    game_move: -1,
-                                    ..Stepped::default()
+                            end,
+                        )| {
+                            for (j, m) in members.iter_mut().enumerate() {
+                                let (o, b) = (j * obs_dim, j * board_len);
+                                let s = if m.ended {
+                                    m.core.reset()?;
+                                    Stepped {
+                                        game_move: -1,
+                                        ..Stepped::default()
+                                    }
+                                } else {
+                                    m.core
+                                        .step(&actions[j * action_dim..(j + 1) * action_dim])?
+                                };
+                                m.ended = s.terminated || s.truncated;
+                                end[j] = false;
+                                if m.ended && autoreset == Autoreset::SameStep {
+                                    m.core.observe(&mut fo[o..o + obs_dim]);
+                                    game.write_values(
+                                        m.core.env().board(),
+                                        &mut fb[b..b + board_len],
+                                    );
+                                    m.core.reset()?;
+                                    m.ended = false;
+                                    end[j] = true;
                                 }
-                            } else {
-                                m.core
-                                    .step(&actions[j * action_dim..(j + 1) * action_dim])?
-                            };
-                            m.ended = s.terminated || s.truncated;
-                            end[j] = false;
-                            if m.ended && autoreset == Autoreset::SameStep {
-                                m.core.observe(&mut fo[o..o + obs_dim]);
-                                game.write_values(m.core.env().board(), &mut fb[b..b + board_len]);
-                                m.core.reset()?;
-                                m.ended = false;
-                                end[j] = true;
+                                m.core.observe(&mut obs[o..o + obs_dim]);
+                                game.write_values(
+                                    m.core.env().board(),
+                                    &mut board[b..b + board_len],
+                                );
+                                depth[j] = m.core.depth().map_or(-1, |d| d as i64);
+                                (r[j], te[j], tr[j], mv[j]) =
+                                    (s.reward, s.terminated, s.truncated, s.game_move);
                             }
-                            m.core.observe(&mut obs[o..o + obs_dim]);
-                            game.write_values(m.core.env().board(), &mut board[b..b + board_len]);
-                            depth[j] = m.core.depth().map_or(-1, |d| d as i64);
-                            (r[j], te[j], tr[j], mv[j]) =
-                                (s.reward, s.terminated, s.truncated, s.game_move);
-                        }
-                        Ok::<_, EnvError>(())
-                    },
-                )
+                            Ok::<_, EnvError>(())
+                        },
+                    )
+            })
+            .map_err(value_error)
         })
-        .map_err(value_error)
     }
 
     /// The boards of every environment (num_envs × board values, uint8), row-major.
     fn boards<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, numpy::PyArray2<u8>>> {
-        let rows: Vec<Vec<u8>> = self
-            .members
-            .iter()
-            .map(|m| self.game.values(m.core.env().board()))
-            .collect();
-        numpy::PyArray2::from_vec2(py, &rows).map_err(value_error)
+        crate::guarded(|| {
+            let rows: Vec<Vec<u8>> = self
+                .members
+                .iter()
+                .map(|m| self.game.values(m.core.env().board()))
+                .collect();
+            numpy::PyArray2::from_vec2(py, &rows).map_err(value_error)
+        })
     }
 
     /// Environment i's top view as an RGB image (see `Env.render`).
@@ -391,11 +414,12 @@ impl VecEnv {
         index: usize,
         size: usize,
     ) -> PyResult<Bound<'py, numpy::PyArray3<u8>>> {
-        let m = self
-            .members
-            .get(index)
-            .ok_or_else(|| value_error(format!("environment {index} of {}", self.members.len())))?;
-        crate::render::image(py, m.core.env(), size)
+        crate::guarded(|| {
+            let m = self.members.get(index).ok_or_else(|| {
+                value_error(format!("environment {index} of {}", self.members.len()))
+            })?;
+            crate::render::image(py, m.core.env(), size)
+        })
     }
 }
 

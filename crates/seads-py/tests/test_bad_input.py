@@ -118,3 +118,16 @@ def test_a_negative_or_too_large_move_is_a_value_error():
     for mv in (-1, 12, 10**6):
         with pytest.raises(ValueError, match=f"move {mv}: the game has moves 0 to 11"):
             game.apply(game.goal(), mv)
+
+
+def test_a_panic_of_ours_is_a_runtime_error_that_except_exception_catches():
+    """A defect in the Rust half never reaches Python as pyo3's ``PanicException``, a
+    ``BaseException`` that ``except Exception`` misses (issue 82): every fallible call guards
+    its body (the tidy test ``every_fallible_python_method_guards_its_body`` lists them)."""
+    try:
+        seads._seads._panic("a defect")
+    except Exception as e:  # noqa: BLE001 -- the point: an ordinary exception
+        assert isinstance(e, RuntimeError), type(e)
+        assert "a defect" in str(e)
+    else:
+        raise AssertionError("no exception")

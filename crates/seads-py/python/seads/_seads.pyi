@@ -19,6 +19,7 @@ __all__ = [
     "Game",
     "Agent",
     "plan",
+    "_panic",
 ]
 
 _Board = Sequence[int] | npt.ArrayLike
@@ -33,6 +34,10 @@ def env_titles() -> dict[str, str]:
 
 def game_names() -> list[str]:
     """The names of the registered games (``lightsout``, ``tileswap``, ``sliding``)."""
+
+def _panic(message: str) -> None:
+    """For the tests only: panics with ``message`` inside a guarded call; it arrives as a
+    ``RuntimeError``."""
 
 @final
 class Env:
