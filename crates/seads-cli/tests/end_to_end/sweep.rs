@@ -247,6 +247,9 @@ fn a_sweep_is_planned_once_run_to_the_end_and_reported() {
         "coverage-lightsout-cursor.png",
         "coverage-lightsout-cursor.svg",
         "success-lightsout-cursor.png",
+        "intervals.csv",
+        "profile-lightsout-cursor.png",
+        "profile-lightsout-cursor.svg",
     ] {
         assert!(report.join(f).is_file(), "report has {f}");
     }

@@ -171,6 +171,85 @@ pub fn coverage_figures(
     Ok(written)
 }
 
+/// The run score distribution of final skill coverage per environment (a performance profile,
+/// Agarwal et al. 2021): for each threshold τ from 0 to K, the share of a variant's runs whose
+/// final coverage exceeds τ, a step line per variant; returns the files written.
+pub fn profile_figures(
+    out: &Path,
+    groups: &[Group<'_>],
+    k_of: &dyn Fn(&Group<'_>) -> usize,
+) -> Result<Vec<PathBuf>> {
+    let mut written = Vec::new();
+    for env in envs(groups) {
+        let mut k = 1;
+        let mut profiles = Vec::new();
+        for g in groups.iter().filter(|g| g.env == env) {
+            let finals: Vec<f64> = g.runs.iter().filter_map(|r| r.final_coverage()).collect();
+            if finals.is_empty() {
+                continue;
+            }
+            k = k.max(k_of(g));
+            profiles.push((format!("{} (n = {})", g.variant, finals.len()), finals));
+        }
+        if profiles.is_empty() {
+            continue;
+        }
+        let x_max = k as f64;
+        let title = format!("Run score distribution: {env}");
+        written.extend(png_and_svg(
+            out,
+            &format!("profile-{env}"),
+            &|p: &Path| -> Result<()> {
+                render_to!(p, (900, 520), |area: &DrawingArea<_, Shift>| {
+                    let mut chart = ChartBuilder::on(area)
+                        .caption(&title, ("sans-serif", 20))
+                        .margin(12)
+                        .x_label_area_size(45)
+                        .y_label_area_size(60)
+                        .build_cartesian_2d(0.0..x_max, 0.0..1.05)
+                        .map_err(plot_err)?;
+                    chart
+                        .configure_mesh()
+                        .x_desc("final skill coverage τ (distinct moves)")
+                        .y_desc("share of runs with coverage > τ")
+                        .draw()
+                        .map_err(plot_err)?;
+                    for (i, (name, finals)) in profiles.iter().enumerate() {
+                        let colour = skill_colour(i);
+                        // A step at each run's value: the share holds until τ reaches it.
+                        let mut steps: Vec<f64> = finals.clone();
+                        steps.sort_by(f64::total_cmp);
+                        let mut points = vec![(0.0, super::intervals::share_above(finals, 0.0))];
+                        for &v in &steps {
+                            let before = points.last().map_or(1.0, |p| p.1);
+                            points.push((v, before));
+                            points.push((v, super::intervals::share_above(finals, v)));
+                        }
+                        let last = points.last().map_or(0.0, |p| p.1);
+                        points.push((x_max, last));
+                        chart
+                            .draw_series(LineSeries::new(points, colour.stroke_width(2)))
+                            .map_err(plot_err)?
+                            .label(name.as_str())
+                            .legend(move |(x, y)| {
+                                PathElement::new(vec![(x, y), (x + 20, y)], colour.stroke_width(2))
+                            });
+                    }
+                    chart
+                        .configure_series_labels()
+                        .position(SeriesLabelPosition::LowerLeft)
+                        .border_style(BLACK)
+                        .background_style(WHITE.mix(0.9))
+                        .draw()
+                        .map_err(plot_err)?;
+                    Ok::<(), StudyError>(())
+                })
+            },
+        )?);
+    }
+    Ok(written)
+}
+
 /// A run's task success over training as (epoch, env steps, % solved): a baseline evaluates its
 /// policy as it trains (`metrics.jsonl`); a SEADS run has what `seads evaluate --checkpoints`
 /// added (with re-planning, depths pooled). Empty for a run not evaluated over training.

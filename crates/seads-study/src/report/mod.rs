@@ -1,5 +1,6 @@
 //! Reports over any set of sweeps and runs: the paper's Table 1 with its Mann–Whitney tests,
-//! task success and lengths, failed tasks and the skills that deviated from the model's
+//! interval estimates over runs (IQM, bootstrap confidence intervals, probability of
+//! improvement, performance profiles), task success and lengths, failed tasks and the skills that deviated from the model's
 //! predictions (each failed task's wrong moves too), where the training time went, coverage and
 //! success curves and length box plots, written to `report.md`, CSV files and PNG + SVG figures
 //! by [`write_report`].
@@ -9,6 +10,7 @@ mod deep;
 mod failed_tasks;
 mod failures;
 mod figures;
+pub mod intervals;
 mod paper;
 mod runs;
 pub mod stats;
@@ -98,6 +100,10 @@ pub fn write_report(options: &ReportOptions, out: &Path) -> Result<ReportSummary
     if let Some((_, csv)) = &over_training {
         write("coverage-over-training.csv", csv)?;
     }
+    let intervals = tables::interval_tables(&groups, reference.as_deref());
+    if let Some((_, csv)) = &intervals {
+        write("intervals.csv", csv)?;
+    }
     let (success_md, success_csv) = tables::success_tables(&groups);
     write("success.csv", &success_csv)?;
     let noise = tables::noise_tables(&groups);
@@ -132,6 +138,7 @@ pub fn write_report(options: &ReportOptions, out: &Path) -> Result<ReportSummary
     }
     let k_of = |g: &runs::Group<'_>| tables::skills(g.runs[0]);
     let mut figures = figures::coverage_figures(out, &groups, &k_of)?;
+    figures.extend(figures::profile_figures(out, &groups, &k_of)?);
     figures.extend(figures::success_figures(out, &groups)?);
     figures.extend(figures::length_figures(out, &groups)?);
 
@@ -206,6 +213,15 @@ pub fn write_report(options: &ReportOptions, out: &Path) -> Result<ReportSummary
         let _ = writeln!(md, "## Against the paper's Table 1\n");
         md += paper_md;
         let _ = writeln!(md, "\nAs CSV: `paper.csv`.\n");
+    }
+    if let Some((intervals_md, _)) = &intervals {
+        let _ = writeln!(md, "## Interval estimates over runs\n");
+        md += intervals_md;
+        let _ = writeln!(
+            md,
+            "\nAs CSV: `intervals.csv`; the run score distributions (performance profiles) of \
+             coverage are the figures `profile-<environment>`.\n"
+        );
     }
     if let Some((curve_md, _)) = &over_training {
         let _ = writeln!(md, "## Skill coverage over training\n");
