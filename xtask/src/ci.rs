@@ -146,10 +146,15 @@ fn pytest(python: &str, extra: &[&str], totals: &mut Totals) -> Result<()> {
         .chain(["crates/seads-py/tests"])
         .collect();
     eprintln!("xtask: $ {python} -m pytest {}", shown.join(" "));
+    // The binary the Rust tests built, for the tests that train a run with it (`SEADS_BIN`
+    // switches them on).
+    let target = std::env::var_os("CARGO_TARGET_DIR")
+        .map_or_else(|| root().join("target"), std::path::PathBuf::from);
     let output = Command::new(python)
         .args(["-m", "pytest", "-q", "-p", "no:cacheprovider"])
         .args(extra)
         .arg("crates/seads-py/tests")
+        .env("SEADS_BIN", target.join("debug").join("seads"))
         .current_dir(root())
         .output()
         .context("could not start pytest")?;

@@ -9,7 +9,8 @@
 //!   `configs/`; validated on load.
 //! - [`store`]: the run directory: atomic writes, JSON Lines, `metrics.jsonl`, checkpoints'
 //!   names, order and metadata, and the run's one writer ([`store::RunLock`]).
-//! - [`Metrics`], [`TaskMetrics`]: the lines of `metrics.jsonl` of SEADS and of the baselines.
+//! - [`Metrics`], [`TaskMetrics`]: the lines of `metrics.jsonl` of SEADS and of the baselines;
+//!   [`tensorboard`]: the same lines as TensorBoard events beside them.
 //! - [`PopulationKey`]: which runs can train in one population.
 //! - [`fitted`]: a forward model fitted afterwards to a run's frozen skills, and its record.
 //!
@@ -31,6 +32,7 @@ mod sac;
 mod sections;
 mod skill_model;
 pub mod store;
+pub mod tensorboard;
 
 pub use config::{
     TrainConfig, config_difference, learner_names, machine_memory_bytes, merge_toml, preset_layers,

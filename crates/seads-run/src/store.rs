@@ -550,9 +550,11 @@ pub fn read_json_lines<T: DeserializeOwned>(path: &Path) -> Result<(Vec<T>, bool
     Ok((lines, torn))
 }
 
-/// Appends one line to `dir/metrics.jsonl` and fsyncs it.
+/// Appends one line to `dir/metrics.jsonl` and fsyncs it, then its event to the TensorBoard
+/// view of the metrics ([`crate::tensorboard`]).
 pub fn append_metrics<M: MetricsLine>(dir: &Path, metrics: &M) -> Result<(), RunError> {
-    append_json_line(&dir.join(METRICS), metrics)
+    append_json_line(&dir.join(METRICS), metrics)?;
+    crate::tensorboard::append_event(dir, metrics)
 }
 
 /// Appends `value` as one JSON line to `path` (created if missing) and fsyncs it. A torn last
@@ -576,7 +578,8 @@ pub fn append_json_line<T: Serialize>(path: &Path, value: &T) -> Result<(), RunE
         .map_err(|e| RunError::io(path, e))
 }
 
-/// Rewrites `dir/metrics.jsonl` with exactly `metrics`.
+/// Rewrites `dir/metrics.jsonl` with exactly `metrics`, and the TensorBoard view of them
+/// ([`crate::tensorboard`]).
 pub fn write_metrics<M: MetricsLine>(dir: &Path, metrics: &[M]) -> Result<(), RunError> {
     let path = dir.join(METRICS);
     let mut text = String::new();
@@ -584,7 +587,8 @@ pub fn write_metrics<M: MetricsLine>(dir: &Path, metrics: &[M]) -> Result<(), Ru
         text += &serde_json::to_string(m).map_err(|e| RunError::io(&path, e))?;
         text.push('\n');
     }
-    write_atomic(&path, text.as_bytes())
+    write_atomic(&path, text.as_bytes())?;
+    crate::tensorboard::write_events(dir, metrics)
 }
 
 /// Raises the budget of the run in `dir` to `env_steps` environment steps and records it in its
