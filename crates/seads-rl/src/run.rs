@@ -235,7 +235,7 @@ impl<L: Learner> Run<L> {
             write_metrics(dir, &metrics)?;
         } else {
             // The TensorBoard view follows the metrics kept, whatever a crash left of it.
-            seads_run::tensorboard::write_events(dir, &metrics)?;
+            seads_run::store::write_events(dir, &metrics)?;
         }
         let wall_before = metrics.last().map_or(0.0, |m| m.wall_s());
         Ok(Self::new(dir, trainer, wall_before, repairs))

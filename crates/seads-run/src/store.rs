@@ -554,7 +554,24 @@ pub fn read_json_lines<T: DeserializeOwned>(path: &Path) -> Result<(Vec<T>, bool
 /// view of the metrics ([`crate::tensorboard`]).
 pub fn append_metrics<M: MetricsLine>(dir: &Path, metrics: &M) -> Result<(), RunError> {
     append_json_line(&dir.join(METRICS), metrics)?;
-    crate::tensorboard::append_event(dir, metrics)
+    let path = dir.join(crate::tensorboard::EVENTS);
+    let bytes =
+        crate::tensorboard::event(metrics, !path.exists()).map_err(|e| RunError::io(&path, e))?;
+    let mut file = fs::OpenOptions::new()
+        .create(true)
+        .append(true)
+        .open(&path)
+        .map_err(|e| RunError::io(&path, e))?;
+    file.write_all(&bytes)
+        .and_then(|()| file.sync_data())
+        .map_err(|e| RunError::io(&path, e))
+}
+
+/// Writes `dir`'s TensorBoard event file anew with the events of exactly `metrics` (atomically).
+pub fn write_events<M: MetricsLine>(dir: &Path, metrics: &[M]) -> Result<(), RunError> {
+    let path = dir.join(crate::tensorboard::EVENTS);
+    let bytes = crate::tensorboard::events(metrics).map_err(|e| RunError::io(&path, e))?;
+    write_atomic(&path, &bytes)
 }
 
 /// Appends `value` as one JSON line to `path` (created if missing) and fsyncs it. A torn last
@@ -588,7 +605,7 @@ pub fn write_metrics<M: MetricsLine>(dir: &Path, metrics: &[M]) -> Result<(), Ru
         text.push('\n');
     }
     write_atomic(&path, text.as_bytes())?;
-    crate::tensorboard::write_events(dir, metrics)
+    write_events(dir, metrics)
 }
 
 /// Raises the budget of the run in `dir` to `env_steps` environment steps and records it in its

@@ -3,6 +3,9 @@
 //! that `tensorboard --logdir <sweep>` shows every run of a sweep, named by its directory
 //! (environment, variant, seed).
 //!
+//! This module makes the bytes; the store writes them ([`crate::store::append_metrics`],
+//! [`crate::store::write_metrics`], [`crate::store::write_events`]).
+//!
 //! The file is TensorFlow's record format: per record its length (u64, little-endian), the
 //! masked CRC-32C of those 8 bytes, the bytes of an `Event` protocol buffer, and their masked
 //! CRC-32C. The first event names the format (`file_version`), each later one holds a
@@ -13,13 +16,7 @@
 //! their table's name (`timings/collect`); the step is its `env_steps`, the event's wall time
 //! its `wall_s`, the seconds since the run started (TensorBoard's relative time).
 
-use std::fs;
-use std::io::Write as _;
-use std::path::Path;
-
 use serde::Serialize;
-
-use crate::RunError;
 
 /// The event file of a run directory (TensorBoard reads files whose name holds `tfevents`).
 pub const EVENTS: &str = "events.out.tfevents.seads";
@@ -114,8 +111,8 @@ fn scalars(prefix: &str, value: &serde_json::Value, out: &mut Vec<SummaryValue>)
 }
 
 /// The record of one metrics line.
-fn line_record<M: Serialize>(line: &M, path: &Path) -> Result<Vec<u8>, RunError> {
-    let json = serde_json::to_value(line).map_err(|e| RunError::io(path, e))?;
+fn line_record<M: Serialize>(line: &M) -> Result<Vec<u8>, serde_json::Error> {
+    let json = serde_json::to_value(line)?;
     let mut value = Vec::new();
     scalars("", &json, &mut value);
     let step = json["env_steps"].as_u64().unwrap_or(0);
@@ -128,33 +125,21 @@ fn line_record<M: Serialize>(line: &M, path: &Path) -> Result<Vec<u8>, RunError>
     Ok(record(&prost::Message::encode_to_vec(&event)))
 }
 
-/// Appends the event of one metrics line to `dir`'s event file (started with its header if
-/// missing) and fsyncs it.
-pub fn append_event<M: Serialize>(dir: &Path, line: &M) -> Result<(), RunError> {
-    let path = dir.join(EVENTS);
-    let mut bytes = Vec::new();
-    if !path.exists() {
-        bytes = header();
-    }
-    bytes.extend(line_record(line, &path)?);
-    let mut file = fs::OpenOptions::new()
-        .create(true)
-        .append(true)
-        .open(&path)
-        .map_err(|e| RunError::io(&path, e))?;
-    file.write_all(&bytes)
-        .and_then(|()| file.sync_data())
-        .map_err(|e| RunError::io(&path, e))
+/// The bytes to append to a run's event file for one metrics line: its event, after the
+/// file's opening record where the file is `new`.
+pub fn event<M: Serialize>(line: &M, new: bool) -> Result<Vec<u8>, serde_json::Error> {
+    let mut bytes = if new { header() } else { Vec::new() };
+    bytes.extend(line_record(line)?);
+    Ok(bytes)
 }
 
-/// Writes `dir`'s event file anew with the events of exactly `lines` (atomically).
-pub fn write_events<M: Serialize>(dir: &Path, lines: &[M]) -> Result<(), RunError> {
-    let path = dir.join(EVENTS);
+/// A whole event file holding the events of exactly `lines`.
+pub fn events<M: Serialize>(lines: &[M]) -> Result<Vec<u8>, serde_json::Error> {
     let mut bytes = header();
     for line in lines {
-        bytes.extend(line_record(line, &path)?);
+        bytes.extend(line_record(line)?);
     }
-    crate::store::write_atomic(&path, &bytes)
+    Ok(bytes)
 }
 
 #[cfg(test)]
