@@ -102,7 +102,7 @@ fn row(
         });
     match reference_means.and_then(|r| worse_than(&means, &r)) {
         Some(t) => {
-            let text = format!("U = {}, p = {:.4}, exact {:.4}", t.u, t.p, t.p_exact);
+            let text = t.shown();
             if t.significant() {
                 let _ = writeln!(md, " **{text}** |");
             } else {

@@ -96,6 +96,21 @@ impl Test {
     pub fn can_be_significant(&self) -> bool {
         self.min_p < ALPHA
     }
+
+    /// The test in words for a table: U, SciPy's p and the exact p; but where SciPy's normal
+    /// approximation (taken for ties) gives a p below the smallest that the run counts allow
+    /// ([`Test::min_p`]: 0.05 for 3 against 3), only the exact p, since no split of the runs is
+    /// that unlikely.
+    pub fn shown(&self) -> String {
+        if self.p < self.min_p {
+            format!("U = {}, exact p = {:.4}", self.u, self.p_exact)
+        } else {
+            format!(
+                "U = {}, p = {:.4}, exact {:.4}",
+                self.u, self.p, self.p_exact
+            )
+        }
+    }
 }
 
 /// Cohen's d of a variant against the reference: the reference's mean minus the variant's, over
@@ -267,6 +282,22 @@ mod tests {
         assert!(!t.significant());
         assert!(worse_than(&[], &[1.0]).is_none());
         assert!(worse_than(&[f64::NAN], &[1.0]).is_none());
+    }
+
+    /// Three runs all below three tied ones: SciPy's normal approximation (ties) gives a p
+    /// below 1 / C(6, 3) = 0.05, which no split of six runs reaches; the table shows only the
+    /// exact p, 0.05 (issue 79). Where SciPy's p is reachable, both are shown.
+    #[test]
+    fn an_unreachable_p_is_never_shown() {
+        let t = worse_than(&[20.9, 21.55, 22.7], &[24.8, 24.95, 24.95]).unwrap();
+        assert!(t.p < t.min_p, "{t:?}");
+        assert!((t.p_exact - 0.05).abs() < 1e-12, "{t:?}");
+        assert_eq!(t.shown(), "U = 0, exact p = 0.0500");
+        let t = worse_than(&[1.0, 2.0, 3.0, 4.0, 5.0], &[6.0, 7.0, 8.0, 9.0, 10.0]).unwrap();
+        assert_eq!(
+            t.shown(),
+            format!("U = 0, p = {:.4}, exact {:.4}", t.p, t.p_exact)
+        );
     }
 
     #[test]

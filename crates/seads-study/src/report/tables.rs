@@ -105,10 +105,7 @@ pub fn coverage_markdown(cells: &[CoverageCell], reference: Option<&str>) -> Str
                     };
                     let test = c.test.map_or(String::new(), |t| {
                         let out_of_reach = if t.can_be_significant() { "" } else { " †" };
-                        format!(
-                            "; U = {}, p = {:.4}, exact {:.4}{out_of_reach}",
-                            t.u, t.p, t.p_exact
-                        )
+                        format!("; {}{out_of_reach}", t.shown())
                     });
                     let _ = write!(md, " {value} (n = {}{test}) |", c.summary.n);
                 }
@@ -122,7 +119,8 @@ pub fn coverage_markdown(cells: &[CoverageCell], reference: Option<&str>) -> Str
          moves of the K skills, mean over 20 test initialisations). U and p: one-sided Mann–Whitney U \
          test that the variant is worse than `{}` (SciPy's `mannwhitneyu(variant, reference, \
          alternative=\"less\")`: exact without ties for up to 8 values, tie-corrected normal otherwise), \
-         and its exact permutation p with ties kept (SciPy's `permutation_test`); **bold**: both p < 0.01. \
+         and its exact permutation p with ties kept (SciPy's `permutation_test`; alone where SciPy's \
+         normal approximation falls below the smallest p the run counts allow); **bold**: both p < 0.01. \
          †: p < 0.01 is out of reach with so few runs, whatever they give: the smallest exact p of n₁ \
          runs against n₂ is 1 / C(n₁ + n₂, n₁) (3 against 3: 0.05; 5 against 5: 0.004); compare \
          effect sizes instead (Cliff's δ and Cohen's d in `table1.csv`; beside the paper's below, \
@@ -505,14 +503,8 @@ pub fn success_comparison(groups: &[Group<'_>], reference: Option<&str>) -> Opti
             .and_then(|o| worse_than(&v, &values(o).0));
         let value = format!("{:.1} ± {:.1} %", 100.0 * s.mean, 100.0 * s.std);
         let (value, test) = match test {
-            Some(t) if t.significant() => (
-                format!("**{value}**"),
-                format!("U = {}, p = {:.4}, exact {:.4}", t.u, t.p, t.p_exact),
-            ),
-            Some(t) => (
-                value,
-                format!("U = {}, p = {:.4}, exact {:.4}", t.u, t.p, t.p_exact),
-            ),
+            Some(t) if t.significant() => (format!("**{value}**"), t.shown()),
+            Some(t) => (value, t.shown()),
             None => (value, String::from("–")),
         };
         let _ = writeln!(
