@@ -527,10 +527,17 @@ pub fn success_comparison(groups: &[Group<'_>], reference: Option<&str>) -> Opti
     Some(md)
 }
 
-/// The metrics the interval estimates are given for: each run's final skill coverage, and its
-/// share of all test tasks solved at the end of training (SEADS with re-planning, a baseline's
-/// policy acting alone, as [`success_comparison`] compares them).
-fn interval_metrics(g: &Group<'_>) -> [(&'static str, Vec<f64>); 2] {
+/// The metrics the interval estimates are given for: each run's final skill coverage, its share
+/// of all test tasks solved at the end of training (SEADS with re-planning, a baseline's policy
+/// acting alone, as [`success_comparison`] compares them), and the same with re-planning by a
+/// forward model fitted to its frozen skills (`seads fit-model`).
+fn interval_metrics(g: &Group<'_>) -> [(&'static str, Vec<f64>); 3] {
+    let pooled = |results: &Vec<DepthResult>| {
+        let (solved, tasks) = results
+            .iter()
+            .fold((0, 0), |(s, t), d| (s + d.solved, t + d.tasks));
+        solved as f64 / tasks.max(1) as f64
+    };
     [
         (
             "coverage",
@@ -541,6 +548,13 @@ fn interval_metrics(g: &Group<'_>) -> [(&'static str, Vec<f64>); 2] {
             g.runs
                 .iter()
                 .filter_map(|r| pooled_success(r).map(|p| p.1))
+                .collect(),
+        ),
+        (
+            "success, fitted model",
+            g.runs
+                .iter()
+                .filter_map(|r| fitted(r, Mode::Replan).map(|(e, _)| pooled(e)))
                 .collect(),
         ),
     ]
@@ -576,10 +590,10 @@ pub fn interval_tables(groups: &[Group<'_>], reference: Option<&str>) -> Option<
             };
             any = true;
             // Success in percent, coverage in moves.
-            let (scale, digits) = if metric == "success" {
-                (100.0, 1)
-            } else {
+            let (scale, digits) = if metric == "coverage" {
                 (1.0, 2)
+            } else {
+                (100.0, 1)
             };
             let scaled = |i: super::intervals::Interval| super::intervals::Interval {
                 estimate: scale * i.estimate,
@@ -588,8 +602,10 @@ pub fn interval_tables(groups: &[Group<'_>], reference: Option<&str>) -> Option<
             };
             let improvement = reference_group
                 .map(|o| {
-                    let [coverage, success] = interval_metrics(o);
-                    if i == 0 { coverage.1 } else { success.1 }
+                    interval_metrics(o)
+                        .into_iter()
+                        .nth(i)
+                        .map_or_else(Vec::new, |m| m.1)
                 })
                 .and_then(|r| improvement_interval(&values, &r, &key("improvement")));
             let _ = writeln!(
@@ -597,7 +613,7 @@ pub fn interval_tables(groups: &[Group<'_>], reference: Option<&str>) -> Option<
                 "| {} | {} | {metric}{} | {} | {} | {} | {} |",
                 g.env,
                 g.variant,
-                if metric == "success" { " (%)" } else { "" },
+                if metric == "coverage" { "" } else { " (%)" },
                 values.len(),
                 scaled(q).show(digits),
                 scaled(m).show(digits),
@@ -606,9 +622,10 @@ pub fn interval_tables(groups: &[Group<'_>], reference: Option<&str>) -> Option<
             let number = |v: Option<f64>| v.map_or(String::new(), |v| format!("{v:.6}"));
             let _ = writeln!(
                 csv,
-                "{},{},{metric},{},{},{},{},{},{},{},{},{},{}",
+                "{},{},{},{},{},{},{},{},{},{},{},{},{}",
                 csv_field(&g.env),
                 csv_field(&g.variant),
+                csv_field(metric),
                 values.len(),
                 number(Some(q.estimate)),
                 number(Some(q.low)),
@@ -625,7 +642,8 @@ pub fn interval_tables(groups: &[Group<'_>], reference: Option<&str>) -> Option<
     let _ = write!(
         md,
         "\nA run is the unit: its final skill coverage (distinct moves), and its share of all test \
-         tasks solved at the end of training (SEADS with re-planning, a baseline's policy alone). \
+         tasks solved at the end of training (SEADS with re-planning, a baseline's policy alone; \
+         with a fitted model: re-planning with SEADS's forward model fitted to the frozen skills). \
          IQM: the mean of the middle half of the runs (a quarter cut from each end, as rliable \
          computes it). Intervals: percentile bootstrap over the runs, {} resamples, seeded, so a \
          report repeats exactly; with 3 or 5 runs they are wide and coarse. P(run > reference \
