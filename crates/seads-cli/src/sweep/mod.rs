@@ -26,9 +26,9 @@ pub enum SweepCommand {
     /// variant × seed, each with its full config.toml, plus the sweep's index. Planning the same
     /// manifest again changes nothing.
     Plan(PlanArgs),
-    /// Train and evaluate every run of a sweep that is not done, on this machine: new runs
-    /// start, killed ones resume, failed ones are tried again. Stop it at any time; running it
-    /// again loses nothing.
+    /// Train and evaluate every run of a sweep that is not done, on this machine: killed runs
+    /// resume (those already begun before any new one starts), new runs start, failed ones are
+    /// tried again. Stop it at any time; running it again loses nothing.
     Run(RunArgs),
     /// Train and evaluate one run of a sweep (what each Slurm array task runs); resumes a run
     /// that a killed or re-queued task left.

@@ -71,6 +71,10 @@ pub fn run_sweep(
             }
         }
     }
+    // Runs already begun resume before new ones start (a restarted sweep finishes what it had
+    // begun first).
+    let run_dirs: Vec<_> = sweep.runs.iter().map(|r| dir.join(&r.dir)).collect();
+    let todo = seads_study::sweep::begun_first(&run_dirs, &todo);
     let listed = todo.len();
     let todo: Vec<Vec<usize>> = match population {
         Some(k) => seads_study::sweep::populations(dir, &sweep, &todo, k)?,

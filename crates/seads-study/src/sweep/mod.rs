@@ -18,7 +18,7 @@ pub use manifest::{EvaluationPlan, Manifest, PlannedRun};
 pub use overview::{Overview, RunStatus};
 pub use population::populations;
 pub use state::{
-    Claim, LOG, Missing, Outcome, PATIENCE, RECORD, Record, Status, TAKEN_EXIT, check_outputs,
-    damage, is_claimed, status,
+    Claim, LOG, Missing, Outcome, PATIENCE, RECORD, Record, Status, TAKEN_EXIT, begun_first,
+    check_outputs, damage, is_claimed, status,
 };
 pub use task::{Task, Work};

@@ -341,9 +341,43 @@ pub fn damage(run: &Path) -> Option<String> {
     }
 }
 
+/// `todo` (runs of the sweep in `dir` to train, in their order) with the runs already begun
+/// (environment steps in their metrics) first, each part in its order, so that a restarted
+/// sweep finishes what it had begun before it starts anything new. A run whose metrics cannot
+/// be read counts as not begun.
+pub fn begun_first(run_dirs: &[std::path::PathBuf], todo: &[usize]) -> Vec<usize> {
+    let begun = |i: usize| {
+        run_dirs
+            .get(i)
+            .and_then(|run| seads_run::store::last_env_steps(run).ok())
+            .is_some_and(|steps| steps > 0)
+    };
+    let (first, rest): (Vec<usize>, Vec<usize>) = todo.iter().partition(|&&i| begun(i));
+    first.into_iter().chain(rest).collect()
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// Of four runs to train, the two with steps in their metrics come first, each part in its
+    /// order; a run without metrics, or with only its first line at step 0, is not begun.
+    #[test]
+    fn begun_runs_come_before_new_ones() {
+        let dir = tempfile::tempdir().unwrap();
+        let runs: Vec<std::path::PathBuf> =
+            (0..5).map(|i| dir.path().join(format!("r{i}"))).collect();
+        for run in &runs {
+            std::fs::create_dir(run).unwrap();
+        }
+        let line = |steps: u64| format!("{{\"epoch\":1,\"env_steps\":{steps},\"wall_s\":0.1}}\n");
+        std::fs::write(runs[1].join("metrics.jsonl"), line(0)).unwrap();
+        std::fs::write(runs[2].join("metrics.jsonl"), line(0) + &line(4200)).unwrap();
+        std::fs::write(runs[4].join("metrics.jsonl"), line(137)).unwrap();
+        assert_eq!(begun_first(&runs, &[0, 1, 2, 3, 4]), [2, 4, 0, 1, 3]);
+        assert_eq!(begun_first(&runs, &[4, 3, 0]), [4, 3, 0]);
+        assert_eq!(begun_first(&runs, &[]), Vec::<usize>::new());
+    }
 
     #[test]
     fn a_claim_shows_as_running_and_excludes_a_second_task() {
