@@ -945,20 +945,7 @@ fn methods_in_block(file: &str, head: &str) -> Vec<String> {
         .unwrap_or_else(|| panic!("{file} has no {head:?}"));
     let body = &code[start..];
     let open = body.find('{').unwrap();
-    let mut depth = 0;
-    let mut end = open;
-    for (i, c) in body[open..].char_indices() {
-        match c {
-            '{' => depth += 1,
-            '}' => depth -= 1,
-            _ => {}
-        }
-        if depth == 0 {
-            end = open + i;
-            break;
-        }
-    }
-    let block = &body[open..end];
+    let block = &body[open..closing_brace(body, open)];
     let words: Vec<&str> = words(block).collect();
     words
         .windows(2)
