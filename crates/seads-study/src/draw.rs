@@ -12,6 +12,36 @@ use seads_embodiment::{FieldView, Scene, Shape, SkillRun};
 /// A chart in board coordinates.
 pub type BoardChart<'a, DB> = ChartContext<'a, DB, Cartesian2d<RangedCoordf64, RangedCoordf64>>;
 
+/// Draws `line` into `chart` with a legend entry `name`: a short stroke of `colour`, the line's
+/// colour.
+pub fn labelled_line<'a, DB: DrawingBackend + 'a>(
+    chart: &mut BoardChart<'a, DB>,
+    line: LineSeries<DB, (f64, f64)>,
+    name: &str,
+    colour: RGBColor,
+) -> Result<()> {
+    chart
+        .draw_series(line)
+        .map_err(plot_err)?
+        .label(name)
+        .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], colour.stroke_width(2)));
+    Ok(())
+}
+
+/// The legend of `chart`'s labelled series at `position`, framed on a light background.
+pub fn framed_legend<'a, DB: DrawingBackend + 'a>(
+    chart: &mut BoardChart<'a, DB>,
+    position: SeriesLabelPosition,
+) -> Result<()> {
+    chart
+        .configure_series_labels()
+        .position(position)
+        .border_style(BLACK)
+        .background_style(WHITE.mix(0.9))
+        .draw()
+        .map_err(plot_err)
+}
+
 /// Registers DejaVu Sans as plotters' "sans-serif" (once per process).
 pub fn register_font() {
     static ONCE: Once = Once::new();

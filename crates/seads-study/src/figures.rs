@@ -10,7 +10,9 @@ use seads_embodiment::{Environment, SkillPolicy, SkillRun, execute_skill};
 use seads_planner::DepthResult;
 use seads_run::COVERAGE_SEED;
 
-use crate::draw::{draw_paths, draw_scene, plot_err, render_to, skill_colour};
+use crate::draw::{
+    draw_paths, draw_scene, framed_legend, labelled_line, plot_err, render_to, skill_colour,
+};
 use crate::{Result, StudyError};
 
 /// The trajectories and push points of every skill, executed in `env` from the 20 coverage
@@ -157,21 +159,14 @@ pub fn success_figure(
                 .iter()
                 .map(|r| (r.depth as f64 + dx, 100.0 * r.success_rate()))
                 .collect();
-            chart
-                .draw_series(LineSeries::new(points, colour.stroke_width(2)).point_size(4))
-                .map_err(plot_err)?
-                .label(label)
-                .legend(move |(x, y)| {
-                    PathElement::new(vec![(x, y), (x + 20, y)], colour.stroke_width(2))
-                });
+            labelled_line(
+                &mut chart,
+                LineSeries::new(points, colour.stroke_width(2)).point_size(4),
+                label,
+                colour,
+            )?;
         }
-        chart
-            .configure_series_labels()
-            .position(SeriesLabelPosition::LowerLeft)
-            .border_style(BLACK)
-            .background_style(WHITE.mix(0.9))
-            .draw()
-            .map_err(plot_err)?;
+        framed_legend(&mut chart, SeriesLabelPosition::LowerLeft)?;
         Ok::<(), StudyError>(())
     })
 }

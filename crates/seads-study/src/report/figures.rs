@@ -10,7 +10,7 @@ use plotters::coord::Shift;
 use plotters::prelude::*;
 
 use super::runs::{Group, RunData};
-use crate::draw::{plot_err, png_and_svg, render_to, skill_colour};
+use crate::draw::{framed_legend, labelled_line, plot_err, png_and_svg, render_to, skill_colour};
 
 /// A curve: x, mean, min, max.
 type Band = Vec<(f64, f64, f64, f64)>;
@@ -104,24 +104,14 @@ fn band_figure(
                     colour.mix(0.18).filled(),
                 )))
                 .map_err(plot_err)?;
-            chart
-                .draw_series(LineSeries::new(
-                    band.iter().map(|p| (p.0, p.1)),
-                    colour.stroke_width(2),
-                ))
-                .map_err(plot_err)?
-                .label(name.as_str())
-                .legend(move |(x, y)| {
-                    PathElement::new(vec![(x, y), (x + 20, y)], colour.stroke_width(2))
-                });
+            labelled_line(
+                &mut chart,
+                LineSeries::new(band.iter().map(|p| (p.0, p.1)), colour.stroke_width(2)),
+                name,
+                colour,
+            )?;
         }
-        chart
-            .configure_series_labels()
-            .position(legend_corner(curves, x_max, y_max))
-            .border_style(BLACK)
-            .background_style(WHITE.mix(0.9))
-            .draw()
-            .map_err(plot_err)?;
+        framed_legend(&mut chart, legend_corner(curves, x_max, y_max))?;
         Ok::<(), StudyError>(())
     })
 }
@@ -227,21 +217,14 @@ pub fn profile_figures(
                         }
                         let last = points.last().map_or(0.0, |p| p.1);
                         points.push((x_max, last));
-                        chart
-                            .draw_series(LineSeries::new(points, colour.stroke_width(2)))
-                            .map_err(plot_err)?
-                            .label(name.as_str())
-                            .legend(move |(x, y)| {
-                                PathElement::new(vec![(x, y), (x + 20, y)], colour.stroke_width(2))
-                            });
+                        labelled_line(
+                            &mut chart,
+                            LineSeries::new(points, colour.stroke_width(2)),
+                            name,
+                            colour,
+                        )?;
                     }
-                    chart
-                        .configure_series_labels()
-                        .position(SeriesLabelPosition::LowerLeft)
-                        .border_style(BLACK)
-                        .background_style(WHITE.mix(0.9))
-                        .draw()
-                        .map_err(plot_err)?;
+                    framed_legend(&mut chart, SeriesLabelPosition::LowerLeft)?;
                     Ok::<(), StudyError>(())
                 })
             },
@@ -266,14 +249,10 @@ fn success_series(run: &RunData) -> Vec<(u64, f64, f64)> {
         .iter()
         .filter(|l| l.replan)
         .map(|l| {
-            let (solved, tasks) = l
-                .results
-                .iter()
-                .fold((0, 0), |(s, t), d| (s + d.solved, t + d.tasks));
             (
                 l.epoch,
                 l.env_steps as f64,
-                100.0 * solved as f64 / tasks.max(1) as f64,
+                100.0 * super::tables::solved_share(&l.results),
             )
         })
         .collect()

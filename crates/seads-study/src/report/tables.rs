@@ -466,10 +466,15 @@ fn pooled_success(run: &RunData) -> Option<(Mode, f64)> {
         (None, Some(p)) => (Mode::Policy, p),
         (None, None) => return None,
     };
+    Some((mode, solved_share(results)))
+}
+
+/// The share of all tasks solved over an evaluation's depths (0 for none).
+pub(super) fn solved_share(results: &[DepthResult]) -> f64 {
     let (solved, tasks) = results
         .iter()
         .fold((0, 0), |(s, t), d| (s + d.solved, t + d.tasks));
-    Some((mode, solved as f64 / tasks.max(1) as f64))
+    solved as f64 / tasks.max(1) as f64
 }
 
 /// SEADS against the baselines on task success (the paper's Fig. 3 at the end of training):
@@ -532,12 +537,6 @@ pub fn success_comparison(groups: &[Group<'_>], reference: Option<&str>) -> Opti
 /// acting alone, as [`success_comparison`] compares them), and the same with re-planning by a
 /// forward model fitted to its frozen skills (`seads fit-model`).
 fn interval_metrics(g: &Group<'_>) -> [(&'static str, Vec<f64>); 3] {
-    let pooled = |results: &Vec<DepthResult>| {
-        let (solved, tasks) = results
-            .iter()
-            .fold((0, 0), |(s, t), d| (s + d.solved, t + d.tasks));
-        solved as f64 / tasks.max(1) as f64
-    };
     [
         (
             "coverage",
@@ -554,7 +553,7 @@ fn interval_metrics(g: &Group<'_>) -> [(&'static str, Vec<f64>); 3] {
             "success, fitted model",
             g.runs
                 .iter()
-                .filter_map(|r| fitted(r, Mode::Replan).map(|(e, _)| pooled(e)))
+                .filter_map(|r| fitted(r, Mode::Replan).map(|(e, _)| solved_share(e)))
                 .collect(),
         ),
     ]
@@ -577,9 +576,11 @@ pub fn interval_tables(groups: &[Group<'_>], reference: Option<&str>) -> Option<
     );
     let mut any = false;
     for g in groups {
-        let reference_group = reference
+        // The reference's values of each metric, once per group.
+        let reference_metrics = reference
             .filter(|r| *r != g.variant)
-            .and_then(|r| groups.iter().find(|o| o.env == g.env && o.variant == r));
+            .and_then(|r| groups.iter().find(|o| o.env == g.env && o.variant == r))
+            .map(interval_metrics);
         for (i, (metric, values)) in interval_metrics(g).into_iter().enumerate() {
             let key = |what: &str| format!("{what}/{}/{}/{metric}", g.env, g.variant);
             let (Some(q), Some(m)) = (
@@ -600,14 +601,9 @@ pub fn interval_tables(groups: &[Group<'_>], reference: Option<&str>) -> Option<
                 low: scale * i.low,
                 high: scale * i.high,
             };
-            let improvement = reference_group
-                .map(|o| {
-                    interval_metrics(o)
-                        .into_iter()
-                        .nth(i)
-                        .map_or_else(Vec::new, |m| m.1)
-                })
-                .and_then(|r| improvement_interval(&values, &r, &key("improvement")));
+            let improvement = reference_metrics
+                .as_ref()
+                .and_then(|r| improvement_interval(&values, &r[i].1, &key("improvement")));
             let _ = writeln!(
                 md,
                 "| {} | {} | {metric}{} | {} | {} | {} | {} |",
