@@ -571,11 +571,20 @@ fn the_documents_cite_only_files_and_tests_that_exist() {
         ".rs", ".toml", ".md", ".py", ".json", ".jsonl", ".csv", ".sh", ".gz",
     ];
     let mut missing = Vec::new();
-    for doc in ["docs/ARCHITECTURE.md", "docs/RESULTS.md"] {
+    for doc in [
+        "README.md",
+        "docs/ARCHITECTURE.md",
+        "docs/RESULTS.md",
+        "docs/USAGE.md",
+    ] {
         let text = read(doc);
         for cited in text.split('`').skip(1).step_by(2) {
             let cited = cited.trim();
-            if cited.contains(' ') || cited.contains('*') || cited.contains('<') {
+            if cited.contains(' ')
+                || cited.contains('*')
+                || cited.contains('<')
+                || cited.starts_with('~')
+            {
                 continue;
             }
             let is_test = cited.split('_').count() >= 4
@@ -1044,4 +1053,25 @@ fn every_fallible_python_method_guards_its_body() {
     }
     assert!(checked.len() >= 25, "{checked:?}");
     assert!(unguarded.is_empty(), "not guarded: {unguarded:#?}");
+}
+
+/// RESULTS' summary is the table that `seads summary` computes from each study's claims.toml
+/// and committed runs: a number typed into it, or data committed without regenerating it, fails
+/// here (regenerate with `seads summary --write docs/RESULTS.md`). RESULTS stays a reference of
+/// at most 300 lines.
+#[test]
+fn results_summary_is_generated_from_the_data() {
+    use seads_study::report::summary::{replace_summary, summary_table};
+    let document = read("docs/RESULTS.md");
+    let table = summary_table(&root().join("docs/results")).unwrap();
+    let generated = replace_summary(&document, &table).unwrap();
+    assert!(
+        generated == document,
+        "docs/RESULTS.md's summary differs from the data: run `seads summary --write docs/RESULTS.md`"
+    );
+    let lines = document.lines().count();
+    assert!(
+        lines <= 300,
+        "docs/RESULTS.md has {lines} lines, more than 300"
+    );
 }

@@ -91,6 +91,8 @@ enum Command {
     Replay(episodes::ReplayArgs),
     /// Tables, Mann–Whitney tests and figures over sweeps and runs (the paper's Table 1 and more).
     Report(report::ReportArgs),
+    /// RESULTS' summary table, computed from each study's claims.toml and its committed runs.
+    Summary(report::SummaryArgs),
     /// Rewrite runs' configurations, study manifests and evaluation files of older versions'
     /// layouts into today's (once: every other command reads today's layout only).
     Migrate(migrate::MigrateArgs),
@@ -343,6 +345,7 @@ fn main() -> ExitCode {
         Command::Replay(args) => episodes::replay(args),
         Command::Sweep(cmd) => sweep::run(cmd),
         Command::Report(args) => report::report(args),
+        Command::Summary(args) => report::summary(args),
         Command::Migrate(args) => migrate::migrate(args),
         Command::Uarm(uarm::UarmCommand::Calibrate(args)) => uarm::calibrate(args),
         Command::Uarm(uarm::UarmCommand::Train(args)) => uarm::train(args),

@@ -83,3 +83,54 @@ pub fn report(args: ReportArgs) -> Result<()> {
     );
     Ok(())
 }
+
+/// Arguments of `seads summary`.
+#[derive(Debug, clap::Args)]
+pub struct SummaryArgs {
+    /// The folder of committed studies; each study with a claims.toml beside its runs gives
+    /// rows of the table.
+    #[arg(long, default_value = "docs/results", value_name = "DIR")]
+    results: PathBuf,
+    /// Write the table into this document, between its summary markers (RESULTS.md), instead
+    /// of printing it.
+    #[arg(long, value_name = "FILE", conflicts_with = "check")]
+    write: Option<PathBuf>,
+    /// Exit 1 when this document's summary differs from the table the data give.
+    #[arg(long, value_name = "FILE")]
+    check: Option<PathBuf>,
+}
+
+/// Runs `seads summary`: RESULTS' summary table from the studies' claims and committed runs.
+pub fn summary(args: SummaryArgs) -> Result<()> {
+    use seads_study::report::summary::{replace_summary, summary_table};
+    if !args.results.is_dir() {
+        return Err(crate::bad_input(anyhow::anyhow!(
+            "--results {} is not a folder of studies",
+            args.results.display()
+        ))
+        .into());
+    }
+    let table = summary_table(&args.results).map_err(crate::study_error)?;
+    let Some(document) = args.write.as_ref().or(args.check.as_ref()) else {
+        outln!("{table}");
+        return Ok(());
+    };
+    let text = std::fs::read_to_string(document)
+        .map_err(|e| crate::bad_input(anyhow::anyhow!("reading {}: {e}", document.display())))?;
+    let updated = replace_summary(&text, &table)
+        .map_err(|e| crate::bad_input(anyhow::anyhow!("{}: {e}", document.display())))?;
+    if args.check.is_some() {
+        if updated != text {
+            anyhow::bail!(
+                "{}: its summary differs from the data; run `seads summary --write {}`",
+                document.display(),
+                document.display()
+            );
+        }
+        outln!("{}: the summary matches the data", document.display());
+    } else {
+        seads_run::store::write_atomic(document, updated.as_bytes())?;
+        outln!("wrote the summary into {}", document.display());
+    }
+    Ok(())
+}

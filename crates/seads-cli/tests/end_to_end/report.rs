@@ -267,3 +267,37 @@ fn a_garbage_evaluation_file_is_named_as_such() {
     );
     assert!(!stderr.contains("cannot load checkpoint"), "{stderr}");
 }
+
+/// `seads summary` writes the table between a document's markers and checks it: the committed
+/// RESULTS matches its data; a document that was edited by hand fails the check (exit 1); a
+/// folder that is not there, or a document without the markers, is one line of bad input and
+/// the document is left as it was.
+#[test]
+fn the_summary_is_checked_written_and_refused_as_it_should_be() {
+    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../..");
+    let results = root.join("docs/results");
+    let committed = root.join("docs/RESULTS.md");
+    seads_ok(&["summary", "--results", s(&results), "--check", s(&committed)]);
+    let dir = tempfile::tempdir().unwrap();
+    let edited = dir.path().join("RESULTS.md");
+    let text = std::fs::read_to_string(&committed).unwrap();
+    let first_row = text.find("| LightsOutCursor").unwrap();
+    let mut typed = text.clone();
+    typed.insert_str(first_row, "| a row typed by hand | 1 | 2 | 3 | x |\n");
+    std::fs::write(&edited, &typed).unwrap();
+    let out = seads(&["summary", "--results", s(&results), "--check", s(&edited)]);
+    assert_eq!(out.status.code(), Some(1), "{out:?}");
+    seads_ok(&["summary", "--results", s(&results), "--write", s(&edited)]);
+    assert_eq!(std::fs::read_to_string(&edited).unwrap(), text);
+    check_bad_input(
+        &["summary", "--results", s(&dir.path().join("none"))],
+        "is not a folder of studies",
+    );
+    let bare = dir.path().join("bare.md");
+    std::fs::write(&bare, "# no markers\n").unwrap();
+    check_bad_input(
+        &["summary", "--results", s(&results), "--write", s(&bare)],
+        "lacks the lines",
+    );
+    assert_eq!(std::fs::read_to_string(&bare).unwrap(), "# no markers\n");
+}

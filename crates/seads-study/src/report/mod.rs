@@ -14,6 +14,7 @@ pub mod intervals;
 mod paper;
 mod runs;
 pub mod stats;
+pub mod summary;
 mod tables;
 mod versions;
 mod walltime;
