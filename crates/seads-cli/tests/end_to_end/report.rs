@@ -277,7 +277,13 @@ fn the_summary_is_checked_written_and_refused_as_it_should_be() {
     let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../..");
     let results = root.join("docs/results");
     let committed = root.join("docs/RESULTS.md");
-    seads_ok(&["summary", "--results", s(&results), "--check", s(&committed)]);
+    seads_ok(&[
+        "summary",
+        "--results",
+        s(&results),
+        "--check",
+        s(&committed),
+    ]);
     let dir = tempfile::tempdir().unwrap();
     let edited = dir.path().join("RESULTS.md");
     let text = std::fs::read_to_string(&committed).unwrap();

@@ -164,6 +164,44 @@ fn run_value(run: &RunData, claim: &Claim) -> Option<f64> {
     }
 }
 
+/// The protocol of the evaluation a run's value of `metric` comes from, in a few words
+/// (`standard`, or how it departs from it); `None` for metrics that are not task success of a
+/// final evaluation.
+fn run_protocol(run: &RunData, metric: Metric) -> Option<&str> {
+    let label = |i: usize| run.success_protocols[i].as_deref();
+    match metric {
+        Metric::Success if run.replan.is_some() => label(0),
+        Metric::Success => label(2),
+        Metric::SuccessReplan => label(0),
+        Metric::SuccessPlanOnce => label(1),
+        Metric::SuccessFitted => run.fitted[0].as_ref().map(|(_, l)| l.as_str()),
+        _ => None,
+    }
+}
+
+/// The one protocol of a cell's evaluations for `metric`, as a row says it ("" for the standard
+/// one); an error when its runs were evaluated under different protocols, which a row must not
+/// pool (as a report never does).
+fn cell_protocol(study: &Study, claim: &Claim, runs: &[&RunData]) -> Result<String> {
+    let mut labels: Vec<&str> = runs
+        .iter()
+        .filter_map(|r| run_protocol(r, claim.metric))
+        .collect();
+    labels.sort_unstable();
+    labels.dedup();
+    match labels[..] {
+        [] | ["standard"] => Ok(String::new()),
+        [one] => Ok(format!(" [protocol: {one}]")),
+        _ => Err(StudyError::failed(format!(
+            "{}: claim {:?}: its runs were evaluated under different protocols ({}), which one row \
+             cannot pool",
+            study.name,
+            claim.what,
+            labels.join("; ")
+        ))),
+    }
+}
+
 /// A run's coverage curve: (environment steps, coverage) in the order of training.
 fn curve(run: &RunData) -> Vec<(u64, f64)> {
     run.lines
@@ -454,7 +492,7 @@ fn our_side(study: &Study, claim: &Claim) -> Result<(String, usize)> {
         }
         _ => {
             let values: Vec<f64> = runs.iter().filter_map(|r| run_value(r, claim)).collect();
-            let mut text = spread(&values, percent);
+            let mut text = spread(&values, percent) + &cell_protocol(study, claim, &runs)?;
             if let Some(against) = &claim.against {
                 let reference: Vec<f64> = cell(study, &claim.env, against)
                     .iter()
@@ -686,6 +724,34 @@ mod tests {
         ));
         // 2, 3, 3, 4, 5, 6: median 3.5.
         assert_eq!(our_side(&s, &length).unwrap().0, "3.5");
+    }
+
+    /// Task success of runs evaluated under different protocols is never pooled in a row; one
+    /// protocol other than the standard one is named in the row.
+    #[test]
+    fn a_row_names_its_protocol_and_never_pools_two() {
+        let evaluated = |seed: u32, protocol: &str| {
+            let mut r = run(seed, "seads", &[(1000, 25.0)]);
+            r.replan = Some(vec![depth(1, 20, 20, vec![3])]);
+            r.success_protocols[0] = Some(protocol.into());
+            r
+        };
+        let c = claim(&format!(
+            "what = \"x\"\n{ENV}variants = [\"seads\"]\nmetric = \"success-replan\""
+        ));
+        let same = study(vec![
+            evaluated(1, "first-found"),
+            evaluated(2, "first-found"),
+        ]);
+        assert_eq!(
+            our_side(&same, &c).unwrap().0,
+            "100.0 % ± 0.0 (100.0, 100.0) [protocol: first-found]"
+        );
+        let standard = study(vec![evaluated(1, "standard")]);
+        assert_eq!(our_side(&standard, &c).unwrap().0, "100.0 %");
+        let mixed = study(vec![evaluated(1, "standard"), evaluated(2, "first-found")]);
+        let e = our_side(&mixed, &c).unwrap_err().to_string();
+        assert!(e.contains("different protocols"), "{e}");
     }
 
     /// A claim on a cell without a finished run is an error, never an empty row.
