@@ -106,6 +106,11 @@ cd "$SEADS_SWEEPS"
 while ${wait:-false}; do sleep 60; done
 EOF
     for segment in "$@"; do
+      if [[ $segment == "run "* ]]; then
+        # A command of its own between the sweeps' segments.
+        echo "${segment#run }"
+        continue
+      fi
       read -r commit sweep indices <<< "$segment"
       cat <<EOF
 B="$SEADS_FROZEN/$commit/bin/seads"

@@ -38,6 +38,10 @@ pub enum SweepCommand {
     Slurm(SlurmArgs),
     /// Done / running / failed / pending per run and in total, read from the run directories.
     Status(StatusArgs),
+    /// Lay a sweep out again from its committed copy (`seads report --copy-runs`, e.g.
+    /// docs/results/STUDY/runs/SWEEP) on this machine: planned again from its manifest, the
+    /// committed runs laid in as copied; `seads sweep run` then trains the rest.
+    Restore(RestoreArgs),
 }
 
 /// Arguments of `seads sweep plan`.
@@ -202,10 +206,50 @@ pub struct StatusArgs {
     json: bool,
 }
 
+/// Arguments of `seads sweep restore`.
+#[derive(Debug, Args)]
+pub struct RestoreArgs {
+    /// The committed sweep (its sweep.json, manifest.toml and finished runs' data).
+    committed: PathBuf,
+    /// The sweep directory to create (it must not exist).
+    #[arg(long)]
+    out: PathBuf,
+    /// Plan it with this binary although the sweep was planned by another commit (its runs
+    /// would then mix code versions).
+    #[arg(long)]
+    allow_other_commit: bool,
+}
+
+/// Runs `seads sweep restore`.
+fn restore(args: RestoreArgs) -> Result<()> {
+    let restored = seads_study::sweep::restore(
+        &args.committed,
+        &args.out,
+        crate::build().commit,
+        args.allow_other_commit,
+    )
+    .map_err(crate::study_error)?;
+    outln!(
+        "laid out {}: {} runs, {} copied in from {} (no checkpoints), {} to train",
+        args.out.display(),
+        restored.runs,
+        restored.copied,
+        args.committed.display(),
+        restored.runs - restored.copied
+    );
+    for dir in &restored.departures {
+        outln!(
+            "  {dir}: trained with another configuration than today's plan (kept as it trained)"
+        );
+    }
+    Ok(())
+}
+
 /// Runs `seads sweep …`.
 pub fn run(command: SweepCommand) -> Result<()> {
     match command {
         SweepCommand::Plan(args) => plan(args),
+        SweepCommand::Restore(args) => restore(args),
         SweepCommand::Run(args) => {
             crate::build()
                 .allows_study(allow_dirty(args.allow_dirty)?)

@@ -1111,3 +1111,63 @@ fn planned_sweep(dir: &Path) -> (PathBuf, PathBuf) {
     seads_ok(&["sweep", "plan", s(&manifest), "--out", s(&out)]);
     (manifest, out)
 }
+
+/// A committed study's sweep is laid out again on this machine (issue 81 item 4): the DIAYN
+/// study's copy, planned by 4df69f9, is refused by a binary of another commit unless told, then
+/// comes back with its 18 finished runs copied in (their data byte for byte) and nothing to
+/// train; a folder that exists already is refused and left as it was.
+#[test]
+fn a_committed_sweep_is_laid_out_again_from_its_runs() {
+    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../..");
+    let committed = root.join("docs/results/diayn/runs/diayn");
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("diayn");
+    check_bad_input(
+        &["sweep", "restore", s(&committed), "--out", s(&out)],
+        "was planned by commit 4df69f9",
+    );
+    assert!(!out.exists(), "nothing laid out");
+    seads_ok(&[
+        "sweep",
+        "restore",
+        s(&committed),
+        "--out",
+        s(&out),
+        "--allow-other-commit",
+    ]);
+    let status = json(&["sweep", "status", s(&out), "--json"]);
+    assert_eq!(status["total"], 18, "{status}");
+    assert_eq!(status["copied"], 18, "{status}");
+    for run in status["runs"].as_array().unwrap() {
+        let rel = std::path::Path::new(run["dir"].as_str().unwrap())
+            .strip_prefix(&out)
+            .unwrap()
+            .to_path_buf();
+        for file in [
+            "metrics.jsonl",
+            "evaluation-replan.json",
+            "provenance.jsonl",
+        ] {
+            let from = committed.join(&rel).join(file);
+            if from.exists() {
+                assert_eq!(
+                    std::fs::read(out.join(&rel).join(file)).unwrap(),
+                    std::fs::read(&from).unwrap(),
+                    "{}",
+                    from.display()
+                );
+            }
+        }
+    }
+    check_bad_input(
+        &[
+            "sweep",
+            "restore",
+            s(&committed),
+            "--out",
+            s(&out),
+            "--allow-other-commit",
+        ],
+        "exists",
+    );
+}

@@ -8,6 +8,7 @@ pub mod index;
 pub mod manifest;
 pub mod overview;
 pub mod population;
+pub mod restore;
 pub mod slurm;
 pub mod state;
 pub mod task;
@@ -17,6 +18,7 @@ pub use index::{INDEX, MANIFEST, Planned, Sweep, SweepRun};
 pub use manifest::{EvaluationPlan, Manifest, PlannedRun};
 pub use overview::{Overview, RunStatus};
 pub use population::populations;
+pub use restore::{Restored, restore};
 pub use state::{
     Claim, LOG, Missing, Outcome, PATIENCE, RECORD, Record, Status, TAKEN_EXIT, begun_first,
     check_outputs, damage, is_claimed, status,
