@@ -18,14 +18,16 @@
 # 3. writes the chains into $SEADS_SWEEPS (atomically: a running chain keeps its own copy) and
 #    starts each that is not running, detached (setsid, nohup): two cores, one chain each, sharing
 #    the sweeps from their two ends, so that the cores finish one study before the next:
-#      chainS: DIAYN against VIC and SEADS (experiments/diayn.toml), then the LightsOutJaco cells
-#      (experiments/arms-jaco.toml; each seed's no forward-model relabelling run first), then the
-#      13×13 board's seeds 1-3, at nice 10;
-#      chainJ: the same studies from the far end of each list (the Jaco seeds' SEADS run first),
-#      at nice 5.
+#      chainS: the LightsOutJaco cells (experiments/arms-jaco.toml; each seed's no forward-model
+#      relabelling run first), then five LightsOutCursor agents at 5·10⁵ steps
+#      (experiments/fig-s7-agents.toml) and their deeper search (scripts/studies/fig-s7.sh), then
+#      the Reacher's bold cells (experiments/arms-reacher-bold.toml), then the 13×13 board's seeds
+#      1-3, at nice 10;
+#      chainJ: the LightsOutJaco cells and the Reacher's bold cells from the far end of each list
+#      (the Jaco seeds' SEADS run first), then the 13×13 board, at nice 5.
 #    Each chain resumes the runs it had begun before it starts new ones (index_chain below).
 #    The finished studies (the Reacher cells, VIC, the TileSwapCursor baselines, board sizes to
-#    9×9) are committed under docs/results/ and run no more; git history holds their chains.
+#    9×9, DIAYN) are committed under docs/results/ and run no more; git history holds their chains.
 # Runs in progress resume from their checkpoints; runs lost with a machine start again.
 # Progress: $SEADS_SWEEPS/done.log, `seads sweep status <sweep>` by the study's frozen binary.
 set -euo pipefail
@@ -39,8 +41,9 @@ esac
 
 # study, its frozen binary, the commit of its manifest, the manifest, its committed sweep
 STUDIES=(
-  "diayn 4df69f9 4df69f9 experiments/diayn.toml docs/results/diayn/runs/diayn"
   "arms-jaco 73dac45 73dac45 experiments/arms-jaco.toml docs/results/arms-jaco/runs/arms-jaco"
+  "fig-s7-agents d45d7e2 d45d7e2 experiments/fig-s7-agents.toml docs/results/fig-s7-agents/runs/fig-s7-agents"
+  "arms-reacher-bold d45d7e2 d45d7e2 experiments/arms-reacher-bold.toml docs/results/arms-reacher-bold/runs/arms-reacher-bold"
   "board-size 948442b 948442b experiments/board-size.toml docs/results/board-size-948442b/runs/board-size"
 )
 # The last commit whose committed manifests and run configurations were in the layout the frozen
@@ -48,7 +51,7 @@ STUDIES=(
 LAYOUT=951086a
 # The binaries the studies run, frozen from these clean commits in this order; a chain runs no
 # other.
-FROZEN=(4df69f9 73dac45 948442b)
+FROZEN=(73dac45 d45d7e2 948442b)
 
 # Steps 1 and 2.
 prepare() {
@@ -127,15 +130,18 @@ EOF
     done
   } | write "$chain.sh"
 }
-index_chain chainS "# DIAYN, VIC and SEADS on both Cursor boards, planned with fitted models (issue 78 item 7,
-# frozen 4df69f9), the 18 runs in the sweep's order; then the LightsOutJaco cells, each seed's
-# no forward-model relabelling run first (issue 48 item 2, frozen 73dac45); then the 13×13
-# board, seeds 1-3 (issue 48 item 4, frozen 948442b; scripts/studies/resume.sh)." 10 "" \
-  "4df69f9 diayn $(seq -s ' ' 0 17)" "73dac45 arms-jaco 1 0 3 2 5 4" "948442b board-size 3 8 13"
-index_chain chainJ "# The same studies as chainS from the far end of each list: DIAYN (frozen 4df69f9), then the
-# LightsOutJaco cells, each seed's SEADS run first (frozen 73dac45), then the 13×13 board, seeds
-# 3-1 (frozen 948442b; scripts/studies/resume.sh)." 5 "" \
-  "4df69f9 diayn $(seq -s ' ' 17 -1 0)" "73dac45 arms-jaco 0 1 2 3 4 5" "948442b board-size 13 8 3"
+index_chain chainS "# The LightsOutJaco cells, each seed's no forward-model relabelling run first (issue 48 item 2,
+# frozen 73dac45); then five LightsOutCursor agents at 5·10⁵ steps and their deeper search
+# (Fig. S.7, issue 81 item 2.4, frozen d45d7e2; scripts/studies/fig-s7.sh, this chain only: a
+# search may take 16 GiB); then the Reacher's bold cells (issue 81 item 2.2, frozen d45d7e2); then
+# the 13×13 board, seeds 1-3 (issue 48 item 4, frozen 948442b; scripts/studies/resume.sh)." 10 "" \
+  "73dac45 arms-jaco 1 0 3 2 5 4" "d45d7e2 fig-s7-agents 0 1 2 3 4" \
+  "run bash $root/scripts/studies/fig-s7.sh $SEADS_SWEEPS/fig-s7-agents $SEADS_FROZEN/d45d7e2/bin/seads >> fig-s7.out 2>&1" \
+  "d45d7e2 arms-reacher-bold 0 1 2 3 4 5" "948442b board-size 3 8 13"
+index_chain chainJ "# The LightsOutJaco cells, each seed's SEADS run first (frozen 73dac45), then the Reacher's
+# bold cells from the far end (frozen d45d7e2), then the 13×13 board, seeds 3-1 (frozen 948442b;
+# scripts/studies/resume.sh)." 5 "" \
+  "73dac45 arms-jaco 0 1 2 3 4 5" "d45d7e2 arms-reacher-bold 5 4 3 2 1 0" "948442b board-size 13 8 3"
 [[ ${1:-} == --chains ]] && exit 0
 cd "$SEADS_SWEEPS"
 for chain in chainS chainJ; do
