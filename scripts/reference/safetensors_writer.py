@@ -1,6 +1,6 @@
-"""A safetensors file from a dict of float32 torch tensors (the format: an 8-byte little-endian
-header length, a JSON header of dtypes, shapes and offsets, then the raw data), so that the
-reference scripts need nothing beyond torch."""
+"""A safetensors file from a dict of float32 torch tensors or NumPy arrays (the format: an 8-byte
+little-endian header length, a JSON header of dtypes, shapes and offsets, then the raw data), so
+that the reference scripts need nothing beyond torch or NumPy."""
 
 import json
 import struct
@@ -9,8 +9,13 @@ import struct
 def write(path, tensors):
     header, blobs, offset = {}, [], 0
     for name in sorted(tensors):
-        t = tensors[name].detach().to("cpu").float().contiguous()
-        data = t.numpy().tobytes()
+        t = tensors[name]
+        if hasattr(t, "detach"):  # a torch tensor
+            t = t.detach().to("cpu").float().contiguous().numpy()
+        import numpy  # a torch script has it too
+
+        t = numpy.ascontiguousarray(t, dtype="<f4")
+        data = t.tobytes()
         header[name] = {
             "dtype": "F32",
             "shape": list(t.shape),

@@ -70,7 +70,7 @@ fn evaluate_agent_resuming(
         action_noise: protocol.action_noise,
     };
     let mut fitted = fitted;
-    let (policy, model) = match fitted.as_mut() {
+    let (policy, model): (_, &mut dyn seads_games::Successor) = match fitted.as_mut() {
         Some(model) => (&agent.policy, model),
         None => agent.parts()?,
     };

@@ -101,6 +101,10 @@ const ROBOT_SETTINGS: &str = "robot.toml";
 
 /// The file of the forward model in a checkpoint.
 pub const MODEL_FILE: &str = "forward_model.safetensors";
+
+/// The weights of a mixture skill model (`seads_skillmodel::MixtureModel`), which this crate
+/// does not evaluate.
+const MIXTURE_FILE: &str = "mixture_model.safetensors";
 /// The file of the actor in a checkpoint.
 pub const ACTOR_FILE: &str = "sac_actor.safetensors";
 
@@ -174,6 +178,14 @@ impl Agent {
             return Err(InferError::Environment {
                 env: config.env,
                 reason: format!("the spec given is of {}", spec.name),
+            });
+        }
+        if dir.join(MIXTURE_FILE).is_file() {
+            return Err(InferError::Environment {
+                env: config.env,
+                reason: "its forward model is a mixture (skill_model.kind = \"mixture\"), which \
+                         this light agent does not evaluate yet; plan with the `seads` binary"
+                    .into(),
             });
         }
         let model = ForwardModel::new(Tensors::read(&dir.join(MODEL_FILE))?.mlp("forward_model")?)?;

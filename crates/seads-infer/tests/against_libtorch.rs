@@ -169,7 +169,7 @@ fn plans_match_libtorchs_on_a_hundred_boards() {
             continue;
         }
         let a = bfs_plan(&mut light.model, board, game.goal(), &config);
-        let b = bfs_plan(&mut torch_model, board, game.goal(), &config);
+        let b = bfs_plan(&mut *torch_model, board, game.goal(), &config);
         // The same plan after as many expansions; its log-probability to float32 rounding.
         // Of the (state, skill) successors the search saw, a logit within rounding of 0 may
         // decide one differently (one in 10⁴ at most).
@@ -231,7 +231,7 @@ fn an_evaluation_matches_libtorchs_task_for_task() {
         tasks
     };
     let light_tasks = outcomes(&light.policy, &mut light.model);
-    let torch_tasks = outcomes(&torch.policy, &mut torch_model);
+    let torch_tasks = outcomes(&torch.policy, &mut *torch_model);
     assert_eq!(light_tasks.len(), 20);
     assert_eq!(light_tasks, torch_tasks);
 }

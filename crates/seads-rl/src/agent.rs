@@ -5,7 +5,8 @@ use seads_nn::Resolve as _;
 use std::path::{Path, PathBuf};
 
 use seads_embodiment::{EnvSpec, SkillPolicy, make_env};
-use seads_skillmodel::{ForwardModel, SkillModel, SkillModelKind};
+use seads_games::Successor;
+use seads_skillmodel::{ForwardModel, MixtureModel, PlanningModel, SkillModel, SkillModelKind};
 
 use crate::episode::policy_input;
 use crate::store::{checkpoints, latest_checkpoint};
@@ -74,9 +75,10 @@ pub struct Agent {
     pub epoch: u64,
     /// The skill policy.
     pub policy: AgentPolicy,
-    /// The agent's own forward model (SEADS's); `None` for a learner that learns none (VIC,
-    /// DIAYN), whose skills are planned with a model fitted to them ([`Agent::fitted_model`]).
-    pub model: Option<ForwardModel>,
+    /// The agent's own forward model (SEADS's: the paper's or the mixture); `None` for a learner
+    /// that learns none (VIC, DIAYN), whose skills are planned with a model fitted to them
+    /// ([`Agent::fitted_model`]).
+    pub model: Option<Box<dyn PlanningModel>>,
 }
 
 /// The checkpoint of epoch `epoch` of the run in `dir`, or its latest.
@@ -154,11 +156,16 @@ impl Agent {
         } else {
             None
         };
-        let model = match own_model {
+        let model: Option<Box<dyn PlanningModel>> = match own_model {
             Some(settings) if settings.kind == SkillModelKind::Forward => {
                 let mut model = ForwardModel::new(spec.symbolic_len, k, &settings, device, 0);
                 model.load(checkpoint, false)?;
-                Some(model)
+                Some(Box::new(model))
+            }
+            Some(settings) if settings.kind == SkillModelKind::Mixture => {
+                let mut model = MixtureModel::new(spec.symbolic_len, k, &settings, device, 0);
+                model.load(checkpoint, false)?;
+                Some(Box::new(model))
             }
             _ => None,
         };
@@ -184,9 +191,9 @@ impl Agent {
 
     /// The policy and the forward model, borrowed together (planning executes with one and
     /// searches with the other). Errors for an agent without a forward model.
-    pub fn parts(&mut self) -> Result<(&AgentPolicy, &mut ForwardModel), RlError> {
+    pub fn parts(&mut self) -> Result<(&AgentPolicy, &mut dyn Successor), RlError> {
         match &mut self.model {
-            Some(model) => Ok((&self.policy, model)),
+            Some(model) => Ok((&self.policy, model.as_mut())),
             None => Err(RlError::config(format!(
                 "this {} agent learned no forward model to plan with; fit one to its skills \
                  (`seads fit-model`) and plan with that",

@@ -6,7 +6,7 @@ use seads_embodiment::{EnvConfig, env_names};
 use serde::{Deserialize, Serialize};
 
 use crate::sections::{BaselineConfig, HacConfig, LearnerConfig, SeadsConfig, Section};
-use crate::{RunError, SacConfig};
+use crate::{RunError, SacConfig, SkillModelKind};
 
 /// Everything a training run needs: the run's own settings (environment, seed, budget,
 /// evaluation and checkpoint cadence, threads, numerics, device), the soft actor-critic's
@@ -484,7 +484,11 @@ impl TrainConfig {
         let steps = f(spec.step_limit.unwrap_or(1).max(1));
         let actor = mlp(obs + skills, &self.sac.hidden, 2.0 * act);
         let critic = mlp(obs + skills + act, &self.sac.hidden, 1.0);
-        let forward_model = mlp(board + skills, &seads.skill_model.hidden, board);
+        let outputs = match seads.skill_model.kind {
+            SkillModelKind::Mixture => f(seads.skill_model.mixture_components()) * (board + 1.0),
+            SkillModelKind::Forward | SkillModelKind::Vic => board,
+        };
+        let forward_model = mlp(board + skills, &seads.skill_model.hidden, outputs);
         let weights = 4.0 * actor + 10.0 * critic + 4.0 * forward_model;
         let activations =
             sac_activations + f(seads.skill_model.batch_size) * width(&seads.skill_model.hidden);

@@ -46,7 +46,9 @@ pub use sections::{
     BaselineConfig, COVERAGE_SEED, HacConfig, LearnerConfig, MAX_PER_EPOCH, RelabelConfig,
     SeadsConfig, Section,
 };
-pub use skill_model::{Normalisation, RelabelKind, RewardConfig, SkillModelConfig, SkillModelKind};
+pub use skill_model::{
+    DEFAULT_COMPONENTS, Normalisation, RelabelKind, RewardConfig, SkillModelConfig, SkillModelKind,
+};
 pub use store::{load_config, raise_budget};
 
 use std::path::Path;

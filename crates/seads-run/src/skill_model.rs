@@ -10,8 +10,12 @@ use crate::RunError;
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields, default)]
 pub struct SkillModelConfig {
-    /// `forward` (SEADS) or `vic` (skill discriminator, no planning).
+    /// `forward` (SEADS), `mixture` (a mixture of forward models: effects that depend on the
+    /// board stay coherent) or `vic` (skill discriminator, no planning).
     pub kind: SkillModelKind,
+    /// Components of the `mixture` model (default [`DEFAULT_COMPONENTS`]); only with that kind.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub components: Option<usize>,
     /// Hidden layer sizes.
     pub hidden: Vec<i64>,
     /// Adam learning rate.
@@ -26,6 +30,7 @@ impl Default for SkillModelConfig {
     fn default() -> Self {
         Self {
             kind: SkillModelKind::Forward,
+            components: None,
             hidden: vec![256, 256],
             lr: 1e-3,
             batch_size: 32,
@@ -50,7 +55,35 @@ impl SkillModelConfig {
         if self.batch_size == 0 {
             return bad("skill_model.batch_size must be at least 1".into());
         }
+        match (self.kind, self.components) {
+            (SkillModelKind::Mixture, Some(0)) => {
+                return bad("skill_model.components must be at least 1".into());
+            }
+            (SkillModelKind::Mixture, _) | (_, None) => {}
+            (kind, Some(_)) => {
+                return bad(format!(
+                    "skill_model.components belongs to kind = \"mixture\", not {kind:?}"
+                ));
+            }
+        }
         Ok(())
+    }
+
+    /// The mixture model's number of components.
+    pub fn mixture_components(&self) -> usize {
+        self.components.unwrap_or(DEFAULT_COMPONENTS)
+    }
+}
+
+/// Components of a mixture skill model unless its settings say otherwise: room for the few
+/// outcomes a skill has from one board while it is still stochastic (its move, nothing, another
+/// move), each kept whole in a component of its own.
+pub const DEFAULT_COMPONENTS: usize = 4;
+
+impl SkillModelKind {
+    /// Whether the model predicts successors, so that an agent plans with it (not VIC's).
+    pub fn plans(self) -> bool {
+        matches!(self, Self::Forward | Self::Mixture)
     }
 }
 
@@ -60,6 +93,10 @@ impl SkillModelConfig {
 pub enum SkillModelKind {
     /// SEADS: the forward model q(z_T | z_0, k).
     Forward,
+    /// A mixture of forward models q(z_T | z_0, k) = Σ_m π_m(z_0, k) Π_d Bern(flip_d; p_md):
+    /// an effect that changes several bits together (a slide: the tile's and the gap's) stays
+    /// one outcome of one component instead of being averaged bit by bit.
+    Mixture,
     /// VIC: the discriminator q(k | z_0, z_T).
     Vic,
 }

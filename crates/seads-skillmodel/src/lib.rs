@@ -27,16 +27,26 @@
 //! `cargo run -p seads-skillmodel --example fit` fits a forward model to the LightsOut move table
 //! and measures how often its mode is the true successor.
 
+mod build;
 mod groundtruth;
+mod mixture;
 mod model;
 mod relabel;
 mod reward;
 mod screen;
 
+pub use build::BuildSkillModel;
 pub use groundtruth::{agreement_with_game, fit_to_game, move_transitions};
+pub use mixture::MixtureModel;
+
+/// A skill model an agent plans with: its likelihoods ([`SkillModel`]) and its successors
+/// ([`seads_games::Successor`]); the paper's [`ForwardModel`] and the [`MixtureModel`].
+pub trait PlanningModel: SkillModel + seads_games::Successor {}
+
+impl<T: SkillModel + seads_games::Successor> PlanningModel for T {}
 pub use model::{
-    BuildSkillModel, ForwardModel, OPTIMISER_FILES, SkillDiscriminator, SkillModel,
-    SkillModelConfig, SkillModelKind, SkillTransition, fast_int8_products,
+    ForwardModel, OPTIMISER_FILES, SkillDiscriminator, SkillModel, SkillModelConfig,
+    SkillModelKind, SkillTransition, fast_int8_products,
 };
 pub use relabel::{RelabelKind, relabel, relabel_assignment, relabel_max};
 pub use reward::{

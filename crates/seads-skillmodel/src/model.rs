@@ -21,7 +21,7 @@ pub use seads_run::{SkillModelConfig, SkillModelKind};
 const DEVICE_BATCH: usize = 32_768;
 
 /// float32 machine epsilon: α is clamped to [ε, 1 − ε] as PyTorch's Bernoulli does.
-const EPS: f64 = 1.192_092_9e-7;
+pub(crate) const EPS: f64 = 1.192_092_9e-7;
 
 /// One (relabelled) skill execution as the skill model sees it.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -53,22 +53,6 @@ pub trait SkillModel: Send {
     fn load(&mut self, dir: &Path, optimiser: bool) -> Result<(), SkillModelError>;
 }
 
-/// Builds a skill model from its settings ([`SkillModelConfig`], which lives with the run's
-/// configuration in `seads-run`).
-pub trait BuildSkillModel {
-    /// The model for symbolic states of `d` bits and `k` skills, initialised from `seed`.
-    fn build(&self, d: usize, k: usize, device: Device, seed: u64) -> Box<dyn SkillModel>;
-}
-
-impl BuildSkillModel for SkillModelConfig {
-    fn build(&self, d: usize, k: usize, device: Device, seed: u64) -> Box<dyn SkillModel> {
-        match self.kind {
-            SkillModelKind::Forward => Box::new(ForwardModel::new(d, k, self, device, seed)),
-            SkillModelKind::Vic => Box::new(SkillDiscriminator::new(d, k, self, device, seed)),
-        }
-    }
-}
-
 /// Writes the first `d` bits of each state as 0/1 floats into consecutive rows of width `width`
 /// starting at column `offset`.
 fn write_bits(
@@ -83,7 +67,11 @@ fn write_bits(
     }
 }
 
-fn states_tensor(states: impl Iterator<Item = SymbolicState>, d: usize, device: Device) -> Tensor {
+pub(crate) fn states_tensor(
+    states: impl Iterator<Item = SymbolicState>,
+    d: usize,
+    device: Device,
+) -> Tensor {
     let states: Vec<SymbolicState> = states.collect();
     let n = states.len();
     let mut data = vec![0.0f32; n * d];
@@ -580,23 +568,24 @@ impl SkillModel for SkillDiscriminator {
 }
 
 /// The checkpoint files of the skill models' optimiser states (read only when resuming).
-pub const OPTIMISER_FILES: [&str; 2] = [
+pub const OPTIMISER_FILES: [&str; 3] = [
     "forward_model_adam.safetensors",
     "discriminator_adam.safetensors",
+    "mixture_model_adam.safetensors",
 ];
 
 /// A named network with its own var store and optimiser, saved as `<name>.safetensors` and
 /// `<name>_adam.safetensors` (one of [`OPTIMISER_FILES`]; read only when resuming training).
 #[derive(Debug)]
-struct Trainable {
+pub(crate) struct Trainable {
     name: &'static str,
     vs: nn::VarStore,
-    net: Mlp,
-    opt: Adam,
+    pub(crate) net: Mlp,
+    pub(crate) opt: Adam,
 }
 
 impl Trainable {
-    fn new(
+    pub(crate) fn new(
         name: &'static str,
         input: usize,
         output: usize,
@@ -618,7 +607,7 @@ impl Trainable {
         Self { name, vs, net, opt }
     }
 
-    fn save(&self, dir: &Path) -> Result<(), SkillModelError> {
+    pub(crate) fn save(&self, dir: &Path) -> Result<(), SkillModelError> {
         let io = |path: PathBuf| {
             move |source| SkillModelError::Io {
                 path: path.display().to_string(),
@@ -631,7 +620,7 @@ impl Trainable {
         self.opt.state().save(&path).map_err(io(path.clone()))
     }
 
-    fn load(&mut self, dir: &Path, optimiser: bool) -> Result<(), SkillModelError> {
+    pub(crate) fn load(&mut self, dir: &Path, optimiser: bool) -> Result<(), SkillModelError> {
         let corrupt = |path: &Path, e: seads_nn::WeightsError| SkillModelError::Checkpoint {
             path: path.display().to_string(),
             reason: match e {

@@ -326,3 +326,63 @@ fn fitted_model_reproduces_the_move_table() {
     let agreement = seads_skillmodel::agreement_with_game(&mut model, &game, 400, 2);
     assert!(agreement > 0.999, "{agreement}");
 }
+
+/// Where one skill from one board has two outcomes that each change two bits together (half the
+/// time bits 0 and 1, half the time bits 2 and 3: a stochastic skill's two slides), the mixture
+/// model learns both outcomes whole: each gets about half the probability and its most likely
+/// successor is one of them. The paper's per-bit model learns each of the four bits at one half,
+/// and no outcome keeps most of the probability mass.
+#[test]
+fn the_mixture_model_keeps_two_outcomes_of_one_skill_whole() {
+    use seads_games::Successor as _;
+    let z0 = SymbolicState::from_u64(0b1_0000);
+    let (a, b) = (
+        SymbolicState::from_u64(0b1_0011),
+        SymbolicState::from_u64(0b1_1100),
+    );
+    let batch: Vec<SkillTransition> = (0..32)
+        .map(|i| SkillTransition {
+            z0,
+            skill: 0,
+            zt: if i % 2 == 0 { a } else { b },
+        })
+        .collect();
+    let mixture = SkillModelConfig {
+        kind: SkillModelKind::Mixture,
+        hidden: vec![16, 16],
+        lr: 1e-2,
+        ..SkillModelConfig::default()
+    };
+    let paper = SkillModelConfig {
+        kind: SkillModelKind::Forward,
+        ..mixture.clone()
+    };
+    let (d, k) = (6, 2);
+    let mut ours = seads_skillmodel::MixtureModel::new(d, k, &mixture, Device::Cpu, 5);
+    let mut theirs = paper.build(d, k, Device::Cpu, 5);
+    for _ in 0..300 {
+        seads_skillmodel::SkillModel::train_step(&mut ours, &batch);
+        theirs.train_step(&batch);
+    }
+    let probability = |scores: Vec<f32>| scores.iter().map(|s| f64::from(*s).exp()).sum::<f64>();
+    let ours_ab = probability(
+        ours.log_likelihoods(&[(z0, 0, a), (z0, 0, b)])
+            .expect("skill 0 exists"),
+    );
+    let theirs_ab = probability(vec![
+        theirs.scores(&[(z0, a)])[0],
+        theirs.scores(&[(z0, b)])[0],
+    ]);
+    assert!(
+        ours_ab > 0.95,
+        "the mixture gives the two outcomes {ours_ab}"
+    );
+    assert!(theirs_ab < 0.2, "the per-bit model gives them {theirs_ab}");
+    let mut next = Vec::new();
+    ours.successors(&[z0], &mut next);
+    assert!(
+        next[0] == a || next[0] == b,
+        "successor {:#b}",
+        next[0].low_u64()
+    );
+}

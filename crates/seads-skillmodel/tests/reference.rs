@@ -4,13 +4,17 @@
 //! scripts/reference/forward_model.py with torch.nn, torch.distributions.Bernoulli and
 //! torch.optim.Adam); and both skill models start with the distribution of PyTorch's default
 //! `nn.Linear` initialisation (data/reference/torch_linear_init.json, written by
-//! scripts/reference/torch_linear_init.py).
+//! scripts/reference/torch_linear_init.py). The mixture model (issue 80) against NumPy: its
+//! log-likelihoods for every skill, its successors and its loss at the same weights and inputs
+//! (data/reference/mixture_model.safetensors, written by scripts/reference/mixture_model.py).
 
 use std::path::Path;
 
+use seads_games::Successor as _;
 use seads_games::SymbolicState;
 use seads_skillmodel::{
-    ForwardModel, SkillDiscriminator, SkillModel, SkillModelConfig, SkillTransition,
+    ForwardModel, MixtureModel, SkillDiscriminator, SkillModel, SkillModelConfig, SkillModelKind,
+    SkillTransition,
 };
 use tch::{Device, Tensor};
 
@@ -254,5 +258,71 @@ fn initial_weights_follow_pytorchs_linear() {
     assert!(
         drawn.is_empty(),
         "parameters the reference lacks: {drawn:?}"
+    );
+}
+
+/// The mixture model's likelihoods (the reward's and relabelling's scores, and the planner's step
+/// log-probabilities), successors and loss equal NumPy's, computed from the formula in float64.
+#[test]
+fn the_mixture_models_likelihoods_successors_and_loss_match_numpy() {
+    let (d, k, m) = (6, 3, 3);
+    let path = Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../../data/reference/mixture_model.safetensors");
+    let data = Tensor::read_safetensors(path).unwrap();
+    let config = SkillModelConfig {
+        kind: SkillModelKind::Mixture,
+        components: Some(m),
+        hidden: vec![8, 8],
+        ..SkillModelConfig::default()
+    };
+    let mut model = MixtureModel::new(d, k, &config, Device::Cpu, 0);
+    let dir = tempfile::tempdir().unwrap();
+    model.save(dir.path()).unwrap();
+    let weights: Vec<(String, Tensor)> = data
+        .iter()
+        .filter(|(n, _)| n.starts_with("mixture_model."))
+        .map(|(n, t)| (n.clone(), t.shallow_clone()))
+        .collect();
+    assert_eq!(weights.len(), 6);
+    Tensor::write_safetensors(&weights, dir.path().join("mixture_model.safetensors")).unwrap();
+    model.load(dir.path(), true).unwrap();
+
+    let z0 = states(get(&data, "input.z0"), d);
+    let zt = states(get(&data, "input.zt"), d);
+    let pairs: Vec<_> = z0.iter().copied().zip(zt.iter().copied()).collect();
+    let scores = model.scores(&pairs);
+    let expected = floats(get(&data, "expected.scores"));
+    assert_eq!(scores.len(), expected.len());
+    for (i, (a, b)) in scores.iter().zip(&expected).enumerate() {
+        assert!(
+            (a - b).abs() <= 1e-4 * (1.0 + b.abs()),
+            "score {i}: {a} vs NumPy {b}"
+        );
+    }
+    // The planner's step log-probabilities are the same numbers.
+    let steps: Vec<_> = pairs
+        .iter()
+        .flat_map(|&(a, b)| (0..k).map(move |s| (a, s, b)))
+        .collect();
+    let by_step = model.log_likelihoods(&steps).unwrap();
+    assert_eq!(by_step, scores);
+
+    let mut next = Vec::new();
+    model.successors(&z0, &mut next);
+    assert_eq!(next, states(get(&data, "expected.successors"), d));
+
+    let labels = floats(get(&data, "input.labels"));
+    let batch: Vec<SkillTransition> = (0..z0.len())
+        .map(|i| SkillTransition {
+            z0: z0[i],
+            skill: labels[i] as usize,
+            zt: zt[i],
+        })
+        .collect();
+    let loss = model.train_step(&batch);
+    let expected_loss = floats(get(&data, "expected.loss"))[0];
+    assert!(
+        (loss - expected_loss).abs() <= 1e-5 * (1.0 + expected_loss.abs()),
+        "loss {loss} vs NumPy {expected_loss}"
     );
 }

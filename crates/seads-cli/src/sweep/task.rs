@@ -10,7 +10,6 @@ use seads_rl::store::MetricsLine as _;
 use seads_rl::{ComputeDevice, Learner, Members, Population, Run, SeadsConfig, WithLearner};
 
 use seads_rl::InWords;
-use seads_skillmodel::SkillModelKind;
 
 use super::index::Sweep;
 use crate::BadInput;
@@ -211,9 +210,7 @@ fn evaluate(sweep: &Sweep, run: &Path, device: ComputeDevice) -> Result<()> {
     // The planner's parts and bookkeeping run on the task's rayon pool (`cores` threads), each
     // part's network on one libtorch thread.
     seads_rl::set_threads(1);
-    let own_model = config
-        .seads()
-        .is_ok_and(|s| s.skill_model.kind == SkillModelKind::Forward);
+    let own_model = config.seads().is_ok_and(|s| s.skill_model.kind.plans());
     if !own_model && !plan.fitted_model {
         outln!(
             "{}: a {} run learned no forward model to plan with; no task evaluation (its skill \

@@ -858,3 +858,63 @@ fn a_diayn_run_plans_with_a_model_fitted_to_its_skills() {
             .exists()
     );
 }
+
+/// A run whose skill model is the mixture (issue 80; `[seads.skill_model] kind = "mixture"`)
+/// trains, checkpoints the mixture's weights, resumes and plans: its agent solves tasks with the
+/// mixture's successors and likelihoods. Components belong to that kind only.
+#[test]
+fn a_run_with_the_mixture_model_trains_resumes_and_plans() {
+    let dir = tempfile::tempdir().unwrap();
+    let config = tiny_config(dir.path());
+    let text = std::fs::read_to_string(&config)
+        .unwrap()
+        .replace("kind = \"forward\"", "kind = \"mixture\"\ncomponents = 3");
+    assert!(text.contains("kind = \"mixture\""));
+    std::fs::write(&config, &text).unwrap();
+    let run = dir.path().join("run");
+    seads_ok(&["train", "--config", s(&config), "--out", s(&run), "--quiet"]);
+    let saved = std::fs::read_to_string(run.join("config.toml")).unwrap();
+    assert!(saved.contains("kind = \"mixture\"") && saved.contains("components = 3"));
+    let checkpoints: Vec<_> = std::fs::read_dir(run.join("checkpoints"))
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .filter(|p| p.is_dir())
+        .collect();
+    assert!(!checkpoints.is_empty());
+    assert!(
+        checkpoints
+            .iter()
+            .all(|c| c.join("mixture_model.safetensors").is_file()
+                && !c.join("forward_model.safetensors").exists()),
+        "{checkpoints:?}"
+    );
+    seads_ok(&[
+        "train",
+        "--resume",
+        s(&run),
+        "--env-steps",
+        "900",
+        "--quiet",
+    ]);
+    let evaluation = evaluate_two_boards_of_depths_1_2(s(&run));
+    assert_eq!(
+        evaluation["success_rate"].as_object().unwrap().len(),
+        2,
+        "{evaluation}"
+    );
+    let tasks = std::fs::read_to_string(run.join(format!("{TWO_BOARDS}-tasks.jsonl"))).unwrap();
+    assert_eq!(tasks.lines().count(), 4, "two boards of each depth");
+    // `components` with the paper's model is refused in one line.
+    let wrong = text.replace("kind = \"mixture\"", "kind = \"forward\"");
+    std::fs::write(&config, wrong).unwrap();
+    check_bad_input(
+        &[
+            "train",
+            "--config",
+            s(&config),
+            "--out",
+            s(&dir.path().join("x")),
+        ],
+        "components belongs to kind = \"mixture\"",
+    );
+}
