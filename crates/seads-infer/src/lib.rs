@@ -29,6 +29,7 @@
 //! ```
 
 mod checkpoint;
+mod mixture;
 mod mlp;
 mod model;
 mod policy;
@@ -36,8 +37,10 @@ mod policy;
 use std::path::Path;
 
 use seads_embodiment::{EnvConfig, EnvSpec, make_env};
+use seads_games::{Successor, SymbolicState};
 
 pub use checkpoint::{Tensors, checkpoint_dir};
+pub use mixture::MixtureModel;
 pub use mlp::{Dense, Mlp};
 pub use model::ForwardModel;
 pub use policy::Policy;
@@ -102,9 +105,58 @@ const ROBOT_SETTINGS: &str = "robot.toml";
 /// The file of the forward model in a checkpoint.
 pub const MODEL_FILE: &str = "forward_model.safetensors";
 
-/// The weights of a mixture skill model (`seads_skillmodel::MixtureModel`), which this crate
-/// does not evaluate.
-const MIXTURE_FILE: &str = "mixture_model.safetensors";
+/// The file of a mixture skill model (`seads_skillmodel::MixtureModel`) in a checkpoint.
+pub const MIXTURE_FILE: &str = "mixture_model.safetensors";
+
+/// The skill model an agent plans with: the paper's forward model or the mixture.
+#[derive(Debug, Clone)]
+pub enum Model {
+    /// The paper's per-bit forward model.
+    Forward(ForwardModel),
+    /// The mixture of forward models.
+    Mixture(MixtureModel),
+}
+
+impl Model {
+    fn inner(&mut self) -> &mut dyn Successor {
+        match self {
+            Self::Forward(m) => m,
+            Self::Mixture(m) => m,
+        }
+    }
+
+    fn inner_ref(&self) -> &dyn Successor {
+        match self {
+            Self::Forward(m) => m,
+            Self::Mixture(m) => m,
+        }
+    }
+}
+
+impl Successor for Model {
+    fn num_skills(&self) -> usize {
+        self.inner_ref().num_skills()
+    }
+
+    fn symbolic_len(&self) -> usize {
+        self.inner_ref().symbolic_len()
+    }
+
+    fn successors(&mut self, states: &[SymbolicState], out: &mut Vec<SymbolicState>) {
+        self.inner().successors(states, out);
+    }
+
+    fn preferred_batch(&self) -> usize {
+        self.inner_ref().preferred_batch()
+    }
+
+    fn log_likelihoods(
+        &mut self,
+        steps: &[(SymbolicState, usize, SymbolicState)],
+    ) -> Option<Vec<f32>> {
+        self.inner().log_likelihoods(steps)
+    }
+}
 /// The file of the actor in a checkpoint.
 pub const ACTOR_FILE: &str = "sac_actor.safetensors";
 
@@ -114,7 +166,7 @@ pub struct Agent {
     /// The skill policy.
     pub policy: Policy,
     /// The forward model.
-    pub model: ForwardModel,
+    pub model: Model,
     /// The environment it was trained on.
     pub env: String,
     /// That environment's options as the run set them (`[env_config]`: board size, spacing,
@@ -180,15 +232,18 @@ impl Agent {
                 reason: format!("the spec given is of {}", spec.name),
             });
         }
-        if dir.join(MIXTURE_FILE).is_file() {
-            return Err(InferError::Environment {
-                env: config.env,
-                reason: "its forward model is a mixture (skill_model.kind = \"mixture\"), which \
-                         this light agent does not evaluate yet; plan with the `seads` binary"
-                    .into(),
-            });
-        }
-        let model = ForwardModel::new(Tensors::read(&dir.join(MODEL_FILE))?.mlp("forward_model")?)?;
+        // The mixture's file where the run learned one (`skill_model.kind = "mixture"`), else
+        // the paper's forward model's.
+        let model = if dir.join(MIXTURE_FILE).is_file() {
+            Model::Mixture(MixtureModel::new(
+                Tensors::read(&dir.join(MIXTURE_FILE))?.mlp("mixture_model")?,
+                spec.symbolic_len,
+            )?)
+        } else {
+            Model::Forward(ForwardModel::new(
+                Tensors::read(&dir.join(MODEL_FILE))?.mlp("forward_model")?,
+            )?)
+        };
         let actor = Tensors::read(&dir.join(ACTOR_FILE))?;
         let policy = Policy::new(
             actor.mlp("actor")?,

@@ -19,6 +19,12 @@ impl ForwardModel {
     /// The model of `mlp`, which maps `board + K` inputs to `board` flip logits.
     pub fn new(mlp: Mlp) -> Result<Self, InferError> {
         let board = mlp.outputs();
+        Self::with_board(mlp, board)
+    }
+
+    /// A network on `[z_0, onehot(k)]` for boards of `board` fields, whatever it outputs per
+    /// row (the mixture's heads).
+    pub(crate) fn with_board(mlp: Mlp, board: usize) -> Result<Self, InferError> {
         if mlp.inputs() <= board || board > SymbolicState::MAX_BITS {
             return Err(InferError::Shape(format!(
                 "a forward model takes the board and a skill; this one takes {} values and gives {}",
@@ -96,7 +102,7 @@ impl ForwardModel {
 }
 
 /// log σ(x), stably.
-fn log_sigmoid(x: f32) -> f32 {
+pub(crate) fn log_sigmoid(x: f32) -> f32 {
     x.min(0.0) - (-x.abs()).exp().ln_1p()
 }
 

@@ -288,3 +288,67 @@ fn bad_runs_and_questions_are_errors() {
         assert!(err.to_string().contains(what), "{what}: {err}");
     }
 }
+
+/// A tiny run whose skill model is the mixture (issue 80), made once.
+static MIXTURE_RUN: LazyLock<tempfile::TempDir> = LazyLock::new(|| {
+    let dir = tempfile::tempdir().unwrap();
+    let mut config = seads_rl::TrainConfig::preset("lightsout-cursor").unwrap();
+    config.env_steps = 3000;
+    config.sac.hidden = vec![32, 32];
+    config
+        .edit(|s: &mut seads_rl::SeadsConfig| {
+            s.skill_model.kind = seads_skillmodel::SkillModelKind::Mixture;
+            s.skill_model.components = Some(3);
+            s.skill_model.hidden = vec![32, 32];
+            (s.sampled_episodes, s.recent_episodes) = (32, 16);
+            s.eval_seeds = 1;
+        })
+        .unwrap();
+    config.eval_every = 50;
+    config.checkpoint_every = 50;
+    config.sac_threads_alone = 0;
+    config.portable_numerics = true;
+    let run_dir = dir.path().join("run");
+    let mut run = seads_rl::Run::<seads_rl::Trainer>::create(&run_dir, config).unwrap();
+    while !run.finished() {
+        run.step().unwrap();
+    }
+    drop(run);
+    dir
+});
+
+/// The mixture model in plain Rust against libtorch's on the same checkpoint: the same
+/// successors of random boards under every skill, and the same log-probabilities within 1e-5.
+#[test]
+fn the_mixture_models_successors_and_probabilities_match_libtorchs() {
+    let run = MIXTURE_RUN.path().join("run");
+    let mut light = seads_infer::Agent::load(&run, None).unwrap();
+    let torch = seads_rl::Agent::load(&run, None).unwrap();
+    assert!(matches!(light.model, seads_infer::Model::Mixture(_)));
+    let mut torch_model = torch.model.unwrap();
+    let mut rng = ChaCha8Rng::seed_from_u64(5);
+    let states: Vec<SymbolicState> = (0..200)
+        .map(|_| {
+            let bits: Vec<bool> = (0..25)
+                .map(|_| rand::RngExt::random::<bool>(&mut rng))
+                .collect();
+            SymbolicState::from_bools(&bits)
+        })
+        .collect();
+    let (mut a, mut b) = (Vec::new(), Vec::new());
+    light.model.successors(&states, &mut a);
+    Successor::successors(&mut *torch_model, &states, &mut b);
+    assert_eq!(a, b);
+    let k = Successor::num_skills(&light.model);
+    let steps: Vec<(SymbolicState, usize, SymbolicState)> = states
+        .iter()
+        .enumerate()
+        .flat_map(|(i, &z)| [(z, i % k, a[i * k + i % k]), (z, (i + 1) % k, z)])
+        .collect();
+    let la = light.model.log_likelihoods(&steps).unwrap();
+    let lb = Successor::log_likelihoods(&mut *torch_model, &steps).unwrap();
+    assert_eq!(la.len(), lb.len());
+    for (x, y) in la.iter().zip(&lb) {
+        assert!((x - y).abs() <= 1e-5 * y.abs().max(1.0), "{x} against {y}");
+    }
+}

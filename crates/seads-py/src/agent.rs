@@ -12,7 +12,7 @@ use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 use seads_embodiment::{EnvConfig, EnvSpec, Environment, Filmed, Push, SkillPolicy, execute_skill};
 use seads_games::{BoardGame, Successor, SymbolicState};
-use seads_infer::{ForwardModel, Policy};
+use seads_infer::{Model, Policy};
 use seads_planner::{PlanChoice, PlannerConfig, Search, SolveConfig, find_plan};
 
 use crate::env::Env;
@@ -27,7 +27,7 @@ pub struct Agent {
     /// The skill policy.
     policy: Policy,
     /// The forward model, one search at a time.
-    model: Mutex<ForwardModel>,
+    model: Mutex<Model>,
     /// The environment the agent was trained on, its options and its dimensions.
     env: String,
     env_config: EnvConfig,
@@ -42,7 +42,7 @@ const ACT_ROWS: usize = 4096;
 
 /// The forward model, whichever thread used it last (a panic there leaves it whole: it is
 /// only read and its buffers rewritten).
-fn lock(model: &Mutex<ForwardModel>) -> std::sync::MutexGuard<'_, ForwardModel> {
+fn lock(model: &Mutex<Model>) -> std::sync::MutexGuard<'_, Model> {
     model
         .lock()
         .unwrap_or_else(std::sync::PoisonError::into_inner)
