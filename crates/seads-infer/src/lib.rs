@@ -6,8 +6,10 @@
 //!   trainer computes them, and a [`SkillPolicy`](seads_embodiment::SkillPolicy), so the
 //!   planner's executor runs its skills;
 //! - [`ForwardModel`], the symbolic forward model q(z_T | z_0, k): a
-//!   [`Successor`](seads_games::Successor), so the planner plans with it, with the model's
-//!   log-probabilities for the most likely plan.
+//!   [`Successor`], so the planner plans with it, with the model's
+//!   log-probabilities for the most likely plan;
+//! - [`MixtureModel`], the mixture of forward models (`skill_model.kind = "mixture"`), planned
+//!   with in the same way; [`Model`] holds whichever the run learned.
 //!
 //! The networks are small perceptrons (two hidden layers of 256, ReLU), so a CPU evaluates them
 //! quickly; the crate links neither libtorch nor a physics engine, and so serves the Python
