@@ -23,8 +23,9 @@
 #      (experiments/fig-s7-agents.toml) and their deeper search (scripts/studies/fig-s7.sh), then
 #      the Reacher's bold cells (experiments/arms-reacher-bold.toml), then the 13×13 board's seeds
 #      1-3, at nice 10;
-#      chainJ: the LightsOutJaco cells and the Reacher's bold cells from the far end of each list
-#      (the Jaco seeds' SEADS run first), then the 13×13 board, at nice 5.
+#      chainJ: the LightsOutJaco cells (the Jaco seeds' SEADS run first), the sliding puzzle with
+#      the mixture skill model (experiments/sliding-mixture.toml), the Reacher's bold cells from
+#      the far end, then the 13×13 board, at nice 5.
 #    Each chain resumes the runs it had begun before it starts new ones (index_chain below).
 #    The finished studies (the Reacher cells, VIC, the TileSwapCursor baselines, board sizes to
 #    9×9, DIAYN) are committed under docs/results/ and run no more; git history holds their chains.
@@ -44,6 +45,7 @@ STUDIES=(
   "arms-jaco 73dac45 73dac45 experiments/arms-jaco.toml docs/results/arms-jaco/runs/arms-jaco"
   "fig-s7-agents d45d7e2 d45d7e2 experiments/fig-s7-agents.toml docs/results/fig-s7-agents/runs/fig-s7-agents"
   "arms-reacher-bold d45d7e2 d45d7e2 experiments/arms-reacher-bold.toml docs/results/arms-reacher-bold/runs/arms-reacher-bold"
+  "sliding-mixture c943245 c943245 experiments/sliding-mixture.toml docs/results/sliding-mixture/runs/sliding-mixture"
   "board-size 948442b 948442b experiments/board-size.toml docs/results/board-size-948442b/runs/board-size"
 )
 # The last commit whose committed manifests and run configurations were in the layout the frozen
@@ -51,7 +53,7 @@ STUDIES=(
 LAYOUT=951086a
 # The binaries the studies run, frozen from these clean commits in this order; a chain runs no
 # other.
-FROZEN=(73dac45 d45d7e2 948442b)
+FROZEN=(73dac45 d45d7e2 c943245 948442b)
 
 # Steps 1 and 2.
 prepare() {
@@ -138,10 +140,12 @@ index_chain chainS "# The LightsOutJaco cells, each seed's no forward-model rela
   "73dac45 arms-jaco 1 0 3 2 5 4" "d45d7e2 fig-s7-agents 0 1 2 3 4" \
   "run bash $root/scripts/studies/fig-s7.sh $SEADS_SWEEPS/fig-s7-agents $SEADS_FROZEN/d45d7e2/bin/seads >> fig-s7.out 2>&1" \
   "d45d7e2 arms-reacher-bold 0 1 2 3 4 5" "948442b board-size 3 8 13"
-index_chain chainJ "# The LightsOutJaco cells, each seed's SEADS run first (frozen 73dac45), then the Reacher's
-# bold cells from the far end (frozen d45d7e2), then the 13×13 board, seeds 3-1 (frozen 948442b;
-# scripts/studies/resume.sh)." 5 "" \
-  "73dac45 arms-jaco 0 1 2 3 4 5" "d45d7e2 arms-reacher-bold 5 4 3 2 1 0" "948442b board-size 13 8 3"
+index_chain chainJ "# The LightsOutJaco cells, each seed's SEADS run first (frozen 73dac45), then the sliding
+# puzzle with the mixture skill model, seeds 1-3 (issue 80 item 3, frozen c943245), then the
+# Reacher's bold cells from the far end (frozen d45d7e2), then the 13×13 board, seeds 3-1 (frozen
+# 948442b; scripts/studies/resume.sh)." 5 "" \
+  "73dac45 arms-jaco 0 1 2 3 4 5" "c943245 sliding-mixture 0 1 2" \
+  "d45d7e2 arms-reacher-bold 5 4 3 2 1 0" "948442b board-size 13 8 3"
 [[ ${1:-} == --chains ]] && exit 0
 cd "$SEADS_SWEEPS"
 for chain in chainS chainJ; do
