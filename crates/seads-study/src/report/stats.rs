@@ -103,13 +103,25 @@ impl Test {
     /// that unlikely.
     pub fn shown(&self) -> String {
         if self.p < self.min_p {
-            format!("U = {}, exact p = {:.4}", self.u, self.p_exact)
+            format!("U = {}, exact p {}", self.u, p_value(self.p_exact))
         } else {
             format!(
-                "U = {}, p = {:.4}, exact {:.4}",
-                self.u, self.p, self.p_exact
+                "U = {}, p {}, exact {}",
+                self.u,
+                p_value(self.p),
+                p_value(self.p_exact).trim_start_matches("= ")
             )
         }
+    }
+}
+
+/// A p-value as a table says it: "= 0.0136" with four decimals, or "< 0.0001" for one that
+/// four decimals would show as 0.
+pub fn p_value(p: f64) -> String {
+    if p < 0.000_05 {
+        String::from("< 0.0001")
+    } else {
+        format!("= {p:.4}")
     }
 }
 
@@ -298,6 +310,16 @@ mod tests {
             t.shown(),
             format!("U = 0, p = {:.4}, exact {:.4}", t.p, t.p_exact)
         );
+        // Ten runs all below ten: 1 / C(20, 10) ≈ 5.4e-6, never shown as 0.
+        let t = worse_than(
+            &(0..10).map(f64::from).collect::<Vec<_>>(),
+            &(10..20).map(f64::from).collect::<Vec<_>>(),
+        )
+        .unwrap();
+        assert!(t.p_exact < 1e-5, "{t:?}");
+        assert_eq!(t.shown(), format!("U = 0, p = {:.4}, exact < 0.0001", t.p));
+        assert_eq!(p_value(0.00005), "= 0.0001");
+        assert_eq!(p_value(0.00004), "< 0.0001");
     }
 
     #[test]
