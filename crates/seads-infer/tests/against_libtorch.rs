@@ -118,8 +118,19 @@ fn actions_match_libtorchs() {
 fn successors_and_their_probabilities_match_libtorchs() {
     let (mut light, torch) = both();
     let mut torch_model = torch.model.unwrap();
-    let mut rng = ChaCha8Rng::seed_from_u64(3);
-    let states: Vec<SymbolicState> = (0..300)
+    same_successors_and_probabilities(&mut light.model, &mut *torch_model, 300, 3);
+}
+
+/// `n` random boards (seeded by `seed`): both models give the same successors under every skill,
+/// and the same log-probabilities (within 1e-5) of each successor and of the board staying.
+fn same_successors_and_probabilities(
+    light: &mut dyn Successor,
+    torch: &mut dyn Successor,
+    n: usize,
+    seed: u64,
+) {
+    let mut rng = ChaCha8Rng::seed_from_u64(seed);
+    let states: Vec<SymbolicState> = (0..n)
         .map(|_| {
             let bits: Vec<bool> = (0..25)
                 .map(|_| rand::RngExt::random::<bool>(&mut rng))
@@ -128,17 +139,17 @@ fn successors_and_their_probabilities_match_libtorchs() {
         })
         .collect();
     let (mut a, mut b) = (Vec::new(), Vec::new());
-    light.model.successors(&states, &mut a);
-    torch_model.successors(&states, &mut b);
+    light.successors(&states, &mut a);
+    torch.successors(&states, &mut b);
     assert_eq!(a, b);
-    let k = light.model.num_skills();
+    let k = light.num_skills();
     let steps: Vec<(SymbolicState, usize, SymbolicState)> = states
         .iter()
         .enumerate()
         .flat_map(|(i, &z)| [(z, i % k, a[i * k + i % k]), (z, (i + 1) % k, z)])
         .collect();
-    let la = light.model.log_likelihoods(&steps).unwrap();
-    let lb = torch_model.log_likelihoods(&steps).unwrap();
+    let la = light.log_likelihoods(&steps).unwrap();
+    let lb = torch.log_likelihoods(&steps).unwrap();
     assert_eq!(la.len(), lb.len());
     for (x, y) in la.iter().zip(&lb) {
         assert!((x - y).abs() <= 1e-5 * y.abs().max(1.0), "{x} against {y}");
@@ -326,29 +337,5 @@ fn the_mixture_models_successors_and_probabilities_match_libtorchs() {
     let torch = seads_rl::Agent::load(&run, None).unwrap();
     assert!(matches!(light.model, seads_infer::Model::Mixture(_)));
     let mut torch_model = torch.model.unwrap();
-    let mut rng = ChaCha8Rng::seed_from_u64(5);
-    let states: Vec<SymbolicState> = (0..200)
-        .map(|_| {
-            let bits: Vec<bool> = (0..25)
-                .map(|_| rand::RngExt::random::<bool>(&mut rng))
-                .collect();
-            SymbolicState::from_bools(&bits)
-        })
-        .collect();
-    let (mut a, mut b) = (Vec::new(), Vec::new());
-    light.model.successors(&states, &mut a);
-    Successor::successors(&mut *torch_model, &states, &mut b);
-    assert_eq!(a, b);
-    let k = Successor::num_skills(&light.model);
-    let steps: Vec<(SymbolicState, usize, SymbolicState)> = states
-        .iter()
-        .enumerate()
-        .flat_map(|(i, &z)| [(z, i % k, a[i * k + i % k]), (z, (i + 1) % k, z)])
-        .collect();
-    let la = light.model.log_likelihoods(&steps).unwrap();
-    let lb = Successor::log_likelihoods(&mut *torch_model, &steps).unwrap();
-    assert_eq!(la.len(), lb.len());
-    for (x, y) in la.iter().zip(&lb) {
-        assert!((x - y).abs() <= 1e-5 * y.abs().max(1.0), "{x} against {y}");
-    }
+    same_successors_and_probabilities(&mut light.model, &mut *torch_model, 200, 5);
 }

@@ -44,6 +44,21 @@ fn states(t: &Tensor, d: usize) -> Vec<SymbolicState> {
         .collect()
 }
 
+/// Gives `model` the reference's weights of its network `name` (three layers): saved, its
+/// weights file replaced by the reference's tensors, loaded back (with the optimiser's state).
+fn load_reference_weights(model: &mut dyn SkillModel, data: &[(String, Tensor)], name: &str) {
+    let dir = tempfile::tempdir().unwrap();
+    model.save(dir.path()).unwrap();
+    let weights: Vec<(String, Tensor)> = data
+        .iter()
+        .filter(|(n, _)| n.starts_with(&format!("{name}.")))
+        .map(|(n, t)| (n.clone(), t.shallow_clone()))
+        .collect();
+    assert_eq!(weights.len(), 6);
+    Tensor::write_safetensors(&weights, dir.path().join(format!("{name}.safetensors"))).unwrap();
+    model.load(dir.path(), true).unwrap();
+}
+
 #[test]
 fn log_likelihoods_loss_and_step_match_pytorch() {
     let (d, k) = (6, 3);
@@ -56,16 +71,7 @@ fn log_likelihoods_loss_and_step_match_pytorch() {
         ..SkillModelConfig::default()
     };
     let mut model = ForwardModel::new(d, k, &config, Device::Cpu, 0);
-    let dir = tempfile::tempdir().unwrap();
-    model.save(dir.path()).unwrap();
-    let weights: Vec<(String, Tensor)> = data
-        .iter()
-        .filter(|(n, _)| n.starts_with("forward_model."))
-        .map(|(n, t)| (n.clone(), t.shallow_clone()))
-        .collect();
-    assert_eq!(weights.len(), 6);
-    Tensor::write_safetensors(&weights, dir.path().join("forward_model.safetensors")).unwrap();
-    model.load(dir.path(), true).unwrap();
+    load_reference_weights(&mut model, &data, "forward_model");
 
     let z0 = states(get(&data, "input.z0"), d);
     let zt = states(get(&data, "input.zt"), d);
@@ -276,16 +282,7 @@ fn the_mixture_models_likelihoods_successors_and_loss_match_numpy() {
         ..SkillModelConfig::default()
     };
     let mut model = MixtureModel::new(d, k, &config, Device::Cpu, 0);
-    let dir = tempfile::tempdir().unwrap();
-    model.save(dir.path()).unwrap();
-    let weights: Vec<(String, Tensor)> = data
-        .iter()
-        .filter(|(n, _)| n.starts_with("mixture_model."))
-        .map(|(n, t)| (n.clone(), t.shallow_clone()))
-        .collect();
-    assert_eq!(weights.len(), 6);
-    Tensor::write_safetensors(&weights, dir.path().join("mixture_model.safetensors")).unwrap();
-    model.load(dir.path(), true).unwrap();
+    load_reference_weights(&mut model, &data, "mixture_model");
 
     let z0 = states(get(&data, "input.z0"), d);
     let zt = states(get(&data, "input.zt"), d);
