@@ -59,6 +59,35 @@ fn load_reference_weights(model: &mut dyn SkillModel, data: &[(String, Tensor)],
     model.load(dir.path(), true).unwrap();
 }
 
+/// The reference's states (`input.z0`, `input.zt`) and the model's scores of their pairs, checked
+/// against `expected.scores` within `tolerance` (relative, beyond 1).
+#[allow(clippy::type_complexity)]
+fn scores_match(
+    model: &dyn SkillModel,
+    data: &[(String, Tensor)],
+    d: usize,
+    tolerance: f32,
+) -> (
+    Vec<SymbolicState>,
+    Vec<SymbolicState>,
+    Vec<(SymbolicState, SymbolicState)>,
+    Vec<f32>,
+) {
+    let z0 = states(get(data, "input.z0"), d);
+    let zt = states(get(data, "input.zt"), d);
+    let pairs: Vec<_> = z0.iter().copied().zip(zt.iter().copied()).collect();
+    let scores = model.scores(&pairs);
+    let expected = floats(get(data, "expected.scores"));
+    assert_eq!(scores.len(), expected.len());
+    for (i, (a, b)) in scores.iter().zip(&expected).enumerate() {
+        assert!(
+            (a - b).abs() <= tolerance * (1.0 + b.abs()),
+            "score {i}: {a} vs the reference's {b}"
+        );
+    }
+    (z0, zt, pairs, scores)
+}
+
 #[test]
 fn log_likelihoods_loss_and_step_match_pytorch() {
     let (d, k) = (6, 3);
@@ -73,18 +102,7 @@ fn log_likelihoods_loss_and_step_match_pytorch() {
     let mut model = ForwardModel::new(d, k, &config, Device::Cpu, 0);
     load_reference_weights(&mut model, &data, "forward_model");
 
-    let z0 = states(get(&data, "input.z0"), d);
-    let zt = states(get(&data, "input.zt"), d);
-    let pairs: Vec<_> = z0.iter().copied().zip(zt.iter().copied()).collect();
-    let scores = model.scores(&pairs);
-    let expected = floats(get(&data, "expected.scores"));
-    assert_eq!(scores.len(), expected.len());
-    for (i, (a, b)) in scores.iter().zip(&expected).enumerate() {
-        assert!(
-            (a - b).abs() <= 1e-5 * (1.0 + b.abs()),
-            "score {i}: {a} vs PyTorch {b}"
-        );
-    }
+    let (z0, zt, _, _) = scores_match(&model, &data, d, 1e-5);
 
     let labels = floats(get(&data, "input.labels"));
     let batch: Vec<SkillTransition> = (0..z0.len())
@@ -284,18 +302,7 @@ fn the_mixture_models_likelihoods_successors_and_loss_match_numpy() {
     let mut model = MixtureModel::new(d, k, &config, Device::Cpu, 0);
     load_reference_weights(&mut model, &data, "mixture_model");
 
-    let z0 = states(get(&data, "input.z0"), d);
-    let zt = states(get(&data, "input.zt"), d);
-    let pairs: Vec<_> = z0.iter().copied().zip(zt.iter().copied()).collect();
-    let scores = model.scores(&pairs);
-    let expected = floats(get(&data, "expected.scores"));
-    assert_eq!(scores.len(), expected.len());
-    for (i, (a, b)) in scores.iter().zip(&expected).enumerate() {
-        assert!(
-            (a - b).abs() <= 1e-4 * (1.0 + b.abs()),
-            "score {i}: {a} vs NumPy {b}"
-        );
-    }
+    let (z0, zt, pairs, scores) = scores_match(&model, &data, d, 1e-4);
     // The planner's step log-probabilities are the same numbers.
     let steps: Vec<_> = pairs
         .iter()
