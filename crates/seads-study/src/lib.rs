@@ -48,6 +48,7 @@ pub mod figures;
 pub mod provenance;
 pub mod recording;
 pub mod report;
+pub mod run_data;
 pub mod sweep;
 
 pub use error::{BoxError, Context, Result, StudyError};

@@ -24,7 +24,7 @@ use std::path::{Path, PathBuf};
 
 use crate::{Context as _, Result, StudyError};
 
-pub use runs::data_files;
+pub use crate::run_data::data_files;
 pub use versions::is_repository;
 
 /// A CSV field, quoted when it holds a comma or a quote (RFC 4180).
@@ -305,18 +305,7 @@ pub fn write_report(options: &ReportOptions, out: &Path) -> Result<ReportSummary
             .iter()
             .filter(|r| r.finished() && r.damage.is_empty())
         {
-            let dest = out.join("runs").join(&run.copy_to);
-            std::fs::create_dir_all(&dest).doing(|| format!("creating {}", dest.display()))?;
-            for file in runs::data_files(&run.dir)? {
-                let from = run.dir.join(&file);
-                let bytes = std::fs::read(&from).doing(|| format!("reading {}", from.display()))?;
-                let to = dest.join(&file);
-                if let Some(parent) = to.parent() {
-                    std::fs::create_dir_all(parent)
-                        .doing(|| format!("creating {}", parent.display()))?;
-                }
-                seads_run::store::write_atomic(&to, &bytes)?;
-            }
+            crate::run_data::copy_data(&run.dir, &out.join("runs").join(&run.copy_to))?;
         }
         let _ = writeln!(
             md,

@@ -576,35 +576,6 @@ pub fn group(runs: &[RunData]) -> Result<(Vec<Group<'_>>, Vec<&RunData>)> {
     Ok((groups, unfinished))
 }
 
-/// The files of a run that results rest on (small; never checkpoints), by their paths inside the
-/// run: its configuration (with a robot run's `robot.toml`), metrics, evaluations, which code on
-/// which machine trained it (`provenance.jsonl`), and the record of a model fitted to its skills
-/// (`fitted-model/fit.json`; not the model's weights).
-pub fn data_files(run: &Path) -> Result<Vec<PathBuf>> {
-    let mut files = Vec::new();
-    for entry in std::fs::read_dir(run).doing(|| format!("reading {}", run.display()))? {
-        let path = entry?.path();
-        let name = path
-            .file_name()
-            .map_or(String::new(), |n| n.to_string_lossy().into_owned());
-        let wanted = name == "config.toml"
-            || name == "robot.toml"
-            || name == "metrics.jsonl"
-            || name == crate::provenance::PROVENANCE
-            || (name.starts_with("evaluation")
-                && (name.ends_with(".json") || name.ends_with(".jsonl")));
-        if wanted && path.is_file() {
-            files.push(PathBuf::from(name));
-        }
-    }
-    let fit_record = Path::new(seads_run::fitted::FITTED_MODEL).join(seads_run::fitted::FIT_RECORD);
-    if run.join(&fit_record).is_file() {
-        files.push(fit_record);
-    }
-    files.sort();
-    Ok(files)
-}
-
 /// A run with nothing in it but its name and the default config, for tests to fill in.
 #[cfg(test)]
 pub(crate) fn bare_run(seed: u32) -> RunData {

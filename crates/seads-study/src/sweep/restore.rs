@@ -2,7 +2,7 @@
 //! `docs/results/<study>/runs/<sweep>/`: the index, the manifest and each finished run's data,
 //! never checkpoints), so that a study continues on a fresh machine: the sweep is planned again
 //! from the committed manifest, it must expand to the committed index, and each committed run's
-//! files are laid into its run directory, its committed configuration (the one it trained with)
+//! data files are laid into its run directory, its committed configuration (the one it trained with)
 //! in place of the planned one; a run whose configuration departs from the plan is named. The
 //! finished runs then count as copied in, and `sweep run` trains the rest.
 
@@ -25,27 +25,6 @@ pub struct Restored {
     /// The committed runs (their directories in the sweep) whose configuration is not the one
     /// the manifest plans today (another commit's presets, or a setting changed on a resume).
     pub departures: Vec<String>,
-}
-
-/// Copies every file under `from` into `to` (folders created), keeping relative paths.
-fn copy_tree(from: &Path, to: &Path) -> Result<()> {
-    std::fs::create_dir_all(to).doing(|| format!("creating {}", to.display()))?;
-    for entry in std::fs::read_dir(from).doing(|| format!("reading {}", from.display()))? {
-        let path = entry
-            .doing(|| format!("reading {}", from.display()))?
-            .path();
-        let Some(name) = path.file_name() else {
-            continue;
-        };
-        let target = to.join(name);
-        if path.is_dir() {
-            copy_tree(&path, &target)?;
-        } else {
-            let bytes = std::fs::read(&path).doing(|| format!("reading {}", path.display()))?;
-            seads_run::store::write_atomic(&target, &bytes)?;
-        }
-    }
-    Ok(())
 }
 
 /// Lays the committed sweep `committed` out again in `out` (which must not exist), planned by
@@ -130,7 +109,7 @@ fn lay_out(
             Ok(_) => departures.push(run.dir.clone()),
             Err(e) => fail!("{}: {e}", config_file.display()),
         }
-        copy_tree(&from, &to)?;
+        crate::run_data::copy_data(&from, &to)?;
         copied += 1;
     }
     Ok(Restored {
