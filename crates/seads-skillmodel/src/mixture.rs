@@ -36,7 +36,9 @@ use tch::nn::Module;
 use tch::{Device, Kind, Tensor};
 
 use crate::SkillModelError;
-use crate::model::{EPS, SkillModel, SkillModelConfig, SkillTransition, Trainable, states_tensor};
+use crate::model::{
+    EPS, SkillModel, SkillModelConfig, SkillTransition, Trainable, skill_inputs, states_tensor,
+};
 use seads_nn::mean_f32;
 
 /// The mixture forward model.
@@ -68,23 +70,11 @@ impl MixtureModel {
         self.m
     }
 
-    /// Network input rows `[z_0, onehot(k)]`.
-    fn inputs(&self, z0: &[SymbolicState], skills: &[usize]) -> Tensor {
-        let width = self.d + self.k;
-        let mut data = vec![0.0f32; z0.len() * width];
-        for ((row, z), &k) in data.chunks_mut(width).zip(z0).zip(skills) {
-            z.write_f32(&mut row[..self.d]);
-            row[self.d + k] = 1.0;
-        }
-        Tensor::from_slice(&data)
-            .view([z0.len() as i64, width as i64])
-            .to_device(self.device)
-    }
-
     /// The network's output for each `(z_0, k)`, split: mixture log-weights (n × M, log-softmax)
     /// and flip logits (n × M × D).
     fn heads(&self, z0: &[SymbolicState], skills: &[usize]) -> (Tensor, Tensor) {
-        let out = self.network.net.forward(&self.inputs(z0, skills));
+        let inputs = skill_inputs(z0, skills, self.d, self.k, self.device);
+        let out = self.network.net.forward(&inputs);
         let (n, m, d) = (z0.len() as i64, self.m as i64, self.d as i64);
         let log_weights = out.narrow(1, 0, m).log_softmax(1, Kind::Float);
         let flips = out.narrow(1, m, m * d).view([n, m, d]);

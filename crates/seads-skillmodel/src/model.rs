@@ -53,6 +53,25 @@ pub trait SkillModel: Send {
     fn load(&mut self, dir: &Path, optimiser: bool) -> Result<(), SkillModelError>;
 }
 
+/// Network input rows `[z_0, onehot(k)]` for `d`-bit states and `k` skills, on `device`.
+pub(crate) fn skill_inputs(
+    z0: &[SymbolicState],
+    skills: &[usize],
+    d: usize,
+    k: usize,
+    device: Device,
+) -> Tensor {
+    let width = d + k;
+    let mut data = vec![0.0f32; z0.len() * width];
+    write_bits(&mut data, width, 0, z0.iter().copied(), d);
+    for (row, &skill) in data.chunks_mut(width).zip(skills) {
+        row[d + skill] = 1.0;
+    }
+    Tensor::from_slice(&data)
+        .view([z0.len() as i64, width as i64])
+        .to_device(device)
+}
+
 /// Writes the first `d` bits of each state as 0/1 floats into consecutive rows of width `width`
 /// starting at column `offset`.
 fn write_bits(
@@ -152,15 +171,7 @@ impl ForwardModel {
 
     /// Network input rows `[z_0, onehot(k)]`.
     fn inputs(&self, z0: &[SymbolicState], skills: &[usize]) -> Tensor {
-        let width = self.d + self.k;
-        let mut data = vec![0.0f32; z0.len() * width];
-        write_bits(&mut data, width, 0, z0.iter().copied(), self.d);
-        for (row, &k) in data.chunks_mut(width).zip(skills) {
-            row[self.d + k] = 1.0;
-        }
-        Tensor::from_slice(&data)
-            .view([z0.len() as i64, width as i64])
-            .to_device(self.device)
+        skill_inputs(z0, skills, self.d, self.k, self.device)
     }
 
     /// Per-bit log-likelihood of the observed outcome, from flip logits and whether each bit
